@@ -1,0 +1,205 @@
+#include "effects/fog.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+namespace effects::fog {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const double kLn255 = std::log(255.0);
+
+bool finite(double v) { return std::isfinite(v); }
+
+// x * y where 0 * infinity counts as 0: a zero coefficient means "no fog", whatever the distance.
+double mulZero(double x, double y) { return (x == 0.0 || y == 0.0) ? 0.0 : x * y; }
+
+// log g(x), g(x) = (1 - e^-x) / x, stable for all real x.
+double logG(double x) {
+  if (x == 0.0) return 0.0;
+  if (x > 0.0) return std::log(-std::expm1(-x)) - std::log(x);
+  if (x > -700.0) return std::log(std::expm1(-x)) - std::log(-x);
+  return -x - std::log(-x);  // e^-x dominates; log1p(-e^x) underflows to 0
+}
+
+}  // namespace
+
+const char* toString(FogType type) {
+  switch (type) {
+    case FogType::kX3dLinear: return "LINEAR";
+    case FogType::kX3dExponential: return "EXPONENTIAL";
+    case FogType::kGlLinear: return "GL_LINEAR";
+    case FogType::kGlExp: return "GL_EXP";
+    case FogType::kGlExp2: return "GL_EXP2";
+    case FogType::kDistanceExp2: return "DISTANCE_EXP2";
+    case FogType::kDistanceGaussian: return "DISTANCE_GAUSSIAN";
+    case FogType::kHeight: return "HEIGHT";
+  }
+  return "?";
+}
+
+std::optional<FogType> fogTypeFromString(const std::string& name) {
+  for (FogType t : {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear, FogType::kGlExp,
+                    FogType::kGlExp2, FogType::kDistanceExp2, FogType::kDistanceGaussian, FogType::kHeight}) {
+    if (name == toString(t)) return t;
+  }
+  return std::nullopt;
+}
+
+std::optional<Error> validate(const Fog& fog) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(fog.color[i] >= 0.0 && fog.color[i] <= 1.0))
+      return invalid("/color/" + std::to_string(i), "must be in [0, 1]");
+  }
+  auto nonNegative = [](double v, const char* field) -> std::optional<Error> {
+    if (!(v >= 0.0) || !finite(v)) return invalid(field, "must be a finite number >= 0");
+    return std::nullopt;
+  };
+  switch (fog.type) {
+    case FogType::kX3dLinear:
+    case FogType::kX3dExponential: return nonNegative(fog.visibilityRange, "/visibilityRange");
+    case FogType::kGlLinear:
+      if (!finite(fog.start) || fog.start < 0.0) return invalid("/start", "must be a finite number >= 0");
+      if (!finite(fog.end) || !(fog.end > fog.start)) return invalid("/end", "must be finite and greater than start");
+      return std::nullopt;
+    case FogType::kGlExp:
+    case FogType::kGlExp2: return nonNegative(fog.density, "/density");
+    case FogType::kDistanceGaussian:
+      if (!(fog.peak > 0.0 && fog.peak <= 1.0)) return invalid("/peak", "must be in (0, 1]");
+      [[fallthrough]];
+    case FogType::kDistanceExp2: return nonNegative(fog.distanceCoefficient, "/distanceCoefficient");
+    case FogType::kHeight:
+      if (auto e = nonNegative(fog.density, "/density")) return e;
+      if (auto e = nonNegative(fog.heightFalloff, "/heightFalloff")) return e;
+      if (!finite(fog.baseHeight)) return invalid("/baseHeight", "must be finite");
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+double heightOpticalDepth(double a, double b, double h, double originY, double dirY, double t) {
+  if (a == 0.0 || t == 0.0) return 0.0;
+  if (b == 0.0) return a * t;  // uniform density; a * inf = inf
+  const double k = b * dirY;   // density along the ray: a e^{-b(oy-h)} e^{-k s}
+  const double logBase = std::log(a) - b * (originY - h);
+  if (std::isinf(t)) {
+    if (k <= 0.0) return kInf;              // level or descending ray into ever denser fog
+    double logTau = logBase - std::log(k);  // integral of e^{-k s} over [0, inf) = 1/k
+    return logTau > 709.0 ? kInf : std::exp(logTau);
+  }
+  double logTau = logBase + std::log(t) + logG(k * t);
+  return logTau > 709.0 ? kInf : std::exp(logTau);
+}
+
+double heightOpticalDepthMarched(double a, double b, double h, double originY, double dirY, double t, int steps) {
+  const double dt = t / steps;
+  double sum = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    double y = originY + dirY * (i + 0.5) * dt;
+    sum += a * std::exp(-b * (y - h));
+  }
+  return sum * dt;
+}
+
+double factor(const Fog& fog, double d) {
+  switch (fog.type) {
+    case FogType::kX3dLinear: {
+      const double v = fog.visibilityRange;
+      if (v <= 0.0) return 1.0;
+      return d >= v ? 0.0 : (v - d) / v;
+    }
+    case FogType::kX3dExponential: {
+      const double v = fog.visibilityRange;
+      if (v <= 0.0) return 1.0;
+      return d >= v ? 0.0 : std::exp(-d / (v - d));  // d/(v-d) -> +inf as d -> v: f -> 0
+    }
+    case FogType::kGlLinear: return std::clamp((fog.end - d) / (fog.end - fog.start), 0.0, 1.0);
+    case FogType::kGlExp: return std::exp(-mulZero(fog.density, d));
+    case FogType::kGlExp2: {
+      double x = mulZero(fog.density, d);
+      return std::exp(-x * x);
+    }
+    case FogType::kDistanceExp2: return std::exp(-mulZero(fog.distanceCoefficient, d * d));  // seed 003 eqn 1
+    case FogType::kDistanceGaussian:  // seed 003 eqn 2, parameterised (see header)
+      return fog.peak * std::exp(-mulZero(fog.distanceCoefficient, d * d));
+    case FogType::kHeight:
+      return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, fog.baseHeight, 0.0, d));
+  }
+  return 1.0;
+}
+
+double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance) {
+  if (fog.type != FogType::kHeight) return factor(fog, distance);
+  double len = glm::length(direction);
+  if (!(len > 0.0) || !finite(len)) return 1.0;
+  double dirY = std::clamp(direction.y / len, -1.0, 1.0);
+  return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, origin.y, dirY, distance));
+}
+
+double completeDistance(const Fog& fog, double cameraHeight) {
+  switch (fog.type) {
+    case FogType::kX3dLinear:
+    case FogType::kX3dExponential: return fog.visibilityRange > 0.0 ? fog.visibilityRange : kInf;
+    case FogType::kGlLinear: return fog.end;
+    case FogType::kGlExp: return fog.density > 0.0 ? kLn255 / fog.density : kInf;
+    case FogType::kGlExp2: return fog.density > 0.0 ? std::sqrt(kLn255) / fog.density : kInf;
+    case FogType::kDistanceExp2:
+      return fog.distanceCoefficient > 0.0 ? std::sqrt(kLn255 / fog.distanceCoefficient) : kInf;
+    case FogType::kDistanceGaussian: {
+      double l = std::log(255.0 * fog.peak);
+      if (l <= 0.0) return 0.0;
+      return fog.distanceCoefficient > 0.0 ? std::sqrt(l / fog.distanceCoefficient) : kInf;
+    }
+    case FogType::kHeight: {
+      // Horizontal ray: tau = a e^{-b(y-h)} t  ->  t = ln 255 / (a e^{-b(y-h)}), in log space.
+      if (fog.density == 0.0) return kInf;
+      double logT = std::log(kLn255) - std::log(fog.density) + fog.heightFalloff * (cameraHeight - fog.baseHeight);
+      return logT > 709.0 ? kInf : std::exp(logT);
+    }
+  }
+  return kInf;
+}
+
+std::optional<Error> validate(const Region& r) {
+  if (r.shape == Region::Shape::kBox) {
+    for (int i = 0; i < 3; ++i) {
+      if (!finite(r.min[i]) || !finite(r.max[i])) return invalid("/box", "corners must be finite");
+      if (r.min[i] > r.max[i]) return invalid("/box/max/" + std::to_string(i), "must be >= min");
+    }
+  } else {
+    for (int i = 0; i < 3; ++i)
+      if (!finite(r.center[i])) return invalid("/sphere/center/" + std::to_string(i), "must be finite");
+    if (!finite(r.radius) || r.radius < 0.0) return invalid("/sphere/radius", "must be a finite number >= 0");
+  }
+  if (auto e = validate(r.fog)) return Error{e->kind, "/fog" + e->field, e->message};
+  return std::nullopt;
+}
+
+int regionAt(const std::vector<Region>& regions, const glm::dvec3& p) {
+  int best = -1;
+  double bestVolume = kInf;
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const Region& r = regions[i];
+    double volume;
+    bool inside;
+    if (r.shape == Region::Shape::kBox) {
+      inside = p.x >= r.min.x && p.x <= r.max.x && p.y >= r.min.y && p.y <= r.max.y && p.z >= r.min.z && p.z <= r.max.z;
+      glm::dvec3 e = r.max - r.min;
+      volume = e.x * e.y * e.z;
+    } else {
+      glm::dvec3 d = p - r.center;
+      inside = glm::dot(d, d) <= r.radius * r.radius;
+      volume = 4.0 / 3.0 * 3.14159265358979323846 * r.radius * r.radius * r.radius;
+    }
+    if (inside && (best < 0 || volume < bestVolume)) {
+      best = static_cast<int>(i);
+      bestVolume = volume;
+    }
+  }
+  return best;
+}
+
+}  // namespace effects::fog

@@ -1,0 +1,150 @@
+// Fog colour tables: sampling, their interpolation error, and the smallest size for an error.
+#include <algorithm>
+#include <cmath>
+
+#include "effects/fog.h"
+
+namespace effects::fog {
+namespace {
+
+double dirYAt(const Table& t, double row) { return t.height == 1 ? 0.0 : -1.0 + 2.0 * row / double(t.height - 1); }
+double distAt(const Table& t, double col) {
+  return t.rangeStart + (t.rangeEnd - t.rangeStart) * col / double(t.width - 1);
+}
+
+double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
+  if (fog.type != FogType::kHeight) return factor(fog, d);
+  return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, cameraHeight, dirY, d));
+}
+
+void fill(const Fog& fog, double cameraHeight, Table& t) {
+  t.factor.resize(t.width * t.height);
+  for (size_t j = 0; j < t.height; ++j) {
+    double dirY = dirYAt(t, double(j));
+    for (size_t i = 0; i < t.width; ++i)
+      t.factor[j * t.width + i] = static_cast<float>(exact(fog, cameraHeight, distAt(t, double(i)), dirY));
+  }
+}
+
+Result<Table> sized(const Fog& fog, const TableOptions& o, size_t width, size_t height, double start, double end) {
+  Table t;
+  t.width = width;
+  t.height = height;
+  t.rangeStart = start;
+  t.rangeEnd = end;
+  Stopwatch watch;
+  fill(fog, o.cameraHeight, t);
+  t.stats.elapsedMs = watch.ms();
+  t.stats.method = std::string("table-") + toString(fog.type);
+  t.stats.counters["entries"] = double(width * height);
+  return t;
+}
+
+}  // namespace
+
+double measureTableError(const Fog& fog, const Table& t, double cameraHeight, int sub, double* where) {
+  double worst = 0.0, worstAt = t.rangeStart;
+  const size_t rows = t.height == 1 ? 1 : (t.height - 1) * size_t(sub) + 1;
+  const size_t cols = (t.width - 1) * size_t(sub) + 1;
+  for (size_t r = 0; r < rows; ++r) {
+    double row = t.height == 1 ? 0.0 : double(r) / sub;
+    size_t j0 = std::min(size_t(row), t.height - 1), j1 = std::min(j0 + 1, t.height - 1);
+    double fy = row - double(j0);
+    for (size_t c = 0; c < cols; ++c) {
+      double col = double(c) / sub;
+      size_t i0 = std::min(size_t(col), t.width - 1), i1 = std::min(i0 + 1, t.width - 1);
+      double fx = col - double(i0);
+      auto at = [&](size_t j, size_t i) { return double(t.factor[j * t.width + i]); };
+      double lerp0 = at(j0, i0) + (at(j0, i1) - at(j0, i0)) * fx;
+      double lerp1 = at(j1, i0) + (at(j1, i1) - at(j1, i0)) * fx;
+      double approx = lerp0 + (lerp1 - lerp0) * fy;
+      double d = distAt(t, col);
+      double e = std::fabs(approx - exact(fog, cameraHeight, d, dirYAt(t, row)));
+      if (e > worst) {
+        worst = e;
+        worstAt = d;
+      }
+    }
+  }
+  if (where) *where = worstAt;
+  return worst;
+}
+
+Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
+  if (auto e = validate(fog)) return *e;
+  const bool twoD = fog.type == FogType::kHeight;
+  double start = o.rangeStart.value_or(0.0);
+  double end = o.rangeEnd ? *o.rangeEnd : completeDistance(fog, o.cameraHeight);
+  if (!std::isfinite(start) || start < 0.0) return invalid("/range/0", "must be a finite distance >= 0");
+  if (!o.rangeEnd && !(std::isfinite(end) && end > start))
+    return unsatisfiable("/range", "this fog never reaches 1/255 within a finite distance; give range explicitly");
+  if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
+
+  constexpr int kSub1D = 8, kSub2D = 4;
+  const int sub = twoD ? kSub2D : kSub1D;
+  auto entries = [&](size_t n, size_t m) { return n * (twoD ? m : 1); };
+  auto measure = [&](Table& t) {
+    Stopwatch w;
+    t.maxError = measureTableError(fog, t, o.cameraHeight, sub, &t.errorAtDistance);
+    t.stats.counters["errorMs"] = w.ms();
+    t.stats.error = t.maxError;
+    t.stats.errorMetric = "max |lerp(table) - f| over " + std::to_string(sub) + "x denser sampling";
+    t.stats.reference = "exact closed form";
+  };
+
+  if (o.size != 0) {
+    size_t m = twoD ? (o.elevations ? o.elevations : o.size) : 1;
+    if (o.size < 2 || (twoD && m < 2)) return invalid("/size", "must be >= 2");
+    if (entries(o.size, m) > o.maxSize)
+      return overLimit("/size", "table of " + std::to_string(entries(o.size, m)) + " entries exceeds the limit of " +
+                                    std::to_string(o.maxSize));
+    auto t = sized(fog, o, o.size, m, start, end);
+    if (o.measureError) measure(t.value());
+    return t;
+  }
+
+  // Smallest N with error <= maxError: double N until it meets the bound, then bisect.
+  // (Height fog tables stay square.) The error of linear interpolation falls like 1/N^2 for
+  // smooth f, so the search ends after a handful of measurements.
+  if (!(o.maxError > 0.0)) return invalid("/maxError", "must be > 0 when size is not given");
+  Stopwatch total;
+  auto errorFor = [&](size_t n) {
+    auto t = sized(fog, o, n, twoD ? n : 1, start, end);
+    measure(t.value());
+    return t;
+  };
+  size_t lo = 1, hi = 2;
+  auto best = errorFor(hi);
+  int measurements = 1;
+  while (best.value().maxError > o.maxError) {
+    lo = hi;
+    if (entries(hi * 2, hi * 2) > o.maxSize) {
+      size_t cap = twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize;
+      if (cap <= hi) return unsatisfiable("/maxError", "not reachable within the table size limit");
+      hi = cap;
+    } else {
+      hi *= 2;
+    }
+    best = errorFor(hi);
+    ++measurements;
+    if (best.value().maxError > o.maxError && hi == (twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize))
+      return unsatisfiable("/maxError", "error " + std::to_string(best.value().maxError) +
+                                            " at the size limit is above the requested maximum");
+  }
+  while (hi - lo > 1) {
+    size_t mid = lo + (hi - lo) / 2;
+    auto t = errorFor(mid);
+    ++measurements;
+    if (t.value().maxError <= o.maxError) {
+      hi = mid;
+      best = std::move(t);
+    } else {
+      lo = mid;
+    }
+  }
+  best.value().stats.counters["searchMeasurements"] = measurements;
+  best.value().stats.counters["searchMs"] = total.ms();
+  return best;
+}
+
+}  // namespace effects::fog

@@ -1,0 +1,128 @@
+// effects/fog.h — fog weight functions, local fog regions, exact height fog, colour tables.
+//
+// Source: seed 003 (Park, Chin & Kim, "Improving VRML/X3D Fog Effect Using Distance
+// Coefficient"), ISO/IEC 19775-1 (X3D Fog/LocalFog), OpenGL 1.x fixed-function fog, and the
+// exponential height fog engines ship (Unreal, Filament).
+//
+// Every mode yields the *object weight* f in [0, 1] (X3D's name; the paper's density rho):
+// the final colour is C = f * C_object + (1 - f) * C_fog (X3D; seed 003 eqn 3). f is
+// non-increasing in distance and finite for every finite or infinite non-negative distance.
+//
+// Units: distances in scene units (metres by convention); colours linear RGB in [0, 1].
+// Thread-safety: all functions are pure and reentrant.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "effects/common.h"
+
+namespace effects::fog {
+
+enum class FogType {
+  kX3dLinear,         // X3D "LINEAR":      f = (V - d) / V for d < V, else 0; V = 0 disables fog
+  kX3dExponential,    // X3D "EXPONENTIAL": f = exp(-d / (V - d)) for d < V, else 0
+  kGlLinear,          // GL_LINEAR:         f = clamp((end - d) / (end - start), 0, 1)
+  kGlExp,             // GL_EXP:            f = exp(-density * d)
+  kGlExp2,            // GL_EXP2:           f = exp(-(density * d)^2)
+  kDistanceExp2,      // seed 003 eqn 1:    f = 1 / e^(d_c * z^2)  (GL_EXP2 with density sqrt(d_c))
+  kDistanceGaussian,  // seed 003 eqn 2:    f = peak * e^(-d_c * z^2)   (see below)
+  kHeight,            // exponential height fog: f = exp(-tau), tau the exact optical depth
+};
+
+// Seed 003 eqn 2 prints rho = (1/sqrt(2*pi)) * e^(-0.5 z^2) with no d_c although the text says
+// it depends on d_c. effectd parameterises it as rho = peak * e^(-d_c * z^2): the printed curve
+// is d_c = 0.5 with the default peak = 1/sqrt(2*pi). peak < 1 means objects never show their
+// full colour (the paper's curve starts at 0.399); peak = 1 makes it identical to eqn 1.
+inline constexpr double kPaperGaussianPeak = 0.3989422804014327;  // 1/sqrt(2*pi)
+
+struct Fog {
+  FogType type = FogType::kX3dLinear;
+  glm::dvec3 color{1.0, 1.0, 1.0};    // X3D default 1 1 1; each component in [0, 1]
+  double visibilityRange = 0.0;       // X3D V >= 0; 0 = no fog
+  double start = 0.0, end = 1.0;      // GL_LINEAR, 0 <= start < end
+  double density = 1.0;               // GL_EXP/GL_EXP2 >= 0; height fog: density a >= 0 at baseHeight
+  double distanceCoefficient = 0.07;  // d_c >= 0 (seed 003's worked example uses 0.07)
+  double peak = kPaperGaussianPeak;   // kDistanceGaussian only, in (0, 1]
+  double heightFalloff = 0.1;         // height fog b >= 0: density a * e^(-b (y - h))
+  double baseHeight = 0.0;            // height fog h
+};
+
+// Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT").
+const char* toString(FogType type);
+std::optional<FogType> fogTypeFromString(const std::string& name);
+
+// Field errors name the Fog member, e.g. "/visibilityRange".
+std::optional<Error> validate(const Fog& fog);
+
+// f for a point at `distance` from the viewer. For kHeight this is a horizontal ray at
+// baseHeight (use factorAlongRay for the general case). distance may be +infinity.
+double factor(const Fog& fog, double distance);
+
+// f along the ray origin + t * direction, t in [0, distance]; `direction` need not be unit
+// length (a zero direction means distance 0). Distance-based modes use `distance` only.
+double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance);
+
+// Exact optical depth of density a * e^(-b (y - h)) along the ray from height originY with
+// unit-vector y component dirY over length t (t may be +infinity):
+//   tau = a * e^(-b (originY - h)) * t * g(b * dirY * t),  g(x) = (1 - e^(-x)) / x,
+// evaluated in log space with expm1 so that horizontal rays (x -> 0), extreme b and camera
+// heights never overflow to NaN. Returns +infinity when the depth is unbounded.
+double heightOpticalDepth(double a, double b, double h, double originY, double dirY, double t);
+
+// The same integral by the midpoint rule with `steps` samples (the ray-marching reference
+// the closed form is measured against; t must be finite).
+double heightOpticalDepthMarched(double a, double b, double h, double originY, double dirY, double t, int steps);
+
+// Distance where f first reaches 1/255 ("complete to 8 bits"); infinity if never.
+// For kHeight: along a horizontal ray from cameraHeight.
+double completeDistance(const Fog& fog, double cameraHeight = 0.0);
+
+// X3D LocalFog generalised: a region with its own fog. Regions are closed sets (a point on
+// the surface is inside). A point takes the innermost region containing it, that is the one
+// of smallest volume; between equal volumes the earlier region in the list wins. Outside
+// every region the global fog applies. The distance is always viewer-to-point.
+struct Region {
+  enum class Shape { kBox, kSphere } shape = Shape::kBox;
+  glm::dvec3 min{0.0}, max{0.0};  // box, min <= max per axis
+  glm::dvec3 center{0.0};         // sphere
+  double radius = 0.0;            // sphere, >= 0
+  Fog fog;
+};
+std::optional<Error> validate(const Region& region);
+// Index of the region that applies at `point`, or -1 for the global fog.
+int regionAt(const std::vector<Region>& regions, const glm::dvec3& point);
+
+// ---- Colour tables ---------------------------------------------------------------------
+struct TableOptions {
+  size_t size = 0;           // distance samples N >= 2; 0 = pick the smallest N meeting maxError
+  double maxError = 0.0;     // used when size == 0: largest acceptable interpolation error
+  size_t maxSize = 65536;    // bound on entries (size * elevations)
+  std::optional<double> rangeStart, rangeEnd;  // default [0, completeDistance]
+  size_t elevations = 0;     // kHeight only: samples of the ray's y component over [-1, 1];
+                             // 0 = same as size
+  double cameraHeight = 0.0; // kHeight only
+  bool measureError = true;  // dense-sampling error measurement (costs ~8 evaluations/entry)
+};
+
+struct Table {
+  size_t width = 0;       // distance samples
+  size_t height = 1;      // elevation samples (1 for distance-only fogs)
+  double rangeStart = 0.0, rangeEnd = 0.0;
+  std::vector<float> factor;  // row-major [elevation][distance]; f at d_i = start + i*(end-start)/(width-1),
+                              // dirY_j = -1 + 2j/(height-1)
+  double maxError = 0.0;      // max |lerp(table) - f_exact| by dense sampling (if measured)
+  double errorAtDistance = 0.0;
+  Stats stats;                // method, elapsedMs (table only), counters: entries, evaluations
+};
+
+Result<Table> buildTable(const Fog& fog, const TableOptions& options);
+
+// Max |interpolated - exact| of `table` by dense sampling (subdivisions per interval).
+double measureTableError(const Fog& fog, const Table& table, double cameraHeight, int subdivisions, double* where = nullptr);
+
+}  // namespace effects::fog

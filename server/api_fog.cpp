@@ -1,0 +1,189 @@
+// POST /v1/fog — fog definitions -> weight tables (with their error), region lookups.
+#include <cmath>
+
+#include <effects/fog.h>
+
+#include "codec.h"
+#include "endpoints.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace fog = effects::fog;
+
+fog::Fog parseFog(const json& j, const std::string& pointer) {
+  fog::Fog f;
+  f.type = *fog::fogTypeFromString(j.value("fogType", "LINEAR"));  // enum checked by the schema
+  if (j.contains("color")) f.color = toVec3(j["color"]);
+  f.visibilityRange = j.value("visibilityRange", f.visibilityRange);
+  f.start = j.value("start", f.start);
+  f.end = j.value("end", f.end);
+  f.density = j.value("density", f.density);
+  f.distanceCoefficient = j.value("distanceCoefficient", f.distanceCoefficient);
+  f.peak = j.value("peak", f.peak);
+  f.heightFalloff = j.value("heightFalloff", f.heightFalloff);
+  f.baseHeight = j.value("baseHeight", f.baseHeight);
+  if (auto e = fog::validate(f)) throwError(*e, pointer);
+  return f;
+}
+
+fog::Region parseRegion(const json& j, const std::string& pointer) {
+  fog::Region r;
+  if (j.contains("box") == j.contains("sphere"))
+    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": give exactly one of box or sphere",
+                   {{pointer, "give exactly one of box or sphere"}}, {}};
+  if (j.contains("box")) {
+    r.shape = fog::Region::Shape::kBox;
+    r.min = toVec3(j["box"]["min"]);
+    r.max = toVec3(j["box"]["max"]);
+  } else {
+    r.shape = fog::Region::Shape::kSphere;
+    r.center = toVec3(j["sphere"]["center"]);
+    r.radius = j["sphere"]["radius"].get<double>();
+  }
+  r.fog = parseFog(j["fog"], pointer + "/fog");
+  if (auto e = fog::validate(r)) throwError(*e, pointer);
+  return r;
+}
+
+std::string encodeTexels(const fog::Table& t, const fog::Fog& f, const std::string& encoding) {
+  // Texel = ((1 - f) * fogColor, f): the shader computes objectColour * a + rgb.
+  std::string bytes;
+  bytes.reserve(t.factor.size() * (encoding == "rgba8" ? 4 : 8));
+  for (float w : t.factor) {
+    float texel[4] = {float((1 - w) * f.color.r), float((1 - w) * f.color.g), float((1 - w) * f.color.b), w};
+    for (float c : texel) {
+      if (encoding == "rgba8") {
+        bytes += char(static_cast<uint8_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)));
+      } else {
+        uint16_t h = floatToHalf(c);
+        bytes += char(h & 0xFF);
+        bytes += char(h >> 8);
+      }
+    }
+  }
+  return base64Encode(bytes);
+}
+
+json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, const json& objectColors) {
+  json out = {{"fogType", fog::toString(f.type)},
+              {"size", t.width},
+              {"range", {t.rangeStart, t.rangeEnd}},
+              {"maxError", t.maxError},
+              {"errorAtDistance", t.errorAtDistance}};
+  if (t.height > 1) {
+    out["elevations"] = t.height;
+    out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";
+  }
+  const std::string encoding = options.value("encoding", "json");
+  out["encoding"] = encoding;
+  if (encoding == "json") {
+    json factor = json::array(), contribution = json::array();
+    for (float w : t.factor) {
+      factor.push_back(w);
+      for (int c = 0; c < 3; ++c) contribution.push_back(wire((1.0 - w) * f.color[c]));
+    }
+    out["factor"] = std::move(factor);
+    out["fogContribution"] = std::move(contribution);
+    if (!objectColors.is_null()) {
+      json finals = json::array();
+      for (const auto& oc : objectColors) {
+        glm::dvec3 o = toVec3(oc);
+        json row = json::array();
+        for (float w : t.factor)
+          for (int c = 0; c < 3; ++c) row.push_back(wire(w * o[c] + (1.0 - w) * f.color[c]));
+        finals.push_back(std::move(row));
+      }
+      out["finalColors"] = std::move(finals);
+    }
+  } else {
+    out["texelLayout"] = "RGBA = ((1-f)*fogColor, f), row-major, " +
+                         std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
+    out["data"] = encodeTexels(t, f, encoding);
+  }
+  return out;
+}
+
+fog::TableOptions tableOptions(const json& o, const Config& config) {
+  fog::TableOptions opt;
+  opt.maxSize = config.limits.maxTableSize;
+  opt.size = o.value("size", size_t(0));
+  opt.maxError = o.value("maxError", 0.0);
+  if (!o.contains("size") && !o.contains("maxError")) opt.size = 256;
+  if (o.contains("range")) {
+    opt.rangeStart = o["range"][0].get<double>();
+    opt.rangeEnd = o["range"][1].get<double>();
+  }
+  opt.elevations = o.value("elevations", size_t(0));
+  opt.cameraHeight = o.value("cameraHeight", 0.0);
+  return opt;
+}
+
+JsonReply handleFog(const json& body, const RequestContext& ctx) {
+  Includes include(body, {"table"});
+  fog::Fog global = parseFog(body["fog"], "/fog");
+  std::vector<fog::Region> regions;
+  if (body.contains("regions"))
+    for (size_t i = 0; i < body["regions"].size(); ++i)
+      regions.push_back(parseRegion(body["regions"][i], "/regions/" + std::to_string(i)));
+  const json tableOpts = body.value("table", json::object());
+  const json objectColors = body.contains("objectColors") ? body["objectColors"] : json();
+
+  JsonReply reply;
+  reply.method = std::string("table-") + fog::toString(global.type);
+  json out = {{"method", reply.method}};
+  json stats = json::array();
+  auto build = [&](const fog::Fog& f, const std::string& pointer) {
+    auto t = fog::buildTable(f, tableOptions(tableOpts, ctx.config));
+    if (!t.ok()) {
+      effects::Error e = t.error();
+      throwError(e, e.field == "/range" || e.field.rfind("/range/", 0) == 0 || e.field == "/size" ||
+                            e.field == "/maxError"
+                        ? "/table"
+                        : pointer);
+    }
+    reply.computeMs += t.value().stats.elapsedMs;
+    stats.push_back(statsJson(t.value().stats));
+    return tableJson(t.value(), f, tableOpts, objectColors);
+  };
+  if (include.has("table")) {
+    out["table"] = build(global, "/fog");
+    out["error"] = {{"maxError", out["table"]["maxError"]},
+                    {"metric", "max |linear interpolation of the table - exact f|"},
+                    {"reference", "exact closed form"}};
+  }
+  if (include.has("regionTables")) {
+    json list = json::array();
+    for (size_t i = 0; i < regions.size(); ++i)
+      list.push_back(build(regions[i].fog, "/regions/" + std::to_string(i) + "/fog"));
+    out["regionTables"] = std::move(list);
+  }
+  if (include.has("samples")) {
+    if (!body.contains("samples"))
+      throw ApiError{400, "invalid-field", "Invalid field", "/samples: required when include has \"samples\"",
+                     {{"/samples", "is required when include has \"samples\""}}, {}};
+    effects::Stopwatch watch;
+    glm::dvec3 camera = toVec3(body["samples"]["camera"]);
+    json list = json::array();
+    for (const auto& pj : body["samples"]["points"]) {
+      glm::dvec3 p = toVec3(pj);
+      int r = fog::regionAt(regions, p);
+      const fog::Fog& f = r < 0 ? global : regions[size_t(r)].fog;
+      glm::dvec3 d = p - camera;
+      double w = fog::factor(f, camera, d, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
+      list.push_back({{"region", r}, {"factor", wire(w)}});
+    }
+    reply.computeMs += watch.ms();
+    out["samples"] = std::move(list);
+  }
+  if (include.has("stats")) out["stats"] = std::move(stats);
+  reply.body = std::move(out);
+  return reply;
+}
+
+}  // namespace
+
+void addFogEndpoints(Service& service) { service.addJsonEndpoint("/v1/fog", "fog.json", handleFog); }
+
+}  // namespace effectd

@@ -1,0 +1,125 @@
+#include "config.h"
+
+#include <cstdlib>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+namespace effectd {
+namespace {
+
+struct Option {
+  const char* flag;  // without the leading "--"
+  const char* env;
+  const char* help;
+  std::function<bool(const std::string&, Config&)> set;
+};
+
+bool parseInt(const std::string& s, long long lo, long long hi, long long& out) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  long long v = std::strtoll(s.c_str(), &end, 10);
+  if (errno || *end != '\0' || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+template <class T>
+std::function<bool(const std::string&, Config&)> intField(T Config::*field, long long lo, long long hi) {
+  return [=](const std::string& s, Config& c) {
+    long long v;
+    if (!parseInt(s, lo, hi, v)) return false;
+    c.*field = static_cast<T>(v);
+    return true;
+  };
+}
+
+std::function<bool(const std::string&, Config&)> limitField(size_t Limits::*field, long long lo, long long hi) {
+  return [=](const std::string& s, Config& c) {
+    long long v;
+    if (!parseInt(s, lo, hi, v)) return false;
+    c.limits.*field = static_cast<size_t>(v);
+    return true;
+  };
+}
+
+const std::vector<Option>& options() {
+  static const std::vector<Option> opts = {
+      {"host", "EFFECTD_HOST", "address to listen on (default 127.0.0.1)",
+       [](const std::string& s, Config& c) { c.host = s; return !s.empty(); }},
+      {"port", "EFFECTD_PORT", "TCP port, 0 = any free port (default 8080)", intField(&Config::port, 0, 65535)},
+      {"threads", "EFFECTD_THREADS", "HTTP worker threads (default 8)", intField(&Config::threads, 1, 1024)},
+      {"read-timeout", "EFFECTD_READ_TIMEOUT", "seconds to receive a request (default 10)", intField(&Config::readTimeoutS, 1, 3600)},
+      {"write-timeout", "EFFECTD_WRITE_TIMEOUT", "seconds to send a response (default 10)", intField(&Config::writeTimeoutS, 1, 3600)},
+      {"keep-alive-timeout", "EFFECTD_KEEP_ALIVE_TIMEOUT", "idle seconds before a keep-alive connection closes (default 5)",
+       intField(&Config::keepAliveTimeoutS, 0, 3600)},
+      {"keep-alive-max", "EFFECTD_KEEP_ALIVE_MAX", "requests per connection (default 100)", intField(&Config::keepAliveMaxCount, 1, 1000000)},
+      {"access-log", "EFFECTD_ACCESS_LOG", "1/0: one JSON line per request on stderr (default 1)",
+       [](const std::string& s, Config& c) {
+         if (s != "0" && s != "1" && s != "true" && s != "false") return false;
+         c.accessLog = s == "1" || s == "true";
+         return true;
+       }},
+      {"max-body-bytes", "EFFECTD_MAX_BODY_BYTES", "largest request body (default 16777216)",
+       limitField(&Limits::maxBodyBytes, 1024, 1LL << 32)},
+      {"max-grid-cells", "EFFECTD_MAX_GRID_CELLS", "largest lightning grid, width*height (default 16777216)",
+       limitField(&Limits::maxGridCells, 9, 1LL << 28)},
+      {"max-growth-steps", "EFFECTD_MAX_GROWTH_STEPS", "lightning cells added per request (default 2000000)",
+       limitField(&Limits::maxGrowthSteps, 1, 1LL << 30)},
+      {"max-table-size", "EFFECTD_MAX_TABLE_SIZE", "fog table entries (default 65536)", limitField(&Limits::maxTableSize, 2, 1LL << 24)},
+      {"max-mesh-vertices", "EFFECTD_MAX_MESH_VERTICES", "vertices per mesh (default 2000000)",
+       limitField(&Limits::maxMeshVertices, 3, 1LL << 28)},
+      {"max-mesh-triangles", "EFFECTD_MAX_MESH_TRIANGLES", "triangles per mesh (default 4000000)",
+       limitField(&Limits::maxMeshTriangles, 1, 1LL << 28)},
+  };
+  return opts;
+}
+
+}  // namespace
+
+std::string usage() {
+  std::ostringstream os;
+  os << "usage: effectd [serve] [--flag=value ...]\n"
+        "       effectd --help\n\n"
+        "Flags (environment variable in brackets; flags win over the environment):\n";
+  for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";
+  return os.str();
+}
+
+std::string parseConfig(const std::vector<std::string>& args, Config& config, bool& help) {
+  help = false;
+  for (const auto& o : options()) {
+    if (const char* v = std::getenv(o.env)) {
+      if (!o.set(v, config)) return std::string("invalid value for ") + o.env + ": '" + v + "'";
+    }
+  }
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      help = true;
+      return "";
+    }
+    if (a.rfind("--", 0) != 0) return "unexpected argument '" + a + "'";
+    std::string name = a.substr(2), value;
+    auto eq = name.find('=');
+    if (eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    } else if (i + 1 < args.size()) {
+      value = args[++i];
+    } else {
+      return "flag --" + name + " needs a value";
+    }
+    bool known = false;
+    for (const auto& o : options()) {
+      if (name != o.flag) continue;
+      known = true;
+      if (!o.set(value, config)) return "invalid value for --" + name + ": '" + value + "'";
+    }
+    if (!known) return "unknown flag --" + name;
+  }
+  return "";
+}
+
+}  // namespace effectd

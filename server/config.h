@@ -1,0 +1,39 @@
+// Server configuration: embedded defaults, overridden by environment variables
+// (EFFECTD_HOST, EFFECTD_PORT, ...), overridden by command-line flags (--host, --port, ...).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace effectd {
+
+struct Limits {
+  size_t maxBodyBytes = 16u << 20;     // request body
+  size_t maxGridCells = 4096u * 4096u; // lightning grid width*height
+  size_t maxGrowthSteps = 2'000'000;   // lightning cells added per request
+  size_t maxTableSize = 65536;         // fog table entries (all dimensions together)
+  size_t maxMeshVertices = 2'000'000;  // tangents / bubble meshes
+  size_t maxMeshTriangles = 4'000'000;
+};
+
+struct Config {
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  int threads = 8;
+  int readTimeoutS = 10;
+  int writeTimeoutS = 10;
+  int keepAliveTimeoutS = 5;
+  int keepAliveMaxCount = 100;
+  bool accessLog = true;
+  Limits limits;
+};
+
+// Parses argv (after the program name and an optional sub-command) on top of the
+// environment on top of the defaults. Returns "" on success, otherwise the message to print.
+// Sets `help` when --help was given.
+std::string parseConfig(const std::vector<std::string>& args, Config& config, bool& help);
+
+std::string usage();
+
+}  // namespace effectd

@@ -1,0 +1,39 @@
+// Registration of the effect endpoints. Each api_<effect>.cpp turns validated JSON into
+// library params, calls the library, and turns the result into the response body; nothing
+// else about HTTP is its business.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "service.h"
+
+namespace effectd {
+
+void addEffectEndpoints(Service& service);
+void addFogEndpoints(Service& service);
+
+// --- helpers shared by the api_*.cpp files ---
+glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers
+// The body's "include" list as a set test; `defaults` applies when "include" is absent.
+class Includes {
+ public:
+  Includes(const nlohmann::json& body, std::vector<std::string> defaults);
+  bool has(const std::string& what) const;
+
+ private:
+  std::vector<std::string> items_;
+};
+// Rounds to float precision for the wire (geometry is float; see architecture.md).
+inline double wire(double v) { return static_cast<double>(static_cast<float>(v)); }
+
+}  // namespace effectd
+
+namespace effects { struct Stats; }
+namespace effectd {
+// Stats as JSON: {method, elapsedMs, counters, error, errorMetric, reference}.
+nlohmann::json statsJson(const effects::Stats& stats);
+}  // namespace effectd

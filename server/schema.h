@@ -1,0 +1,50 @@
+// JSON Schema validation of request bodies against the contract in proto/schemas.
+//
+// A focused subset of JSON Schema 2020-12, exactly what proto/ uses: type, enum, const,
+// properties, required, additionalProperties (false or a schema), items, minItems, maxItems,
+// minimum, maximum, exclusiveMinimum, exclusiveMaximum, minLength, maxLength, oneOf, anyOf,
+// allOf, $ref (within a document, "#/$defs/x", or across documents, "common.json#/$defs/x").
+// Annotation keywords (title, description, default, examples, $schema, $id, x-*) are ignored.
+// A keyword outside this subset is a programming error: the registry refuses to load it, so
+// the contract cannot silently say more than the server checks.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace effectd {
+
+struct SchemaViolation {
+  std::string pointer;  // JSON pointer into the instance, "" for the root
+  std::string message;
+};
+
+class SchemaRegistry {
+ public:
+  // Loads every document whose key ends in ".json"; keys are file names ("fog.json").
+  // Throws std::runtime_error on a malformed schema (startup only).
+  explicit SchemaRegistry(const std::map<std::string, std::string>& documents);
+
+  // Validates `instance` against document `name`; returns at most `maxErrors` violations.
+  std::vector<SchemaViolation> validate(const std::string& name, const nlohmann::json& instance,
+                                        size_t maxErrors = 16) const;
+
+  const nlohmann::json& document(const std::string& name) const;
+
+ private:
+  struct Ctx;
+  void check(const nlohmann::json& schema, const std::string& doc, const nlohmann::json& value,
+             const std::string& pointer, Ctx& ctx) const;
+  const nlohmann::json& resolve(const std::string& ref, const std::string& doc, std::string& outDoc) const;
+  void lint(const nlohmann::json& schema, const std::string& doc, const std::string& where) const;
+
+  std::map<std::string, nlohmann::json> docs_;
+};
+
+// Escapes a key for use in a JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1").
+std::string pointerEscape(const std::string& key);
+
+}  // namespace effectd

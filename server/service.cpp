@@ -1,0 +1,395 @@
+#include "service.h"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <cstdio>
+#include <ctime>
+#include <random>
+#include <thread>
+
+#include <effects/common.h>
+
+#include "resources.h"
+
+namespace effectd {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr size_t kMaxJsonDepth = 64;
+
+// Per-request state. A request is served start to finish on one worker thread, from the
+// pre-routing handler to the logger, so thread-local storage is the request's scratch pad.
+struct RequestState {
+  bool active = false;
+  std::chrono::steady_clock::time_point start;
+  std::string route = "unmatched";
+  std::string requestId;
+};
+thread_local RequestState tl;
+
+bool saneRequestId(const std::string& id) {
+  if (id.empty() || id.size() > 128) return false;
+  for (char c : id) {
+    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+              c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string newRequestId() {
+  thread_local std::mt19937_64 gen{std::random_device{}() ^
+                                   static_cast<uint64_t>(std::hash<std::thread::id>{}(std::this_thread::get_id()))};
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(gen()));
+  return buf;
+}
+
+const char* statusTitle(int status) {
+  switch (status) {
+    case 400: return "Bad Request";
+    case 404: return "Not Found";
+    case 405: return "Method Not Allowed";
+    case 408: return "Request Timeout";
+    case 411: return "Length Required";
+    case 413: return "Content Too Large";
+    case 414: return "URI Too Long";
+    case 415: return "Unsupported Media Type";
+    case 416: return "Range Not Satisfiable";
+    case 422: return "Unprocessable Content";
+    case 500: return "Internal Server Error";
+    case 503: return "Service Unavailable";
+    default: return status >= 500 ? "Server Error" : "Client Error";
+  }
+}
+
+std::string mediaType(const std::string& contentType) {
+  std::string t = contentType.substr(0, contentType.find(';'));
+  while (!t.empty() && t.back() == ' ') t.pop_back();
+  for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return t;
+}
+
+std::string jsonEscape(const std::string& s) { return json(s).dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// Parses with a nesting limit: nlohmann's parser is iterative, but a 10^5-deep document
+// still costs memory and time for nothing; the contract is never deeper than a few levels.
+json parseBody(const std::string& body) {
+  json::parser_callback_t limit = [](int depth, json::parse_event_t, json&) {
+    if (depth > static_cast<int>(kMaxJsonDepth)) throw ApiError{400, "invalid-json", "Malformed JSON",
+                                                                "JSON nested deeper than 64 levels", {}, {}};
+    return true;
+  };
+  try {
+    return json::parse(body, limit, /*allow_exceptions=*/true, /*ignore_comments=*/false);
+  } catch (const json::exception& e) {
+    std::string what = e.what();
+    // nlohmann messages look like "[json.exception.parse_error.101] parse error at line 1, ...".
+    auto close = what.find("] ");
+    throw ApiError{400, "invalid-json", "Malformed JSON",
+                   "request body is not valid JSON: " + (close == std::string::npos ? what : what.substr(close + 2)),
+                   {{"", "not valid JSON"}}, {}};
+  }
+}
+
+}  // namespace
+
+struct Service::Route {
+  std::string path;
+  std::vector<std::string> methods;  // GET routes also answer HEAD
+  std::string schema;                // for JSON POST routes
+  JsonHandler json;
+  std::map<std::string, BinaryHandler> binary;  // by media type
+};
+
+ApiError toApiError(const effects::Error& error, const std::string& prefix) {
+  ApiError e;
+  std::string pointer = prefix + error.field;
+  switch (error.kind) {
+    case effects::ErrorKind::kInvalidArgument:
+      e = {400, "invalid-field", "Invalid field", "", {}, {}};
+      break;
+    case effects::ErrorKind::kUnsatisfiable:
+      e = {422, "unsatisfiable", "Request cannot be served", "", {}, {}};
+      break;
+    case effects::ErrorKind::kLimitExceeded:
+      e = {413, "limit-exceeded", "Request exceeds a configured limit", "", {}, {}};
+      break;
+  }
+  e.detail = (pointer.empty() ? std::string("request") : pointer) + ": " + error.message;
+  e.errors.push_back({pointer, error.message});
+  return e;
+}
+
+void throwError(const effects::Error& error, const std::string& prefix) { throw toApiError(error, prefix); }
+
+void writeProblem(httplib::Response& res, const ApiError& p, const std::string& requestId) {
+  json body = {{"type", "https://effectd.dev/problems/" + p.slug},
+               {"title", p.title},
+               {"status", p.status},
+               {"detail", p.detail},
+               {"requestId", requestId}};
+  if (!p.errors.empty()) {
+    json list = json::array();
+    for (const auto& e : p.errors) list.push_back({{"pointer", e.pointer}, {"message", e.message}});
+    body["errors"] = std::move(list);
+  }
+  res.status = p.status;
+  for (const auto& [k, v] : p.headers) res.set_header(k, v);
+  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/problem+json");
+}
+
+Service::Service(Config config) : config_(std::move(config)), http_(std::make_unique<httplib::Server>()) {
+  std::map<std::string, std::string> docs;
+  for (const auto& [name, data] : resources())
+    if (name.rfind("schemas/", 0) == 0) docs[name.substr(8)] = std::string(data);
+  schemas_ = std::make_unique<SchemaRegistry>(docs);
+  installCore();
+}
+
+Service::~Service() = default;
+
+const Service::Route* Service::findRoute(const std::string& path) const {
+  for (const auto& r : routes_)
+    if (r->path == path) return r.get();
+  return nullptr;
+}
+
+void Service::installCore() {
+  httplib::Server& s = *http_;
+  const int threads = config_.threads;
+  s.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  s.set_payload_max_length(config_.limits.maxBodyBytes);
+  s.set_read_timeout(config_.readTimeoutS, 0);
+  s.set_write_timeout(config_.writeTimeoutS, 0);
+  s.set_keep_alive_timeout(config_.keepAliveTimeoutS);
+  s.set_keep_alive_max_count(static_cast<size_t>(config_.keepAliveMaxCount));
+
+  auto addGet = [this](const std::string& path, httplib::Server::Handler h) {
+    auto r = std::make_unique<Route>();
+    r->path = path;
+    r->methods = {"GET", "HEAD"};
+    routes_.push_back(std::move(r));
+    if (h) http_->Get(path, std::move(h));
+  };
+  addGet("/healthz", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content("{\"status\":\"ok\"}", "application/json");
+  });
+  addGet("/readyz", [this](const httplib::Request&, httplib::Response& res) {
+    json components = json::object();
+    bool ready = true;
+    for (const auto& [name, probe] : readiness_) {
+      std::string why = probe();
+      components[name] = why.empty() ? json("ready") : json(why);
+      ready = ready && why.empty();
+    }
+    res.status = ready ? 200 : 503;
+    res.set_content(json{{"status", ready ? "ready" : "not ready"}, {"components", components}}.dump(),
+                    "application/json");
+  });
+  addGet("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  addGet("/v1/openapi.yaml", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(resources().at("openapi.yaml")), "application/yaml");
+  });
+  // Route table entry "/v1/schemas/" stands for every schema document below it.
+  addGet("/v1/schemas/", nullptr);
+  http_->Get(R"(/v1/schemas/([A-Za-z0-9_.-]+))", [](const httplib::Request& req, httplib::Response& res) {
+    auto it = resources().find("schemas/" + req.matches[1].str());
+    if (it == resources().end()) {
+      writeProblem(res, {404, "not-found", "Not Found", "no such schema", {}, {}}, tl.requestId);
+      return;
+    }
+    res.set_content(std::string(it->second), "application/schema+json");
+  });
+
+  s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    tl = RequestState{true, std::chrono::steady_clock::now(), "unmatched", ""};
+    metrics_.requestStarted();
+    std::string given = req.get_header_value("X-Request-ID");
+    tl.requestId = saneRequestId(given) ? given : newRequestId();
+    res.set_header("X-Request-ID", tl.requestId);
+
+    const Route* route = findRoute(req.path);
+    if (!route && req.path.rfind("/v1/schemas/", 0) == 0) route = findRoute("/v1/schemas/");
+    auto fail = [&](const ApiError& p) {
+      writeProblem(res, p, tl.requestId);
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (!route) return fail({404, "not-found", "Not Found", "no resource at " + req.path, {}, {}});
+    tl.route = route->path;
+    bool allowed = false;
+    std::string allow;
+    for (const auto& m : route->methods) {
+      allowed = allowed || m == req.method;
+      allow += (allow.empty() ? "" : ", ") + m;
+    }
+    if (!allowed) {
+      return fail({405, "method-not-allowed", "Method Not Allowed",
+                   req.method + " is not allowed on " + route->path + "; allowed: " + allow, {}, {{"Allow", allow}}});
+    }
+    if (req.method != "POST") return httplib::Server::HandlerResponse::Unhandled;
+
+    // Bodies must come with a Content-Length: chunked bodies bypass the payload limit in
+    // cpp-httplib 0.11.4 (CVE-2025-46728), so they are refused before anything is read.
+    if (req.has_header("Transfer-Encoding")) {
+      return fail({411, "length-required", "Length Required",
+                   "chunked request bodies are not accepted; send Content-Length", {}, {{"Connection", "close"}}});
+    }
+    if (!req.has_header("Content-Length")) {
+      return fail({411, "length-required", "Length Required", "a POST needs a Content-Length header", {},
+                   {{"Connection", "close"}}});
+    }
+    const std::string cl = req.get_header_value("Content-Length");
+    char* end = nullptr;
+    unsigned long long length = std::strtoull(cl.c_str(), &end, 10);
+    if (cl.empty() || *end != '\0' || cl[0] == '-') {
+      return fail({400, "bad-request", "Bad Request", "Content-Length is not a number", {}, {{"Connection", "close"}}});
+    }
+    if (length > config_.limits.maxBodyBytes) {
+      return fail({413, "body-too-large", "Content Too Large",
+                   "request body of " + cl + " bytes exceeds the limit of " +
+                       std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
+                   {}, {{"Connection", "close"}}});
+    }
+    std::string type = mediaType(req.get_header_value("Content-Type"));
+    bool typeOk = (type == "application/json" && route->json) || route->binary.count(type);
+    if (!typeOk) {
+      std::string accepted = route->json ? "application/json" : "";
+      for (const auto& [t, h] : route->binary) accepted += (accepted.empty() ? "" : ", ") + t;
+      return fail({415, "unsupported-media-type", "Unsupported Media Type",
+                   "Content-Type '" + type + "' is not accepted here; use " + accepted, {}, {{"Accept-Post", accepted}}});
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+
+  s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+    if (res.get_header_value("Content-Type") == "application/problem+json") {
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (tl.requestId.empty()) tl.requestId = newRequestId();
+    std::string detail = statusTitle(res.status);
+    if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
+    writeProblem(res, {res.status, res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
+                       statusTitle(res.status), detail, {}, {}},
+                 tl.requestId);
+    return httplib::Server::HandlerResponse::Handled;
+  }));
+
+  s.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+    std::string what = "unknown exception";
+    try {
+      std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    std::fprintf(stderr, "{\"level\":\"error\",\"msg\":\"unhandled exception\",\"path\":%s,\"requestId\":%s,\"what\":%s}\n",
+                 jsonEscape(req.path).c_str(), jsonEscape(tl.requestId).c_str(), jsonEscape(what).c_str());
+    writeProblem(res, {500, "internal", "Internal Server Error", "the server failed to handle the request", {}, {}},
+                 tl.requestId);
+  });
+
+  s.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
+    if (!res.has_header("X-Request-ID")) res.set_header("X-Request-ID", tl.requestId);
+  });
+
+  s.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+    if (!tl.active) {  // rejected before routing (e.g. unparsable request line)
+      metrics_.requestStarted();
+      tl.start = std::chrono::steady_clock::now();
+      tl.route = "unmatched";
+    }
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tl.start).count();
+    metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
+    if (config_.accessLog) {
+      char ts[32];
+      std::time_t now = std::time(nullptr);
+      std::tm tm{};
+      gmtime_r(&now, &tm);
+      std::strftime(ts, sizeof ts, "%Y-%m-%dT%H:%M:%SZ", &tm);
+      std::fprintf(stderr,
+                   "{\"ts\":\"%s\",\"method\":%s,\"path\":%s,\"status\":%d,\"bytes\":%zu,\"durationMs\":%.3f,"
+                   "\"requestId\":%s,\"remote\":%s}\n",
+                   ts, jsonEscape(req.method).c_str(), jsonEscape(req.path).c_str(), res.status, res.body.size(),
+                   seconds * 1e3, jsonEscape(tl.requestId).c_str(), jsonEscape(req.remote_addr).c_str());
+    }
+    tl = RequestState{};
+  });
+}
+
+void Service::addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler) {
+  schemas_->document(schema);  // fail at startup, not at the first request
+  auto r = std::make_unique<Route>();
+  r->path = path;
+  r->methods = {"POST"};
+  r->schema = schema;
+  r->json = std::move(handler);
+  const Route* raw = r.get();
+  routes_.push_back(std::move(r));
+  http_->Post(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handleJson(*raw, req, res); });
+}
+
+void Service::addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler) {
+  for (auto& r : routes_)
+    if (r->path == path) r->binary[contentType] = std::move(handler);
+}
+
+void Service::addReadinessCheck(const std::string& name, std::function<std::string()> probe) {
+  readiness_.emplace_back(name, std::move(probe));
+}
+
+void Service::handleJson(const Route& route, const httplib::Request& req, httplib::Response& res) {
+  RequestContext ctx{tl.requestId, config_};
+  try {
+    std::string type = mediaType(req.get_header_value("Content-Type"));
+    if (auto it = route.binary.find(type); it != route.binary.end()) {
+      BinaryReply reply = it->second(req.body, ctx);
+      res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
+      if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
+      res.set_content(std::move(reply.body), reply.contentType);
+      return;
+    }
+    json body = parseBody(req.body);
+    auto violations = schemas_->validate(route.schema, body);
+    if (!violations.empty()) {
+      std::string detail = violations.front().pointer + ": " + violations.front().message;
+      if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
+      throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
+    }
+    JsonReply reply = route.json(body, ctx);
+    res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
+    if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
+    res.set_content(reply.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+  } catch (const ApiError& e) {
+    writeProblem(res, e, ctx.requestId);
+  }
+}
+
+int Service::bind() {
+  if (config_.port == 0) return http_->bind_to_any_port(config_.host);
+  return http_->bind_to_port(config_.host, config_.port) ? config_.port : -1;
+}
+
+bool Service::run() { return http_->listen_after_bind(); }
+
+void Service::stop() {
+  // stop() before the listen loop runs would be lost (cpp-httplib 0.11.4): wait for it.
+  waitUntilRunning(std::chrono::milliseconds(2000));
+  http_->stop();
+}
+
+bool Service::waitUntilRunning(std::chrono::milliseconds timeout) const {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!http_->is_running()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+}  // namespace effectd

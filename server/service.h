@@ -1,0 +1,101 @@
+// The HTTP service: routing, request ids, limits, problem+json errors, access log, metrics.
+// Effect endpoints plug in through addJsonEndpoint(); they never see HTTP details beyond the
+// parsed, schema-validated body, and they report bad input by throwing ApiError.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "config.h"
+#include "metrics.h"
+#include "schema.h"
+
+namespace effects { struct Error; struct Stats; }
+namespace httplib { class Server; struct Request; struct Response; }
+
+namespace effectd {
+
+// An RFC 9457 problem. Thrown by endpoint code; turned into application/problem+json.
+struct ApiError {
+  int status = 400;
+  std::string slug;    // problem type, becomes "https://effectd.dev/problems/<slug>"
+  std::string title;
+  std::string detail;
+  std::vector<SchemaViolation> errors;
+  std::map<std::string, std::string> headers;  // e.g. Retry-After
+};
+
+// Maps a library error to a problem: invalid argument -> 400, unsatisfiable -> 422,
+// over a resource limit -> 413 (`prefix` is prepended to the field to make it a body pointer).
+ApiError toApiError(const effects::Error& error, const std::string& prefix = "");
+[[noreturn]] void throwError(const effects::Error& error, const std::string& prefix = "");
+
+// What a JSON endpoint returns: the body, plus the stats whose timing goes to Server-Timing.
+struct JsonReply {
+  nlohmann::json body;
+  double computeMs = 0;
+  std::string method;  // the method that ran, echoed in the X-Effect-Method header
+};
+
+struct RequestContext {
+  std::string requestId;
+  const Config& config;
+};
+
+using JsonHandler = std::function<JsonReply(const nlohmann::json& body, const RequestContext& ctx)>;
+// Binary request bodies (e.g. model/gltf-binary) -> a binary reply with a media type.
+struct BinaryReply {
+  std::string body;
+  std::string contentType;
+  double computeMs = 0;
+  std::string method;
+};
+using BinaryHandler = std::function<BinaryReply(const std::string& body, const RequestContext& ctx)>;
+
+class Service {
+ public:
+  explicit Service(Config config);
+  ~Service();
+  Service(const Service&) = delete;
+  Service& operator=(const Service&) = delete;
+
+  // POST `path` with an application/json body validated against proto/schemas/<schema>.
+  void addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler);
+  // Lets `path` also accept a body of `contentType` (its own handler, no JSON Schema).
+  void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler);
+  // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
+  void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
+
+  int bind();        // binds host:port from the config; returns the port, or -1
+  bool run();        // serves until stop(); in-flight requests finish before it returns
+  void stop();       // safe from any thread, also before run() has started serving
+  bool waitUntilRunning(std::chrono::milliseconds timeout) const;
+
+  const Config& config() const { return config_; }
+  Metrics& metrics() { return metrics_; }
+  const SchemaRegistry& schemas() const { return *schemas_; }
+
+ private:
+  struct Route;
+  void installCore();
+  void handleJson(const Route& route, const httplib::Request& req, httplib::Response& res);
+  const Route* findRoute(const std::string& path) const;
+
+  Config config_;
+  Metrics metrics_;
+  std::unique_ptr<SchemaRegistry> schemas_;
+  std::unique_ptr<httplib::Server> http_;
+  std::vector<std::unique_ptr<Route>> routes_;
+  std::vector<std::pair<std::string, std::function<std::string()>>> readiness_;
+};
+
+// Writes `problem` into `res` as application/problem+json with the request id.
+void writeProblem(httplib::Response& res, const ApiError& problem, const std::string& requestId);
+
+}  // namespace effectd

@@ -1,0 +1,124 @@
+// POST /v1/fog over HTTP.
+#include <cmath>
+
+#include "codec.h"
+#include "test_server.h"
+
+namespace effectd::testing {
+namespace {
+
+using nlohmann::json;
+
+TEST(FogApi, PaperExampleTable) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "DISTANCE_EXP2"}, {"color", {0.8, 0.8, 0.8}}, {"distanceCoefficient", 0.07}}},
+              {"objectColors", {{0.7, 0.2, 0.1}}},
+              {"table", {{"size", 17}, {"range", {0, 16}}}}};
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->get_header_value("X-Effect-Method"), "table-DISTANCE_EXP2");
+  EXPECT_EQ(r->get_header_value("Server-Timing").rfind("compute;dur=", 0), 0u);
+  json j = json::parse(r->body);
+  const json& t = j["table"];
+  EXPECT_EQ(t["size"], 17);
+  ASSERT_EQ(t["factor"].size(), 17u);
+  ASSERT_EQ(t["finalColors"][0].size(), 17u * 3);
+  EXPECT_NEAR(t["finalColors"][0][0].get<double>(), 0.7, 1e-6);  // z = 0: object colour
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(t["finalColors"][0][9 * 3 + c].get<double>(), 0.8, 1.0 / 255);  // z = 9
+  EXPECT_GT(j["error"]["maxError"].get<double>(), 0.0);
+  EXPECT_FALSE(j.contains("stats"));  // not asked for
+}
+
+TEST(FogApi, IdenticalRequestsGiveIdenticalBytes) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "HEIGHT"}, {"density", 0.2}, {"heightFalloff", 0.3}}},
+              {"table", {{"size", 32}, {"elevations", 8}, {"cameraHeight", 2}}}};
+  auto a = s.postJson("/v1/fog", req), b = s.postJson("/v1/fog", req);
+  ASSERT_TRUE(a && b);
+  ASSERT_EQ(a->status, 200) << a->body;
+  EXPECT_EQ(a->body, b->body);
+  json j = json::parse(a->body);
+  EXPECT_EQ(j["table"]["factor"].size(), 32u * 8);
+  EXPECT_EQ(j["table"]["elevations"], 8);
+}
+
+TEST(FogApi, Rgba8AndRgba16fEncodings) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "GL_EXP"}, {"color", {1, 0.5, 0}}, {"density", 0.1}}}, {"table", {{"size", 16}}}};
+  req["table"]["encoding"] = "rgba8";
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  auto bytes = base64Decode(json::parse(r->body)["table"]["data"].get<std::string>());
+  ASSERT_TRUE(bytes);
+  ASSERT_EQ(bytes->size(), 16u * 4);
+  EXPECT_EQ(uint8_t((*bytes)[3]), 255);  // d = 0: f = 1
+  EXPECT_EQ(uint8_t((*bytes)[0]), 0);    // no fog contribution yet
+  req["table"]["encoding"] = "rgba16f";
+  r = s.postJson("/v1/fog", req);
+  bytes = base64Decode(json::parse(r->body)["table"]["data"].get<std::string>());
+  ASSERT_EQ(bytes->size(), 16u * 8);
+  uint16_t lastAlpha = uint16_t(uint8_t((*bytes)[15 * 8 + 6]) | uint8_t((*bytes)[15 * 8 + 7]) << 8);
+  EXPECT_NEAR(halfToFloat(lastAlpha), 1.0 / 255, 1e-4);
+}
+
+TEST(FogApi, SmallestTableForAnError) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "GL_EXP2"}, {"density", 0.05}}}, {"table", {{"maxError", 1e-3}}}};
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_LE(j["table"]["maxError"].get<double>(), 1e-3);
+  EXPECT_LT(j["table"]["size"].get<int>(), 256);
+}
+
+TEST(FogApi, RegionsAndSamples) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.01}}},
+              {"regions", {{{"box", {{"min", {10, -5, -5}}, {"max", {20, 5, 5}}}}, {"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.1}}}}}},
+              {"samples", {{"camera", {0, 0, 0}}, {"points", {{5, 0, 0}, {15, 0, 0}}}}},
+              {"include", {"samples", "regionTables"}},
+              {"table", {{"size", 8}}}};
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_FALSE(j.contains("table"));
+  EXPECT_EQ(j["regionTables"].size(), 1u);
+  EXPECT_EQ(j["samples"][0]["region"], -1);
+  EXPECT_NEAR(j["samples"][0]["factor"].get<double>(), std::exp(-0.01 * 25), 1e-6);
+  EXPECT_EQ(j["samples"][1]["region"], 0);
+  EXPECT_NEAR(j["samples"][1]["factor"].get<double>(), std::exp(-0.1 * 225), 1e-6);
+}
+
+TEST(FogApi, StatsOnlyWhenAsked) {
+  TestServer s;
+  auto r = s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 10}}}, {"include", {"table", "stats"}}});
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  ASSERT_TRUE(j.contains("stats"));
+  EXPECT_EQ(j["stats"][0]["method"], "table-LINEAR");
+  EXPECT_TRUE(j["stats"][0].contains("elapsedMs"));
+}
+
+TEST(FogApi, BadFieldsAre400WithPointers) {
+  TestServer s;
+  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 5}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/end")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", json::object()}, {"regions", {{{"fog", json::object()}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/regions/0")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", json::object()}, {"include", {"samples"}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/samples")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"range", {3, 1}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/table/range/1")) << p;
+}
+
+TEST(FogApi, TableOverTheLimitIs413) {
+  Config c = TestServer::quietConfig();
+  c.limits.maxTableSize = 1000;
+  TestServer s(c);
+  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"size", 1001}}}}), 413);
+  EXPECT_TRUE(hasPointer(p, "/table/size")) << p;
+}
+
+}  // namespace
+}  // namespace effectd::testing

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# The effectd binary end to end: flags, serving, SIGTERM with a request in flight -> the
+# request completes and the process exits 0.
+set -euo pipefail
+bin="$1"
+log=$(mktemp)
+trap 'rm -f "$log"; kill %1 2>/dev/null || true' EXIT
+
+"$bin" --help | grep -q -- "--port"
+if "$bin" --port nope 2>/dev/null; then echo "bad flag accepted"; exit 1; fi
+
+EFFECTD_THREADS=2 "$bin" --host 127.0.0.1 --port 0 2>"$log" &
+pid=$!
+for _ in $(seq 100); do grep -q '"listening"' "$log" && break; sleep 0.05; done
+port=$(grep -o '"port":[0-9]*' "$log" | head -1 | cut -d: -f2)
+[ -n "$port" ] || { cat "$log"; exit 1; }
+grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; exit 1; }
+
+curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'
+
+# A request that takes a while (a large fog table with dense error measurement), then SIGTERM.
+body='{"fog":{"fogType":"HEIGHT","density":0.1},"table":{"size":256,"elevations":256}}'
+curl -s -o /tmp/effectd_inflight.$$ -w '%{http_code}' -H 'Content-Type: application/json' \
+  -d "$body" "http://127.0.0.1:$port/v1/fog" > /tmp/effectd_code.$$ &
+curlpid=$!
+sleep 0.05
+kill -TERM "$pid"
+wait "$curlpid"
+set +e
+wait "$pid"
+rc=$?
+set -e
+code=$(cat /tmp/effectd_code.$$)
+rm -f /tmp/effectd_inflight.$$ /tmp/effectd_code.$$
+[ "$rc" -eq 0 ] || { echo "exit code $rc"; cat "$log"; exit 1; }
+[ "$code" = "200" ] || { echo "in-flight request got $code"; cat "$log"; exit 1; }
+grep -q '"stopped"' "$log"
+grep -q '"path":"/v1/fog","status":200' "$log" || { echo "no access log line"; cat "$log"; exit 1; }
+echo "binary test ok (port $port)"

@@ -1,0 +1,269 @@
+// effects/fog: the paper's worked example, X3D semantics, stiff and extreme inputs, tables.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include <effects/fog.h>
+
+namespace effects::fog {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Fog make(FogType t) {
+  Fog f;
+  f.type = t;
+  f.visibilityRange = 50;
+  f.start = 5;
+  f.end = 40;
+  f.density = 0.05;
+  f.distanceCoefficient = 0.07;
+  f.heightFalloff = 0.2;
+  return f;
+}
+
+const FogType kAll[] = {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear,       FogType::kGlExp,
+                        FogType::kGlExp2,    FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight};
+
+TEST(Fog, PaperWorkedExample) {
+  // Seed 003, Fig. 3: fog [0.8 0.8 0.8], object [0.7 0.2 0.1], d_c = 0.07: object colour at
+  // z = 0, "only fog colour from z = 8 on". At z = 8 the largest channel is 2/255 from the fog
+  // colour (0.7 * e^-4.48 = 0.0079); from z = 9 on it is within 1/255.
+  Fog f;
+  f.type = FogType::kDistanceExp2;
+  f.distanceCoefficient = 0.07;
+  const glm::dvec3 fogC{0.8}, obj{0.7, 0.2, 0.1};
+  auto colour = [&](double z) { double w = factor(f, z); return w * obj + (1 - w) * fogC; };
+  EXPECT_EQ(colour(0), obj);
+  for (double z = 8; z <= 9; z += 0.25)
+    for (int c = 0; c < 3; ++c) EXPECT_LT(std::fabs(colour(z)[c] - 0.8), 2.0 / 255) << z;
+  for (double z = 9; z < 100; z += 0.5)
+    for (int c = 0; c < 3; ++c) EXPECT_LT(std::fabs(colour(z)[c] - 0.8), 1.0 / 255) << z;
+  EXPECT_GT(std::fabs(colour(6)[2] - 0.8), 10.0 / 255);  // clearly not yet pure fog at z = 6
+}
+
+TEST(Fog, PaperGaussianIsTheD05Case) {
+  Fog f;
+  f.type = FogType::kDistanceGaussian;
+  f.distanceCoefficient = 0.5;
+  for (double z : {0.0, 0.5, 1.0, 2.0, 3.0})
+    EXPECT_NEAR(factor(f, z), 1 / std::sqrt(2 * M_PI) * std::exp(-0.5 * z * z), 1e-15);
+}
+
+TEST(Fog, X3dSemantics) {
+  Fog lin = make(FogType::kX3dLinear), ex = make(FogType::kX3dExponential);
+  EXPECT_DOUBLE_EQ(factor(lin, 0), 1.0);
+  EXPECT_DOUBLE_EQ(factor(lin, 25), 0.5);
+  EXPECT_DOUBLE_EQ(factor(lin, 50), 0.0);
+  EXPECT_DOUBLE_EQ(factor(lin, 60), 0.0);
+  EXPECT_DOUBLE_EQ(factor(ex, 25), std::exp(-1.0));
+  EXPECT_DOUBLE_EQ(factor(ex, 50), 0.0);
+  EXPECT_LT(factor(ex, std::nextafter(50.0, 0.0)), 1e-300);  // dV -> V: no NaN, no inf
+  lin.visibilityRange = ex.visibilityRange = 0;               // 0 = no fog
+  EXPECT_EQ(factor(lin, 1e30), 1.0);
+  EXPECT_EQ(factor(ex, kInf), 1.0);
+}
+
+TEST(Fog, GlModes) {
+  Fog l = make(FogType::kGlLinear), e = make(FogType::kGlExp), e2 = make(FogType::kGlExp2);
+  EXPECT_DOUBLE_EQ(factor(l, 0), 1.0);
+  EXPECT_DOUBLE_EQ(factor(l, 22.5), 0.5);
+  EXPECT_DOUBLE_EQ(factor(e, 20), std::exp(-1.0));
+  EXPECT_DOUBLE_EQ(factor(e2, 20), std::exp(-1.0));
+  // DISTANCE_EXP2 is GL_EXP2 with density sqrt(d_c).
+  Fog p = make(FogType::kDistanceExp2);
+  e2.density = std::sqrt(p.distanceCoefficient);
+  for (double z : {0.5, 3.0, 7.0}) EXPECT_NEAR(factor(p, z), factor(e2, z), 1e-14);
+}
+
+// Property: f in [0, 1] and non-increasing in distance, over random parameters.
+TEST(Fog, BoundedAndMonotoneOverRandomParameters) {
+  Rng rng(7);
+  for (int trial = 0; trial < 2000; ++trial) {
+    Fog f = make(kAll[trial % 8]);
+    auto logUniform = [&](double lo, double hi) { return std::exp(std::log(lo) + rng.uniform() * (std::log(hi) - std::log(lo))); };
+    f.visibilityRange = logUniform(1e-6, 1e6);
+    f.start = logUniform(1e-6, 1e3);
+    f.end = f.start + logUniform(1e-6, 1e6);
+    f.density = logUniform(1e-9, 1e3);
+    f.distanceCoefficient = logUniform(1e-12, 1e6);
+    f.peak = 0.01 + 0.99 * rng.uniform();
+    f.heightFalloff = logUniform(1e-6, 100);
+    ASSERT_FALSE(validate(f)) << trial;
+    double prev = 2.0;
+    for (int i = 0; i <= 200; ++i) {
+      double d = i == 200 ? kInf : logUniform(1e-9, 1e9) * 0 + std::pow(10.0, -9 + 18.0 * i / 199.0);
+      double w = factor(f, d);
+      ASSERT_TRUE(w >= 0.0 && w <= 1.0) << toString(f.type) << " d=" << d << " f=" << w;
+      ASSERT_LE(w, prev + 1e-15) << toString(f.type) << " d=" << d;
+      prev = w;
+    }
+  }
+}
+
+TEST(Fog, ExtremeParametersStayFinite) {
+  for (FogType t : kAll) {
+    for (double dc : {0.0, 1e-12, 1e6}) {
+      for (double v : {0.0, 1e-30, 1e30}) {
+        Fog f = make(t);
+        f.distanceCoefficient = dc;
+        f.density = dc;
+        f.visibilityRange = v;
+        for (double d : {0.0, 1e-30, 1.0, 1e30, kInf}) {
+          double w = factor(f, d);
+          EXPECT_TRUE(std::isfinite(w) && w >= 0 && w <= 1) << toString(t) << " dc=" << dc << " V=" << v << " d=" << d;
+        }
+      }
+    }
+  }
+}
+
+TEST(Fog, HeightFogClosedFormMatchesRayMarching) {
+  const double a = 0.3, b = 0.5, h = 1.0;
+  for (double oy : {0.0, 2.0, 5.0})
+    for (double dy : {-0.7, -0.1, 0.0, 1e-9, 0.3, 0.9})
+      for (double t : {0.5, 10.0, 60.0}) {
+        double exact = heightOpticalDepth(a, b, h, oy, dy, t);
+        double marched = heightOpticalDepthMarched(a, b, h, oy, dy, t, 200000);
+        EXPECT_NEAR(exact, marched, 1e-6 * std::max(1.0, exact)) << oy << " " << dy << " " << t;
+      }
+}
+
+TEST(Fog, HeightFogStiffCases) {
+  // Horizontal and nearly horizontal rays: the closed form must be continuous through dirY = 0.
+  double flat = heightOpticalDepth(0.1, 0.5, 0, 2, 0.0, 100);
+  EXPECT_NEAR(flat, 0.1 * std::exp(-1.0) * 100, 1e-12);
+  for (double dy : {1e-9, -1e-9, 1e-15}) EXPECT_NEAR(heightOpticalDepth(0.1, 0.5, 0, 2, dy, 100), flat, 1e-6 * flat);
+  // b = 0: uniform density; b = 100: a razor-thin layer.
+  EXPECT_DOUBLE_EQ(heightOpticalDepth(0.1, 0, 0, 2, 0.5, 10), 1.0);
+  double thin = heightOpticalDepth(1, 100, 0, 0, 1, 10);
+  EXPECT_NEAR(thin, 1.0 / 100, 1e-12);  // all the fog is in the first centimetre
+  // Camera 1e4 above the fog: e^(-b*1e4) underflows without NaN.
+  for (double b : {0.0, 1e-6, 0.1, 100.0}) {
+    for (double dy : {-1.0, -1e-9, 0.0, 1e-9, 1.0}) {
+      for (double t : {0.0, 1.0, 1e30, kInf}) {
+        for (double oy : {-1e4, 0.0, 1e4}) {
+          double tau = heightOpticalDepth(0.5, b, 0, oy, dy, t);
+          EXPECT_FALSE(std::isnan(tau)) << b << " " << dy << " " << t << " " << oy;
+          EXPECT_GE(tau, 0.0);
+          Fog f = make(FogType::kHeight);
+          f.heightFalloff = b;
+          double w = factor(f, {0, oy, 0}, {std::sqrt(1 - dy * dy), dy, 0}, t);
+          EXPECT_TRUE(w >= 0 && w <= 1) << b << " " << dy << " " << t << " " << oy;
+        }
+      }
+    }
+  }
+  // Looking straight up to infinity from inside the fog: finite depth a/b.
+  EXPECT_NEAR(heightOpticalDepth(0.5, 0.25, 0, 0, 1, kInf), 2.0, 1e-12);
+  EXPECT_EQ(heightOpticalDepth(0.5, 0.25, 0, 0, 0, kInf), kInf);
+  EXPECT_EQ(heightOpticalDepth(0.5, 100, 0, -1e4, 0, 1), kInf);  // deep below: overflow -> inf, not NaN
+}
+
+TEST(Fog, Validation) {
+  Fog f = make(FogType::kX3dLinear);
+  f.visibilityRange = -1;
+  ASSERT_TRUE(validate(f));
+  EXPECT_EQ(validate(f)->field, "/visibilityRange");
+  f.visibilityRange = std::nan("");
+  EXPECT_EQ(validate(f)->field, "/visibilityRange");
+  f = make(FogType::kGlLinear);
+  f.end = f.start;
+  EXPECT_EQ(validate(f)->field, "/end");
+  f = make(FogType::kDistanceGaussian);
+  f.peak = 0;
+  EXPECT_EQ(validate(f)->field, "/peak");
+  f = make(FogType::kHeight);
+  f.density = kInf;
+  EXPECT_EQ(validate(f)->field, "/density");
+  f = make(FogType::kGlExp);
+  f.color = {0.5, 1.5, 0};
+  EXPECT_EQ(validate(f)->field, "/color/1");
+}
+
+TEST(Fog, RegionsInnermostWinsAndBordersAreInside) {
+  std::vector<Region> regions(3);
+  regions[0].shape = Region::Shape::kBox;
+  regions[0].min = {-10, -10, -10};
+  regions[0].max = {10, 10, 10};
+  regions[1].shape = Region::Shape::kSphere;
+  regions[1].center = {0, 0, 0};
+  regions[1].radius = 2;
+  regions[2] = regions[1];  // same volume: the earlier one wins
+  EXPECT_EQ(regionAt(regions, {0, 0, 0}), 1);
+  EXPECT_EQ(regionAt(regions, {2, 0, 0}), 1);  // on the sphere's surface
+  EXPECT_EQ(regionAt(regions, {5, 0, 0}), 0);
+  EXPECT_EQ(regionAt(regions, {10, 10, 10}), 0);  // box corner
+  EXPECT_EQ(regionAt(regions, {10.001, 0, 0}), -1);
+  EXPECT_EQ(regionAt({}, {0, 0, 0}), -1);
+}
+
+TEST(Fog, TableErrorShrinksWithSize) {
+  for (FogType t : kAll) {
+    Fog f = make(t);
+    double prev = 1e9;
+    for (size_t n : {16, 64, 256, 1024}) {
+      TableOptions o;
+      o.size = n;
+      o.elevations = t == FogType::kHeight ? 16 : 0;
+      auto table = buildTable(f, o);
+      ASSERT_TRUE(table.ok()) << table.error().message;
+      double e = table.value().maxError;
+      EXPECT_TRUE(std::isfinite(e));
+      EXPECT_LE(e, prev + 1e-7) << toString(t) << " n=" << n;  // float storage floor ~6e-8
+      if (t != FogType::kX3dLinear && t != FogType::kGlLinear && t != FogType::kHeight) {
+        EXPECT_LT(e, prev) << toString(t) << " n=" << n;
+      }
+      prev = e;
+    }
+  }
+}
+
+TEST(Fog, SmallestSizeForErrorMeetsIt) {
+  for (FogType t : kAll) {
+    for (double target : {1e-2, 1e-3, 1e-4}) {
+      Fog f = make(t);
+      TableOptions o;
+      o.size = 0;
+      o.maxError = target;
+      auto table = buildTable(f, o);
+      ASSERT_TRUE(table.ok()) << toString(t) << " " << table.error().message;
+      EXPECT_LE(table.value().maxError, target) << toString(t);
+      if (table.value().width > 2 && t != FogType::kHeight && t != FogType::kX3dLinear && t != FogType::kGlLinear) {
+        TableOptions smaller = o;
+        smaller.size = table.value().width - 1;
+        EXPECT_GT(buildTable(f, smaller).value().maxError, target) << toString(t) << " not minimal";
+      }
+    }
+  }
+}
+
+TEST(Fog, TableRangesAndLimits) {
+  Fog f = make(FogType::kDistanceExp2);
+  f.distanceCoefficient = 0;
+  TableOptions o;
+  o.size = 8;
+  auto t = buildTable(f, o);
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.error().kind, ErrorKind::kUnsatisfiable);
+  o.rangeEnd = 10;
+  t = buildTable(f, o);
+  ASSERT_TRUE(t.ok());
+  for (float w : t.value().factor) EXPECT_EQ(w, 1.0f);
+  o.size = 100000;
+  o.maxSize = 65536;
+  t = buildTable(f, o);
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.error().kind, ErrorKind::kLimitExceeded);
+  // The default range ends where the fog is complete to 1/255.
+  Fog e = make(FogType::kGlExp);
+  o = TableOptions{};
+  o.size = 64;
+  t = buildTable(e, o);
+  ASSERT_TRUE(t.ok());
+  EXPECT_NEAR(t.value().factor.back(), 1.0 / 255, 1e-6);
+}
+
+}  // namespace
+}  // namespace effects::fog

@@ -1,0 +1,104 @@
+// Server building blocks without sockets: schema validator, codecs, configuration.
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#include "codec.h"
+#include "config.h"
+#include "schema.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+
+SchemaRegistry registry() {
+  return SchemaRegistry({{"a.json", R"({
+      "type": "object", "additionalProperties": false, "required": ["n"],
+      "properties": {
+        "n": {"type": "integer", "minimum": 1, "maximum": 10},
+        "v": {"$ref": "b.json#/$defs/vec"},
+        "e": {"enum": ["x", "y"]},
+        "s": {"type": "string", "maxLength": 3},
+        "o": {"oneOf": [{"type": "object", "required": ["p"], "additionalProperties": false, "properties": {"p": {"type": "number"}}},
+                        {"type": "object", "required": ["q"], "additionalProperties": false, "properties": {"q": {"type": "number"}}}]}
+      }})"},
+                         {"b.json", R"({"$defs": {"vec": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}})"}});
+}
+
+TEST(Schema, AcceptsValidInstances) {
+  auto r = registry();
+  EXPECT_TRUE(r.validate("a.json", json{{"n", 3}}).empty());
+  EXPECT_TRUE(r.validate("a.json", json{{"n", 3.0}, {"v", {1, 2.5}}, {"e", "y"}, {"s", "\xc3\xa9\xc3\xa9\xc3\xa9"}}).empty());
+  EXPECT_TRUE(r.validate("a.json", json{{"n", 1}, {"o", {{"q", 1}}}}).empty());
+}
+
+TEST(Schema, ReportsPointers) {
+  auto r = registry();
+  auto first = [&](const json& j) {
+    auto v = r.validate("a.json", j);
+    return v.empty() ? std::string("<none>") : v.front().pointer + " " + v.front().message;
+  };
+  EXPECT_EQ(first(json::object()), "/n is required");
+  EXPECT_EQ(first(json{{"n", 0}}), "/n must be >= 1");
+  EXPECT_EQ(first(json{{"n", 2.5}}), "/n must be integer, got number");
+  EXPECT_EQ(first(json{{"n", 2}, {"x~y/z", 1}}), "/x~0y~1z is not a known field");
+  EXPECT_EQ(first(json{{"n", 2}, {"v", {1, "a"}}}), "/v/1 must be number, got string");
+  EXPECT_EQ(first(json{{"n", 2}, {"v", {1, 2, 3}}}), "/v must have at most 2 items");
+  EXPECT_EQ(first(json{{"n", 2}, {"e", "z"}}), "/e must be one of [\"x\",\"y\"]");
+  EXPECT_EQ(first(json{{"n", 2}, {"s", "abcd"}}), "/s must have at most 3 characters");
+  EXPECT_EQ(first(json{{"n", 2}, {"o", {{"p", "no"}}}}), "/o/p must be number, got string");
+  EXPECT_EQ(first(json::array()), " must be object, got array");
+}
+
+TEST(Schema, RefusesKeywordsItDoesNotCheck) {
+  using Docs = std::map<std::string, std::string>;
+  EXPECT_THROW(SchemaRegistry(Docs{{"c.json", R"({"type": "string", "pattern": "^a"})"}}), std::runtime_error);
+  EXPECT_THROW(SchemaRegistry(Docs{{"c.json", R"({"$ref": "#/$defs/missing"})"}}), std::runtime_error);
+}
+
+TEST(Codec, Base64RoundTripAndStrictness) {
+  for (std::string s : std::vector<std::string>{"", "f", "fo", "foo", "foob", "fooba", "foobar", std::string("\0\xff\x10", 3)}) {
+    auto d = base64Decode(base64Encode(s));
+    ASSERT_TRUE(d);
+    EXPECT_EQ(*d, s);
+  }
+  EXPECT_EQ(base64Encode("foobar"), "Zm9vYmFy");
+  EXPECT_FALSE(base64Decode("Zm9"));
+  EXPECT_FALSE(base64Decode("Zm9v YmFy"));
+  EXPECT_FALSE(base64Decode("Zm=v"));
+  EXPECT_FALSE(base64Decode("Z==="));
+}
+
+TEST(Codec, HalfFloats) {
+  EXPECT_EQ(floatToHalf(1.0f), 0x3C00);
+  EXPECT_EQ(floatToHalf(-2.0f), 0xC000);
+  EXPECT_EQ(floatToHalf(65504.0f), 0x7BFF);
+  EXPECT_EQ(floatToHalf(1e6f), 0x7C00);
+  EXPECT_EQ(floatToHalf(0.0f), 0);
+  for (float f : {0.1f, 0.5f, 1.0f / 255, 3.14159f, 6e-5f, 1e-7f})
+    EXPECT_NEAR(halfToFloat(floatToHalf(f)), f, std::max(f * 1e-3f, 6e-8f)) << f;
+}
+
+TEST(Config, FlagsOverrideEnvironmentOverrideDefaults) {
+  Config c;
+  bool help;
+  setenv("EFFECTD_PORT", "9000", 1);
+  setenv("EFFECTD_THREADS", "3", 1);
+  EXPECT_EQ(parseConfig({"--port", "9100", "--max-body-bytes=2048"}, c, help), "");
+  unsetenv("EFFECTD_PORT");
+  unsetenv("EFFECTD_THREADS");
+  EXPECT_EQ(c.port, 9100);
+  EXPECT_EQ(c.threads, 3);
+  EXPECT_EQ(c.limits.maxBodyBytes, 2048u);
+  EXPECT_EQ(c.host, "127.0.0.1");
+  Config d;
+  EXPECT_NE(parseConfig({"--port", "70000"}, d, help), "");
+  EXPECT_NE(parseConfig({"--nope", "1"}, d, help), "");
+  EXPECT_NE(parseConfig({"--threads"}, d, help), "");
+  EXPECT_EQ(parseConfig({"--help"}, d, help), "");
+  EXPECT_TRUE(help);
+}
+
+}  // namespace
+}  // namespace effectd
