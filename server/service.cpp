@@ -268,9 +268,8 @@ void Service::installCore() {
   });
 
   s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
-    if (res.get_header_value("Content-Type") == "application/problem+json") {
-      return httplib::Server::HandlerResponse::Handled;
-    }
+    // Bodies set by a handler (problems, /readyz's 503) stand; fill in only bare statuses.
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Handled;
     if (tl.requestId.empty()) tl.requestId = newRequestId();
     std::string detail = statusTitle(res.status);
     if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
