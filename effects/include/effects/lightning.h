@@ -1,0 +1,134 @@
+// effects/lightning.h — lightning paths by Laplacian growth on a 2-D grid.
+//
+// Source: seed 002 (Yun & Yoon, "Physically Inspired Fast Lightning Rendering", KAIST 2016),
+// Niemeyer et al. 1984 (DBM), Kim & Lin 2004 (DBM with CG), Kim, Sewall, Sud & Lin 2007
+// (point charges). Digest: shared/design/effects.md section 1.
+//
+// Grid: width x height cells, cell (x, y) covers [x, x+1] x [y, y+1]; x right, y down.
+// 8-neighbourhood. The bolt grows one cell per step from `start`; candidate i is picked with
+// probability p_i = Phi_i^eta / sum_j Phi_j^eta (seed 002 eqn 2), computed in log space.
+// A segment ends when the bolt touches (8-adjacent) its target; the target joins the bolt.
+// Several targets make chain lightning: each later segment grows from the previous target.
+//
+// Methods (how Phi is obtained):
+//   kFast    seed 002 eqns 4-8: Phi_i = 2^G / (B * N * P), candidates live `lifetime` steps.
+//   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
+//            Phi = 1), warm-started; solver kMgpcg (multigrid-preconditioned CG) or kCg
+//            (plain CG, the baseline of Kim & Lin 2004 and of seed 002's comparison).
+//   kCharges Kim et al. 2007: incremental point-charge potential, no linear solve.
+// Obstacles are cells the bolt may not enter. With guide kAstar (kAuto: when obstacles exist)
+// the fast and charges methods follow the turning points of an 8-connected A* path (seed
+// 002 section 3.2); DBM needs no guide (Laplace solutions have no local minima).
+//
+// Errors: start/target outside the grid or inside an obstacle, start == target, an
+// unreachable target -> kUnsatisfiable naming the field; exhausting the step budget ->
+// kLimitExceeded. Deterministic: same Params -> same Bolt, bit for bit.
+// Thread-safety: reentrant; the boundary-map cache is internally synchronised.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "effects/common.h"
+
+namespace effects::lightning {
+
+struct Cell {
+  int x = 0, y = 0;
+  bool operator==(const Cell& o) const { return x == o.x && y == o.y; }
+};
+
+enum class Method { kFast, kDbm, kCharges };
+enum class Solver { kMgpcg, kCg };
+enum class Guide { kAuto, kAstar, kNone };
+
+const char* toString(Method m);
+const char* toString(Solver s);
+
+struct Params {
+  int width = 128, height = 128;
+  std::vector<uint8_t> obstacles;  // empty, or width*height flags (row-major, nonzero = blocked)
+  Cell start{64, 0};
+  std::vector<Cell> targets{{64, 127}};
+  Method method = Method::kFast;
+  double eta = 2.0;               // [0, 50]; seed 002: 2..3 looks like lightning
+  int lifetime = 4;               // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
+  Guide guide = Guide::kAuto;
+  Solver solver = Solver::kMgpcg; // kDbm
+  double tolerance = 1e-6;        // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
+  uint64_t seed = 1;
+  size_t maxSteps = 2'000'000;    // growth budget (cells added)
+  bool measureError = false;      // per-step TV distance to the converged Laplace distribution
+};
+
+std::optional<Error> validate(const Params& p);
+
+struct Node {
+  Cell cell;
+  int parent = -1;  // index into Bolt::nodes; -1 for the start
+  int step = 0;     // growth step at which the cell joined (0 = start)
+};
+
+struct Bolt {
+  std::vector<Node> nodes;          // in growth order
+  std::vector<int> mainChannel;     // node indices, start -> last target
+  std::vector<Cell> guide;          // waypoints used (empty without a guide)
+  Stats stats;                      // counters: steps, candidatesMax, solverIterations, residual,
+                                    // boundaryMapMs, guideMs ...; error: mean TV (measureError)
+};
+
+Result<Bolt> grow(const Params& params);
+
+// Box-counting dimension of a set of cells (seed 002's quality figure): for box sizes
+// 1, 2, 4, ... up to a quarter of the grid, the minimum box count over four grid offsets;
+// D is the slope of log N against log(1/s) fitted over the straightest run of >= 4 scales.
+double fractalDimension(const std::vector<Cell>& cells, int width, int height);
+
+// ---- for tests and the error report --------------------------------------------------
+// Converged potential of the DBM problem for a given bolt (Phi = 0 on bolt, obstacles and
+// outside; 1 on target). Returns the full grid, row-major.
+std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
+                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
+                                 int* iterations = nullptr, double* residual = nullptr);
+
+// Seed 002 eqn 4: the boundary map's point-charge sum at a cell, sum over border ring and
+// obstacle cells of 1/r (Barnes-Hut, opening angle 0.5; exact for r < 2 block sizes).
+// Normalisation (division by a constant) cancels in p_i and is not applied.
+double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c);
+
+// 8-connected A* (octile heuristic); empty if unreachable.
+std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to);
+
+}  // namespace effects::lightning
+
+namespace effects::lightning {
+
+// ---- Shape for renderers (seed 002 section 3.3) -------------------------------------
+struct ShapeParams {
+  double jitter = 1.0;          // [0, 1]: vertices move up to jitter/2 cells from cell centres
+  uint64_t jitterSeed = 1;      // separate from the growth seed: same bolt, other jitter
+  double branchWidth = 1.0;     // main channel = 2 x branch width (Reed & Wyvill)
+  double branchIntensity = 0.6; // branch brightness where it leaves the main channel (main: 1)
+  double branchFalloff = 16.0;  // cells of tree distance over which branch brightness falls by e
+};
+
+struct Vertex {
+  float x = 0, y = 0;     // grid units, jittered inside the cell
+  int step = 0;           // growth step of the cell (animate the leader by step, the return
+                          // stroke along the main channel from the last step back)
+  float intensity = 1.0f; // 1 on the main channel, fading along branches
+  int node = 0;           // index into Bolt::nodes
+};
+
+struct Polyline {
+  bool main = false;      // channel: main (start -> target) or branch
+  float width = 1.0f;
+  std::vector<Vertex> vertices;  // a branch starts at the vertex it leaves its parent from
+};
+
+// Main channel first, then branches, each following its longest continuation.
+std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& shape);
+
+}  // namespace effects::lightning

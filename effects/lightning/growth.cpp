@@ -1,0 +1,419 @@
+// Laplacian growth: the three ways of getting Phi (fast, dbm, charges), candidate sampling,
+// the A* guide, chain targets, and the per-step error against the converged Laplace solution.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "grid.h"
+#include "laplace.h"
+
+namespace effects::lightning {
+
+const char* toString(Method m) {
+  switch (m) {
+    case Method::kFast: return "fast";
+    case Method::kDbm: return "dbm";
+    case Method::kCharges: return "charges";
+  }
+  return "?";
+}
+const char* toString(Solver s) { return s == Solver::kCg ? "cg" : "mgpcg"; }
+
+std::optional<Error> validate(const Params& p) {
+  if (p.width < 3 || p.height < 3) return invalid("/grid", "width and height must be >= 3");
+  if (p.width > 65536 || p.height > 65536) return overLimit("/grid", "width and height must be <= 65536");
+  if (!p.obstacles.empty() && p.obstacles.size() != size_t(p.width) * size_t(p.height))
+    return invalid("/obstacles", "must have width*height cells");
+  if (!(p.eta >= 0.0 && p.eta <= 50.0)) return invalid("/eta", "must be in [0, 50]");
+  if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
+  if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
+  if (p.targets.empty()) return invalid("/targets", "needs at least one target");
+  return std::nullopt;
+}
+
+namespace {
+
+using detail::Grid;
+using detail::kDx;
+using detail::kDy;
+
+constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+
+struct Candidate {
+  Cell cell;
+  int born;      // step at which it last gained a bolt neighbour
+  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8
+  int parent;    // node it attaches to if chosen: its newest bolt neighbour
+  double charge; // kCharges: sum over bolt cells of 1/r
+};
+
+class Grower {
+ public:
+  Grower(const Params& p, Bolt& bolt) : p_(p), g_{p.width, p.height, &p.obstacles}, bolt_(bolt) {
+    nodeOf_.assign(size_t(p.width) * size_t(p.height), -1);
+    candidateOf_.assign(nodeOf_.size(), -1);
+    reserved_.assign(nodeOf_.size(), 0);
+    for (const Cell& t : p.targets)
+      if (g_.inside(t.x, t.y)) reserved_[g_.index(t)] = 1;
+  }
+
+  std::optional<Error> run();
+
+ private:
+  // Free for growth: inside, no obstacle, not bolt, not a target still to be reached (those
+  // join the bolt only when it touches them).
+  bool free(int x, int y) const {
+    if (!g_.inside(x, y) || g_.blocked(x, y)) return false;
+    size_t i = g_.index({x, y});
+    return nodeOf_[i] < 0 && !reserved_[i];
+  }
+  int addNode(Cell c, int parent);
+  void addCandidatesAround(int node);
+  void removeCandidate(size_t slot);
+  void expireCandidates();
+  void logWeights(std::vector<double>& out);
+  double boundary(Cell c);
+  std::optional<Error> growSegment(size_t k);
+  double stepError(const std::vector<double>& logPhi);
+
+  const Params& p_;
+  Grid g_;
+  Bolt& bolt_;
+  std::vector<int32_t> nodeOf_, candidateOf_;
+  std::vector<uint8_t> reserved_;
+  std::vector<Candidate> cands_;
+  std::vector<float> boundaryMemo_;
+  std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
+  std::unique_ptr<detail::Laplace> laplace_, reference_;
+  Rng rng_{p_.seed};
+  int step_ = 0;
+  Cell anchor_, attractor_;  // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
+  double solverIterations_ = 0, lastResidual_ = 0, errorSum_ = 0;
+  int errorSteps_ = 0;
+  size_t candidatesMax_ = 0;
+};
+
+int Grower::addNode(Cell c, int parent) {
+  int id = int(bolt_.nodes.size());
+  bolt_.nodes.push_back({c, parent, step_});
+  nodeOf_[g_.index(c)] = id;
+  if (int slot = candidateOf_[g_.index(c)]; slot >= 0) removeCandidate(size_t(slot));
+  if (laplace_) laplace_->fix(c.x, c.y, 0.0);
+  if (reference_) reference_->fix(c.x, c.y, 0.0);
+  if (p_.method == Method::kCharges) {  // Kim et al. 2007: one new term per candidate
+    for (auto& cand : cands_) cand.charge += 1.0 / std::hypot(double(cand.cell.x - c.x), double(cand.cell.y - c.y));
+  }
+  return id;
+}
+
+void Grower::removeCandidate(size_t slot) {
+  candidateOf_[g_.index(cands_[slot].cell)] = -1;
+  if (slot + 1 != cands_.size()) {
+    cands_[slot] = cands_.back();
+    candidateOf_[g_.index(cands_[slot].cell)] = int32_t(slot);
+  }
+  cands_.pop_back();
+}
+
+void Grower::addCandidatesAround(int node) {
+  Cell c = bolt_.nodes[size_t(node)].cell;
+  for (int k = 0; k < 8; ++k) {
+    int x = c.x + kDx[k], y = c.y + kDy[k];
+    if (!free(x, y)) continue;
+    size_t i = g_.index({x, y});
+    if (candidateOf_[i] >= 0) {
+      Candidate& cand = cands_[size_t(candidateOf_[i])];
+      cand.neighbours = std::min(cand.neighbours + 1, 8);
+      cand.born = step_;
+      cand.parent = node;
+      continue;
+    }
+    Candidate cand{{x, y}, step_, 0, node, 0.0};
+    for (int j = 0; j < 8; ++j) {
+      int nx = x + kDx[j], ny = y + kDy[j];
+      if (g_.inside(nx, ny) && nodeOf_[g_.index({nx, ny})] >= 0) ++cand.neighbours;
+    }
+    if (p_.method == Method::kCharges)
+      for (const Node& n : bolt_.nodes) cand.charge += 1.0 / std::hypot(double(x - n.cell.x), double(y - n.cell.y));
+    candidateOf_[i] = int32_t(cands_.size());
+    cands_.push_back(cand);
+  }
+  candidatesMax_ = std::max(candidatesMax_, cands_.size());
+}
+
+void Grower::expireCandidates() {
+  // Seed 002: a candidate older than the lifetime is dropped, bounding the candidate set.
+  if (p_.method != Method::kFast || p_.lifetime == 0) return;
+  for (size_t i = cands_.size(); i-- > 0;)
+    if (step_ - cands_[i].born > p_.lifetime) removeCandidate(i);
+}
+
+double Grower::boundary(Cell c) {
+  float& memo = boundaryMemo_[g_.index(c)];
+  if (memo == 0.0f) memo = float(boundaryMap_->potential(c.x, c.y));
+  return memo;
+}
+
+// log of Phi_i for every candidate (-inf where Phi_i = 0).
+void Grower::logWeights(std::vector<double>& out) {
+  out.resize(cands_.size());
+  switch (p_.method) {
+    case Method::kFast: {
+      // Seed 002 eqn 8: P_i = 2^G / (B * N * P). B (eqn 4) is the border/obstacle charge
+      // potential (large near them: Phi small), N (eqn 6) the adjacent bolt cells, P (eqn 5)
+      // the distance to the positive charge, G the candidate's step along anchor -> attractor.
+      double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
+      double len = std::hypot(ax, ay);
+      if (len > 0) {
+        ax /= len;
+        ay /= len;
+      }
+      for (size_t i = 0; i < cands_.size(); ++i) {
+        const Candidate& c = cands_[i];
+        double G = std::floor((c.cell.x - anchor_.x) * ax + (c.cell.y - anchor_.y) * ay);
+        double P = std::hypot(double(c.cell.x - attractor_.x), double(c.cell.y - attractor_.y));
+        out[i] = G * M_LN2 - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
+      }
+      break;
+    }
+    case Method::kDbm:
+      for (size_t i = 0; i < cands_.size(); ++i) {
+        double phi = laplace_->phi(cands_[i].cell.x, cands_[i].cell.y);
+        out[i] = phi > 0 ? std::log(phi) : kNegInf;
+      }
+      break;
+    case Method::kCharges: {
+      // Kim et al. 2007: phi_i = sum_j (1 - R1/r_ij), R1 = h/2, with the target as the positive
+      // charge paired with every bolt charge: phi_i = R1 * sum_j (1/r_it - 1/r_ij), then
+      // normalised to [0, 1] over the candidates.
+      const double R1 = 0.5, n = double(bolt_.nodes.size());
+      double lo = INFINITY, hi = -INFINITY;
+      for (size_t i = 0; i < cands_.size(); ++i) {
+        const Candidate& c = cands_[i];
+        double rt = std::max(0.5, std::hypot(double(c.cell.x - attractor_.x), double(c.cell.y - attractor_.y)));
+        out[i] = R1 * (n / rt - c.charge);
+        lo = std::min(lo, out[i]);
+        hi = std::max(hi, out[i]);
+      }
+      for (double& v : out) v = hi > lo ? std::log((v - lo) / (hi - lo)) : 0.0;
+      break;
+    }
+  }
+}
+
+// Samples index i with probability Phi_i^eta / sum Phi^eta (seed 002 eqn 2), in log space.
+size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vector<double>& w) {
+  w.resize(logPhi.size());
+  double top = kNegInf;
+  for (double l : logPhi) top = std::max(top, l);
+  double sum = 0;
+  for (size_t i = 0; i < logPhi.size(); ++i) {
+    // eta = 0 or all Phi = 0: uniform (0^0 = 1).
+    w[i] = (eta == 0.0 || top == kNegInf) ? 1.0 : std::exp(eta * (logPhi[i] - top));
+    sum += w[i];
+  }
+  double u = rng.uniform() * sum;
+  for (size_t i = 0; i < w.size(); ++i) {
+    u -= w[i];
+    if (u < 0) return i;
+  }
+  size_t last = w.size() - 1;
+  while (last > 0 && w[last] == 0) --last;
+  return last;
+}
+
+double Grower::stepError(const std::vector<double>& logPhi) {
+  // Total-variation distance between this method's candidate distribution and the one the
+  // converged Laplace solution gives on the same bolt state (over all free bolt neighbours).
+  double res = 0;
+  reference_->solve(Solver::kMgpcg, 1e-10, &res);
+  std::vector<double> p(cands_.size());
+  {
+    double top = kNegInf, sum = 0;
+    for (double l : logPhi) top = std::max(top, l);
+    for (size_t i = 0; i < p.size(); ++i) {
+      p[i] = (p_.eta == 0 || top == kNegInf) ? 1.0 : std::exp(p_.eta * (logPhi[i] - top));
+      sum += p[i];
+    }
+    for (double& v : p) v /= sum;
+  }
+  // Reference support: every free cell next to a bolt cell of this segment.
+  std::vector<std::pair<size_t, double>> ref;  // cell index, weight
+  double refSum = 0;
+  std::vector<size_t> cells;
+  for (const Node& n : bolt_.nodes)
+    for (int k = 0; k < 8; ++k) {
+      int x = n.cell.x + kDx[k], y = n.cell.y + kDy[k];
+      if (free(x, y)) cells.push_back(g_.index({x, y}));
+    }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  double top = 0;
+  for (size_t i : cells) top = std::max(top, reference_->phi(int(i % size_t(g_.width)), int(i / size_t(g_.width))));
+  for (size_t i : cells) {
+    double phi = std::max(0.0, reference_->phi(int(i % size_t(g_.width)), int(i / size_t(g_.width))));
+    double wgt = (p_.eta == 0 || top <= 0) ? 1.0 : std::pow(phi / top, p_.eta);
+    ref.push_back({i, wgt});
+    refSum += wgt;
+  }
+  double tv = 0;
+  std::vector<double> mine(cells.size(), 0.0);
+  double outside = 0;  // probability this method puts outside the reference support (none in practice)
+  for (size_t i = 0; i < cands_.size(); ++i) {
+    auto it2 = std::lower_bound(cells.begin(), cells.end(), g_.index(cands_[i].cell));
+    if (it2 != cells.end() && *it2 == g_.index(cands_[i].cell)) mine[size_t(it2 - cells.begin())] += p[i];
+    else outside += p[i];
+  }
+  for (size_t k = 0; k < cells.size(); ++k) tv += std::fabs(mine[k] - ref[k].second / refSum);
+  return 0.5 * (tv + outside);
+}
+
+std::optional<Error> Grower::growSegment(size_t k) {
+  const Cell target = p_.targets[k];
+  const int from = k == 0 ? 0 : int(bolt_.nodes.size()) - 1;  // previous target's node
+  const std::string field = "/targets/" + std::to_string(k);
+  const Cell fromCell = bolt_.nodes[size_t(from)].cell;
+
+  // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
+  std::vector<uint8_t> blocked = p_.obstacles;
+  if (k > 0) {
+    if (blocked.empty()) blocked.assign(nodeOf_.size(), 0);
+    for (const Node& n : bolt_.nodes) blocked[g_.index(n.cell)] = 1;
+    blocked[g_.index(fromCell)] = 0;
+  }
+  Stopwatch guideWatch;
+  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target);
+  bolt_.stats.counters["guideMs"] += guideWatch.ms();
+  if (path.empty()) return unsatisfiable(field, "target is unreachable from " + std::string(k ? "the previous target" : "start"));
+  const bool useGuide = p_.method != Method::kDbm &&
+                        (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
+  std::vector<Cell> waypoints = useGuide ? detail::turningPoints(path) : std::vector<Cell>{target};
+  if (useGuide) bolt_.guide.insert(bolt_.guide.end(), waypoints.begin(), waypoints.end());
+  size_t wp = 0;
+  anchor_ = fromCell;
+  attractor_ = waypoints[0];
+
+  // The DBM problem of this segment: bolt so far, obstacles (and outside) at 0, target at 1.
+  auto dbmProblem = [&] {
+    auto lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
+    for (int y = 0; y < p_.height; ++y)
+      for (int x = 0; x < p_.width; ++x)
+        if (g_.blocked(x, y)) lap->fix(x, y, 0.0);
+    for (const Node& n : bolt_.nodes) lap->fix(n.cell.x, n.cell.y, 0.0);
+    lap->fix(target.x, target.y, 1.0);
+    return lap;
+  };
+  if (p_.method == Method::kDbm) laplace_ = dbmProblem();
+  if (p_.measureError) reference_ = dbmProblem();
+
+  // Chain lightning: the new segment grows from the previous target only.
+  for (size_t i = cands_.size(); i-- > 0;) removeCandidate(i);
+  auto adjacent = [](Cell a, Cell b) { return std::abs(a.x - b.x) <= 1 && std::abs(a.y - b.y) <= 1; };
+  int last = from;
+  std::vector<double> logPhi, scratch;
+  size_t segmentFirstNode = bolt_.nodes.size();
+  addCandidatesAround(from);
+  while (!adjacent(bolt_.nodes[size_t(last)].cell, target)) {
+    if (size_t(step_) >= p_.maxSteps)
+      return overLimit("/maxSteps", "growth step budget of " + std::to_string(p_.maxSteps) + " cells exhausted");
+    ++step_;
+    expireCandidates();
+    if (cands_.empty()) {
+      // Every candidate expired or the sub-bolt is boxed in: revive the segment's frontier.
+      bolt_.stats.counters["revivals"] += 1;
+      addCandidatesAround(from);
+      for (size_t n = segmentFirstNode; n < bolt_.nodes.size(); ++n) addCandidatesAround(int(n));
+      if (cands_.empty()) return unsatisfiable(field, "the bolt enclosed itself before reaching the target");
+    }
+    if (laplace_) {
+      double res = 0;
+      solverIterations_ += laplace_->solve(p_.solver, p_.tolerance, &res);
+      lastResidual_ = res;
+    }
+    logWeights(logPhi);
+    if (reference_) {
+      errorSum_ += stepError(logPhi);
+      ++errorSteps_;
+    }
+    size_t pick = sample(logPhi, p_.eta, rng_, scratch);
+    Candidate chosen = cands_[pick];
+    last = addNode(chosen.cell, chosen.parent);
+    addCandidatesAround(last);
+    // Seed 002 section 3.2: move on to the next waypoint early when the newest bolt cell is
+    // next to the current one or sees the next one.
+    while (wp + 1 < waypoints.size() &&
+           (adjacent(chosen.cell, waypoints[wp]) || detail::lineOfSight(g_, chosen.cell, waypoints[wp + 1]))) {
+      anchor_ = chosen.cell;
+      attractor_ = waypoints[++wp];
+    }
+  }
+  ++step_;
+  reserved_[g_.index(target)] = 0;
+  addNode(target, last);
+  return std::nullopt;
+}
+
+std::optional<Error> Grower::run() {
+  auto checkCell = [&](Cell c, const std::string& field) -> std::optional<Error> {
+    if (!g_.inside(c.x, c.y)) return invalid(field, "is outside the grid");
+    if (g_.blocked(c.x, c.y)) return unsatisfiable(field, "is inside an obstacle");
+    return std::nullopt;
+  };
+  if (auto e = checkCell(p_.start, "/start")) return e;
+  for (size_t k = 0; k < p_.targets.size(); ++k) {
+    std::string f = "/targets/" + std::to_string(k);
+    if (auto e = checkCell(p_.targets[k], f)) return e;
+    Cell prev = k == 0 ? p_.start : p_.targets[k - 1];
+    if (p_.targets[k] == prev) return unsatisfiable(f, k == 0 ? "equals start" : "equals the previous target");
+    for (size_t j = 0; j < k; ++j)
+      if (p_.targets[j] == p_.targets[k]) return unsatisfiable(f, "repeats an earlier target");
+    if (p_.targets[k] == p_.start) return unsatisfiable(f, "equals start");
+  }
+  if (p_.method == Method::kFast) {
+    Stopwatch w;
+    bool hit = false;
+    boundaryMap_ = detail::cachedBoundaryMap(p_.width, p_.height, p_.obstacles, &hit);
+    bolt_.stats.counters["boundaryMapMs"] = w.ms();
+    bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
+    boundaryMemo_.assign(nodeOf_.size(), 0.0f);
+  }
+  addNode(p_.start, -1);
+  for (size_t k = 0; k < p_.targets.size(); ++k) {
+    if (auto e = growSegment(k)) return e;
+    bolt_.mainChannel.clear();
+  }
+  for (int n = int(bolt_.nodes.size()) - 1; n >= 0; n = bolt_.nodes[size_t(n)].parent) bolt_.mainChannel.push_back(n);
+  std::reverse(bolt_.mainChannel.begin(), bolt_.mainChannel.end());
+
+  Stats& s = bolt_.stats;
+  s.counters["steps"] = step_;
+  s.counters["cells"] = double(bolt_.nodes.size());
+  s.counters["candidatesMax"] = double(candidatesMax_);
+  if (p_.method == Method::kDbm) {
+    s.counters["solverIterations"] = solverIterations_;
+    s.counters["residual"] = lastResidual_;
+  }
+  if (p_.measureError && errorSteps_ > 0) {
+    s.error = errorSum_ / errorSteps_;
+    s.errorMetric = "mean per-step total-variation distance of the candidate distribution";
+    s.reference = "dbm, converged Laplace solve (MGPCG, relative residual 1e-10)";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Result<Bolt> grow(const Params& params) {
+  if (auto e = validate(params)) return *e;
+  if (size_t(params.width) * size_t(params.height) > (size_t(1) << 30))
+    return overLimit("/grid", "grid too large");
+  Stopwatch watch;
+  Bolt bolt;
+  Grower grower(params, bolt);
+  if (auto e = grower.run()) return *e;
+  bolt.stats.method = params.method == Method::kDbm ? std::string("dbm-") + toString(params.solver) : toString(params.method);
+  bolt.stats.elapsedMs = watch.ms();
+  return bolt;
+}
+
+}  // namespace effects::lightning

@@ -1,0 +1,143 @@
+// Bolt tree -> polylines for renderers; box-counting fractal dimension.
+#include <algorithm>
+#include <cmath>
+
+#include "effects/lightning.h"
+
+namespace effects::lightning {
+namespace {
+
+// A hash of (seed, node) -> two uniforms: jitter independent of growth order and RNG state.
+void jitterOf(uint64_t seed, int node, double& u, double& v) {
+  Rng r(seed ^ (0x9E3779B97F4A7C15ULL * uint64_t(node + 1)), 0xB5297A4D3F84D5B5ULL);
+  u = r.uniform();
+  v = r.uniform();
+}
+
+}  // namespace
+
+std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& s) {
+  const size_t n = bolt.nodes.size();
+  std::vector<std::vector<int>> children(n);
+  for (size_t i = 1; i < n; ++i) children[size_t(bolt.nodes[i].parent)].push_back(int(i));
+  // Height of each subtree (nodes are in growth order: children come after parents).
+  std::vector<int> depth(n, 0);
+  for (size_t i = n; i-- > 1;) {
+    int p = bolt.nodes[i].parent;
+    depth[size_t(p)] = std::max(depth[size_t(p)], depth[i] + 1);
+  }
+  // Tree distance from the main channel.
+  std::vector<int> fromMain(n, -1);
+  for (int m : bolt.mainChannel) fromMain[size_t(m)] = 0;
+  for (size_t i = 1; i < n; ++i)
+    if (fromMain[i] < 0) fromMain[i] = fromMain[size_t(bolt.nodes[i].parent)] + 1;
+
+  auto vertex = [&](int node) {
+    const Node& nd = bolt.nodes[size_t(node)];
+    double u = 0.5, v = 0.5;
+    if (s.jitter > 0) jitterOf(s.jitterSeed, node, u, v);
+    Vertex out;
+    out.x = float(nd.cell.x + 0.5 + s.jitter * (u - 0.5));
+    out.y = float(nd.cell.y + 0.5 + s.jitter * (v - 0.5));
+    out.step = nd.step;
+    out.node = node;
+    out.intensity = fromMain[size_t(node)] == 0
+                        ? 1.0f
+                        : float(s.branchIntensity * std::exp(-(fromMain[size_t(node)] - 1) / s.branchFalloff));
+    return out;
+  };
+
+  std::vector<Polyline> out;
+  std::vector<uint8_t> onMain(n, 0);
+  Polyline main;
+  main.main = true;
+  main.width = float(2 * s.branchWidth);
+  for (int m : bolt.mainChannel) {
+    onMain[size_t(m)] = 1;
+    main.vertices.push_back(vertex(m));
+  }
+  out.push_back(std::move(main));
+  // Branches: every child that is not the continuation of its parent's line starts one.
+  // The continuation of a branch is its child with the deepest subtree (ties: earliest).
+  std::vector<int> stack;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c : children[i]) {
+      if (onMain[size_t(c)]) continue;
+      bool continuation = false;
+      if (!onMain[i]) {
+        int best = -1;
+        for (int d : children[i])
+          if (best < 0 || depth[size_t(d)] > depth[size_t(best)]) best = d;
+        continuation = best == c;
+      }
+      if (continuation) continue;
+      Polyline b;
+      b.width = float(s.branchWidth);
+      b.vertices.push_back(vertex(int(i)));
+      for (int cur = c;;) {
+        b.vertices.push_back(vertex(cur));
+        int next = -1;
+        for (int d : children[size_t(cur)])
+          if (next < 0 || depth[size_t(d)] > depth[size_t(next)]) next = d;
+        if (next < 0) break;
+        cur = next;
+      }
+      out.push_back(std::move(b));
+    }
+  }
+  return out;
+}
+
+double fractalDimension(const std::vector<Cell>& cells, int width, int height) {
+  if (cells.size() < 2) return 0.0;
+  int maxBox = std::max(1, std::min(width, height) / 4);
+  std::vector<double> logInvS, logN;
+  std::vector<uint64_t> keys;
+  for (int s = 1; s <= maxBox; s *= 2) {
+    size_t best = SIZE_MAX;
+    for (int off = 0; off < 4; ++off) {
+      int ox = (off & 1) ? s / 2 : 0, oy = (off & 2) ? s / 2 : 0;
+      if (s == 1 && off) break;
+      keys.clear();
+      for (const Cell& c : cells)
+        keys.push_back(uint64_t(uint32_t((c.x + ox) / s)) << 32 | uint32_t((c.y + oy) / s));
+      std::sort(keys.begin(), keys.end());
+      best = std::min(best, size_t(std::unique(keys.begin(), keys.end()) - keys.begin()));
+    }
+    logInvS.push_back(-std::log(double(s)));
+    logN.push_back(std::log(double(best)));
+  }
+  auto fit = [&](size_t a, size_t b, double& slope) {  // least squares over [a, b)
+    double n = double(b - a), sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    for (size_t i = a; i < b; ++i) {
+      sx += logInvS[i];
+      sy += logN[i];
+      sxx += logInvS[i] * logInvS[i];
+      sxy += logInvS[i] * logN[i];
+      syy += logN[i] * logN[i];
+    }
+    double vx = sxx - sx * sx / n, vy = syy - sy * sy / n, cxy = sxy - sx * sy / n;
+    slope = vx > 0 ? cxy / vx : 0.0;
+    return (vx > 0 && vy > 0) ? cxy * cxy / (vx * vy) : 0.0;  // R^2
+  };
+  size_t m = logN.size();
+  if (m < 2) return 0.0;
+  double bestSlope = 0;
+  fit(0, m, bestSlope);
+  if (m < 4) return bestSlope;
+  // The straight part: the run of >= 4 consecutive scales with the best R^2 (longest on ties).
+  double bestR2 = -1;
+  size_t bestLen = 0;
+  for (size_t a = 0; a + 4 <= m; ++a)
+    for (size_t b = a + 4; b <= m; ++b) {
+      double slope, r2 = fit(a, b, slope);
+      if (r2 > bestR2 + 1e-4 || (r2 >= bestR2 - 1e-4 && b - a > bestLen)) {
+        bestR2 = std::max(r2, bestR2);
+        bestSlope = slope;
+        bestLen = b - a;
+      }
+    }
+  return bestSlope;
+}
+
+}  // namespace effects::lightning

@@ -1,0 +1,272 @@
+// effects/lightning: growth methods, guide, stiff and extreme cases, shape, quality metrics.
+#include <cmath>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include <effects/lightning.h>
+
+namespace effects::lightning {
+namespace {
+
+Params basic(int n, Method m = Method::kFast, uint64_t seed = 1) {
+  Params p;
+  p.width = p.height = n;
+  p.start = {n / 2, 0};
+  p.targets = {{n / 2, n - 1}};
+  p.method = m;
+  p.seed = seed;
+  return p;
+}
+
+// The bolt is a tree of 8-connected cells, free of obstacles, from start to every target.
+void expectWellFormed(const Params& p, const Bolt& b) {
+  ASSERT_FALSE(b.nodes.empty());
+  EXPECT_EQ(b.nodes[0].cell, p.start);
+  std::set<std::pair<int, int>> seen;
+  for (size_t i = 0; i < b.nodes.size(); ++i) {
+    const Node& n = b.nodes[i];
+    EXPECT_TRUE(seen.insert({n.cell.x, n.cell.y}).second) << "cell twice";
+    ASSERT_TRUE(n.cell.x >= 0 && n.cell.y >= 0 && n.cell.x < p.width && n.cell.y < p.height);
+    if (!p.obstacles.empty()) {
+      EXPECT_EQ(p.obstacles[size_t(n.cell.y) * p.width + n.cell.x], 0);
+    }
+    if (i == 0) continue;
+    ASSERT_TRUE(n.parent >= 0 && size_t(n.parent) < i);
+    const Cell& q = b.nodes[size_t(n.parent)].cell;
+    EXPECT_LE(std::abs(q.x - n.cell.x), 1);
+    EXPECT_LE(std::abs(q.y - n.cell.y), 1);
+  }
+  ASSERT_FALSE(b.mainChannel.empty());
+  EXPECT_EQ(b.nodes[size_t(b.mainChannel.front())].cell, p.start);
+  EXPECT_EQ(b.nodes[size_t(b.mainChannel.back())].cell, p.targets.back());
+  for (const Cell& t : p.targets) EXPECT_TRUE(seen.count({t.x, t.y}));
+}
+
+TEST(Lightning, EveryMethodReachesTheTarget) {
+  for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+    Params p = basic(48, m);
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok()) << b.error().message;
+    expectWellFormed(p, b.value());
+    EXPECT_EQ(b.value().stats.method, m == Method::kDbm ? "dbm-mgpcg" : toString(m));
+  }
+}
+
+TEST(Lightning, Deterministic) {
+  for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+    auto a = grow(basic(40, m, 9)), b = grow(basic(40, m, 9)), c = grow(basic(40, m, 10));
+    ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+    ASSERT_EQ(a.value().nodes.size(), b.value().nodes.size());
+    for (size_t i = 0; i < a.value().nodes.size(); ++i) {
+      EXPECT_EQ(a.value().nodes[i].cell, b.value().nodes[i].cell);
+      EXPECT_EQ(a.value().nodes[i].parent, b.value().nodes[i].parent);
+    }
+    bool differs = a.value().nodes.size() != c.value().nodes.size();
+    for (size_t i = 0; !differs && i < a.value().nodes.size(); ++i) differs = !(a.value().nodes[i].cell == c.value().nodes[i].cell);
+    EXPECT_TRUE(differs) << "another seed should give another bolt";
+  }
+}
+
+TEST(Lightning, EtaRange) {
+  for (double eta : {0.0, 0.5, 10.0, 50.0})
+    for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+      Params p = basic(24, m);
+      p.eta = eta;
+      auto b = grow(p);
+      ASSERT_TRUE(b.ok()) << eta << " " << b.error().message;
+      expectWellFormed(p, b.value());
+    }
+}
+
+TEST(Lightning, TinyGridsAndAdjacentTarget) {
+  Params p = basic(3);
+  p.start = {1, 0};
+  p.targets = {{1, 2}};
+  for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+    p.method = m;
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok());
+    expectWellFormed(p, b.value());
+  }
+  p.targets = {{1, 1}};
+  auto b = grow(p);
+  ASSERT_TRUE(b.ok());
+  EXPECT_EQ(b.value().nodes.size(), 2u);
+}
+
+TEST(Lightning, ClearErrors) {
+  Params p = basic(16);
+  p.targets = {p.start};
+  EXPECT_EQ(grow(p).error().field, "/targets/0");
+  EXPECT_EQ(grow(p).error().kind, ErrorKind::kUnsatisfiable);
+  p = basic(16);
+  p.start = {16, 0};
+  EXPECT_EQ(grow(p).error().field, "/start");
+  p = basic(16);
+  p.obstacles.assign(256, 0);
+  p.obstacles[size_t(p.targets[0].y) * 16 + p.targets[0].x] = 1;
+  EXPECT_EQ(grow(p).error().field, "/targets/0");
+  // Target walled in: unreachable -> 422, never a hang.
+  p = basic(16);
+  p.obstacles.assign(256, 0);
+  for (int x = 0; x < 16; ++x) p.obstacles[size_t(8) * 16 + x] = 1;
+  for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+    p.method = m;
+    auto b = grow(p);
+    ASSERT_FALSE(b.ok());
+    EXPECT_EQ(b.error().kind, ErrorKind::kUnsatisfiable);
+    EXPECT_EQ(b.error().field, "/targets/0");
+  }
+  p = basic(64);
+  p.maxSteps = 10;
+  EXPECT_EQ(grow(p).error().kind, ErrorKind::kLimitExceeded);
+  p = basic(16);
+  p.eta = 51;
+  EXPECT_EQ(grow(p).error().field, "/eta");
+}
+
+TEST(Lightning, MazeCorridorWithGuide) {
+  // A one-cell-wide serpentine corridor: walls every other row with alternating gaps.
+  const int n = 33;
+  Params p = basic(n);
+  p.obstacles.assign(size_t(n) * n, 0);
+  for (int y = 1; y < n - 1; y += 2)
+    for (int x = 0; x < n; ++x) p.obstacles[size_t(y) * n + x] = (y / 2) % 2 == 0 ? (x != n - 1) : (x != 0);
+  p.start = {0, 0};
+  p.targets = {{n - 1, n - 1}};
+  for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
+    p.method = m;
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok()) << toString(m) << " " << b.error().message;
+    expectWellFormed(p, b.value());
+  }
+}
+
+TEST(Lightning, DenseObstacles) {
+  const int n = 96;
+  Params p = basic(n);
+  p.obstacles.assign(size_t(n) * n, 0);
+  Rng rng(3);
+  for (auto& o : p.obstacles) o = rng.uniform() < 0.6 ? 1 : 0;
+  // Carve a guaranteed passage so the target is reachable through 60 % obstacles.
+  for (int y = 0; y < n; ++y) p.obstacles[size_t(y) * n + size_t(n / 2 + (y / 8) % 3)] = 0;
+  for (int y = 0; y < n; ++y) p.obstacles[size_t(y) * n + size_t(n / 2)] = 0;
+  auto b = grow(p);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  expectWellFormed(p, b.value());
+  EXPECT_FALSE(b.value().guide.empty());
+}
+
+TEST(Lightning, ChainLightning) {
+  Params p = basic(48);
+  p.targets = {{10, 30}, {40, 40}, {24, 47}};
+  for (Method m : {Method::kFast, Method::kDbm, Method::kCharges}) {
+    p.method = m;
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok()) << b.error().message;
+    expectWellFormed(p, b.value());
+    // The main channel passes through every target in order.
+    size_t k = 0;
+    for (int m2 : b.value().mainChannel)
+      if (k < p.targets.size() && b.value().nodes[size_t(m2)].cell == p.targets[k]) ++k;
+    EXPECT_EQ(k, p.targets.size());
+  }
+}
+
+TEST(Lightning, SolversAgree) {
+  std::vector<Cell> bolt = {{16, 0}, {16, 1}, {15, 2}, {16, 3}};
+  int itCg = 0, itMg = 0;
+  double resCg = 0, resMg = 0;
+  auto a = solveLaplace(32, 32, {}, bolt, {16, 31}, Solver::kCg, 1e-10, &itCg, &resCg);
+  auto b = solveLaplace(32, 32, {}, bolt, {16, 31}, Solver::kMgpcg, 1e-10, &itMg, &resMg);
+  EXPECT_LE(resCg, 1e-10);
+  EXPECT_LE(resMg, 1e-10);
+  EXPECT_LT(itMg, itCg);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-8);
+  // Discrete harmonic: every free interior cell is the mean of its 4 neighbours.
+  auto at = [&](int x, int y) { return (x < 0 || y < 0 || x >= 32 || y >= 32) ? 0.0 : b[size_t(y) * 32 + x]; };
+  EXPECT_NEAR(at(5, 20), 0.25 * (at(4, 20) + at(6, 20) + at(5, 19) + at(5, 21)), 1e-9);
+  EXPECT_EQ(at(16, 31), 1.0);
+  EXPECT_EQ(at(16, 1), 0.0);
+}
+
+TEST(Lightning, ErrorMeasurementIsOptInAndSmallForDbm) {
+  Params p = basic(24, Method::kDbm);
+  auto plain = grow(p);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain.value().stats.error);
+  p.measureError = true;
+  p.tolerance = 1e-9;
+  auto dbm = grow(p);
+  ASSERT_TRUE(dbm.ok());
+  ASSERT_TRUE(dbm.value().stats.error);
+  EXPECT_LT(*dbm.value().stats.error, 1e-4);
+  p.method = Method::kFast;
+  auto fast = grow(p);
+  ASSERT_TRUE(fast.ok());
+  ASSERT_TRUE(fast.value().stats.error);
+  EXPECT_GT(*fast.value().stats.error, *dbm.value().stats.error);
+  EXPECT_LE(*fast.value().stats.error, 1.0);
+}
+
+TEST(Lightning, PolylinesCoverTheTree) {
+  Params p = basic(64);
+  auto b = grow(p);
+  ASSERT_TRUE(b.ok());
+  ShapeParams s;
+  auto lines = polylines(b.value(), s);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_TRUE(lines[0].main);
+  EXPECT_FLOAT_EQ(lines[0].width, 2 * lines[1 % lines.size()].width * (lines.size() > 1 ? 1 : 0.5f));
+  std::set<int> covered;
+  for (const auto& l : lines) {
+    for (const auto& v : l.vertices) {
+      covered.insert(v.node);
+      const Cell& c = b.value().nodes[size_t(v.node)].cell;
+      EXPECT_TRUE(v.x >= c.x && v.x <= c.x + 1 && v.y >= c.y && v.y <= c.y + 1);  // jitter inside the cell
+      EXPECT_TRUE(v.intensity > 0 && v.intensity <= 1);
+      if (l.main) {
+        EXPECT_EQ(v.intensity, 1.0f);
+      }
+    }
+  }
+  EXPECT_EQ(covered.size(), b.value().nodes.size());
+  s.jitter = 0;
+  auto flat = polylines(b.value(), s);
+  EXPECT_FLOAT_EQ(flat[0].vertices[0].x, p.start.x + 0.5f);
+}
+
+TEST(Lightning, FractalDimensionOfKnownSets) {
+  std::vector<Cell> line, square;
+  for (int i = 0; i < 256; ++i) line.push_back({i, 100});
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 256; ++x) square.push_back({x, y});
+  EXPECT_NEAR(fractalDimension(line, 256, 256), 1.0, 0.02);
+  EXPECT_NEAR(fractalDimension(square, 256, 256), 2.0, 0.02);
+}
+
+TEST(Lightning, BoundaryMapMatchesDirectSum) {
+  const int n = 40;
+  std::vector<uint8_t> obs(size_t(n) * n, 0);
+  for (int i = 5; i < 15; ++i) obs[size_t(20) * n + i] = 1;
+  for (Cell c : {Cell{0, 0}, Cell{20, 19}, Cell{30, 30}, Cell{3, 37}}) {
+    double direct = 0;
+    auto add = [&](int x, int y) { direct += 1.0 / std::hypot(double(x - c.x), double(y - c.y)); };
+    for (int x = -1; x <= n; ++x) {
+      add(x, -1);
+      add(x, n);
+    }
+    for (int y = 0; y < n; ++y) {
+      add(-1, y);
+      add(n, y);
+    }
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        if (obs[size_t(y) * n + x]) add(x, y);
+    EXPECT_NEAR(boundaryPotential(n, n, obs, c), direct, 0.02 * direct);
+  }
+}
+
+}  // namespace
+}  // namespace effects::lightning
