@@ -1,0 +1,166 @@
+// POST /v1/lightning — grid + obstacles + start/targets -> bolt tree, polylines, quality.
+#include <effects/lightning.h>
+
+#include "codec.h"
+#include "endpoints.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace lt = effects::lightning;
+
+ApiError fieldError(int status, const std::string& pointer, const std::string& message) {
+  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-field",
+                  status == 413 ? "Request exceeds a configured limit" : "Invalid field", pointer + ": " + message,
+                  {{pointer, message}}, {}};
+}
+
+std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
+  std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
+  bool any = false;
+  if (o.contains("rects")) {
+    for (const auto& r : o["rects"]) {
+      int x0 = r[0], y0 = r[1], rw = r[2], rh = r[3];
+      for (int y = y0; y < std::min(h, y0 + rh); ++y)
+        for (int x = x0; x < std::min(w, x0 + rw); ++x) grid[size_t(y) * w + x] = 1;
+      any = true;
+    }
+  }
+  if (o.contains("rows")) {
+    const json& rows = o["rows"];
+    for (size_t i = 0; i < rows.size(); ++i) {
+      int y = rows[i]["y"];
+      if (y >= h) throw fieldError(400, "/obstacles/rows/" + std::to_string(i) + "/y", "is outside the grid");
+      for (const auto& run : rows[i]["runs"]) {
+        int x0 = run[0], len = run[1];
+        for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;
+      }
+      any = true;
+    }
+  }
+  if (o.contains("bitmap")) {
+    auto bytes = base64Decode(o["bitmap"].get<std::string>());
+    if (!bytes) throw fieldError(400, "/obstacles/bitmap", "is not valid base64 (standard alphabet, padded)");
+    size_t need = (grid.size() + 7) / 8;
+    if (bytes->size() != need)
+      throw fieldError(400, "/obstacles/bitmap",
+                       "must decode to " + std::to_string(need) + " bytes (width*height bits), got " + std::to_string(bytes->size()));
+    for (size_t i = 0; i < grid.size(); ++i)
+      if ((uint8_t((*bytes)[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
+    any = true;
+  }
+  if (!any) grid.clear();
+  return grid;
+}
+
+lt::Cell cellOf(const json& j) { return {j[0].get<int>(), j[1].get<int>()}; }
+
+JsonReply handleLightning(const json& body, const RequestContext& ctx) {
+  Includes include(body, {"polylines"});
+  lt::Params p;
+  p.width = body["grid"]["width"];
+  p.height = body["grid"]["height"];
+  const size_t cells = size_t(p.width) * size_t(p.height);
+  if (cells > ctx.config.limits.maxGridCells)
+    throw fieldError(413, "/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                                       std::to_string(ctx.config.limits.maxGridCells) + " (--max-grid-cells)");
+  if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height);
+  p.start = cellOf(body["start"]);
+  p.targets.clear();
+  for (const auto& t : body["targets"]) p.targets.push_back(cellOf(t));
+  const std::string method = body.value("method", "fast");
+  p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+  p.eta = body.value("eta", p.eta);
+  p.lifetime = body.value("lifetime", p.lifetime);
+  p.solver = body.value("solver", "mgpcg") == "cg" ? lt::Solver::kCg : lt::Solver::kMgpcg;
+  p.tolerance = body.value("tolerance", p.tolerance);
+  const std::string guide = body.value("guide", "auto");
+  p.guide = guide == "astar" ? lt::Guide::kAstar : guide == "none" ? lt::Guide::kNone : lt::Guide::kAuto;
+  p.seed = body.value("seed", uint64_t(1));
+  p.maxSteps = std::min<size_t>(body.value("maxSteps", ctx.config.limits.maxGrowthSteps), ctx.config.limits.maxGrowthSteps);
+  p.measureError = include.has("error");
+
+  auto grown = lt::grow(p);
+  if (!grown.ok()) {
+    effects::Error e = grown.error();
+    if (e.field == "/maxSteps") e.message += " (--max-growth-steps / maxSteps)";
+    throwError(e);
+  }
+  const lt::Bolt& bolt = grown.value();
+  JsonReply reply;
+  reply.method = bolt.stats.method;
+  reply.computeMs = bolt.stats.elapsedMs;
+  json out = {{"method", bolt.stats.method}, {"grid", {p.width, p.height}}};
+  out["mainChannelLength"] = bolt.mainChannel.size();
+  out["cellCount"] = bolt.nodes.size();
+  out["steps"] = bolt.nodes.back().step;
+
+  if (include.has("polylines")) {
+    lt::ShapeParams shape;
+    const json s = body.value("shape", json::object());
+    shape.jitter = s.value("jitter", shape.jitter);
+    shape.jitterSeed = s.value("jitterSeed", p.seed);
+    shape.branchWidth = s.value("branchWidth", shape.branchWidth);
+    shape.branchIntensity = s.value("branchIntensity", shape.branchIntensity);
+    shape.branchFalloff = s.value("branchFalloff", shape.branchFalloff);
+    json lines = json::array();
+    for (const auto& l : lt::polylines(bolt, shape)) {
+      json xy = json::array(), step = json::array(), intensity = json::array();
+      for (const auto& v : l.vertices) {
+        xy.push_back(v.x);
+        xy.push_back(v.y);
+        step.push_back(v.step);
+        intensity.push_back(v.intensity);
+      }
+      lines.push_back({{"channel", l.main ? "main" : "branch"},
+                       {"width", l.width},
+                       {"points", std::move(xy)},
+                       {"step", std::move(step)},
+                       {"intensity", std::move(intensity)}});
+    }
+    out["polylines"] = std::move(lines);
+  }
+  if (include.has("cells")) {
+    json c = json::array();
+    for (const auto& n : bolt.nodes) {
+      c.push_back(n.cell.x);
+      c.push_back(n.cell.y);
+    }
+    out["cells"] = std::move(c);
+  }
+  if (include.has("tree")) {
+    json parent = json::array(), step = json::array();
+    for (const auto& n : bolt.nodes) {
+      parent.push_back(n.parent);
+      step.push_back(n.step);
+    }
+    out["tree"] = {{"parent", std::move(parent)}, {"step", std::move(step)}, {"mainChannel", bolt.mainChannel}};
+  }
+  if (include.has("guide")) {
+    json g = json::array();
+    for (const auto& c : bolt.guide) g.push_back({c.x, c.y});
+    out["guide"] = std::move(g);
+  }
+  if (include.has("fractalDimension")) {
+    std::vector<lt::Cell> cellsOnly;
+    for (const auto& n : bolt.nodes) cellsOnly.push_back(n.cell);
+    out["fractalDimension"] = lt::fractalDimension(cellsOnly, p.width, p.height);
+  }
+  if (include.has("error")) {
+    out["error"] = {{"meanTotalVariation", bolt.stats.error.value_or(0.0)},
+                    {"metric", bolt.stats.errorMetric},
+                    {"reference", bolt.stats.reference}};
+  }
+  if (include.has("stats")) out["stats"] = statsJson(bolt.stats);
+  reply.body = std::move(out);
+  return reply;
+}
+
+}  // namespace
+
+void addLightningEndpoints(Service& service) {
+  service.addJsonEndpoint("/v1/lightning", "lightning.json", handleLightning);
+}
+
+}  // namespace effectd
