@@ -1,0 +1,118 @@
+// Lightning figures of issue 3, printed side by side in one run. Layout for all: start
+// top-centre, target bottom-centre, eta = 2, no obstacles unless said.
+//   fast 128^2 (target <= 1 ms); fast vs plain-CG dbm at tolerance 1e-6 (targets >= 300x at
+//   64^2, >= 2000x at 128^2); dbm with MGPCG at 128^2 (target <= 100 ms); fast at 1024^2 with
+//   ~20 % obstacles (target <= 50 ms, less with the boundary map cached).
+// Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include <effects/lightning.h>
+
+namespace {
+
+using namespace effects::lightning;
+
+Params layout(int n, Method m, uint64_t seed = 1) {
+  Params p;
+  p.width = p.height = n;
+  p.start = {n / 2, 0};
+  p.targets = {{n / 2, n - 1}};
+  p.method = m;
+  p.seed = seed;
+  return p;
+}
+
+void run(benchmark::State& state, Params p) {
+  uint64_t seed = 1;
+  double cells = 0;
+  for (auto _ : state) {
+    p.seed = seed++;
+    auto b = grow(p);
+    if (!b.ok()) {
+      state.SkipWithError(b.error().message.c_str());
+      return;
+    }
+    cells += double(b.value().nodes.size());
+  }
+  state.counters["cells"] = cells / double(state.iterations());
+}
+
+void BM_Fast(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kFast)); }
+void BM_Charges(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kCharges)); }
+void BM_DbmMgpcg(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kDbm)); }
+void BM_DbmCg(benchmark::State& s) {
+  Params p = layout(int(s.range(0)), Method::kDbm);
+  p.solver = Solver::kCg;
+  run(s, p);
+}
+void BM_Fast1024Obstacles(benchmark::State& s) {
+  Params p = layout(1024, Method::kFast);
+  p.obstacles.assign(size_t(1024) * 1024, 0);
+  effects::Rng rng(12);
+  for (size_t i = 0; i < p.obstacles.size(); ++i) {
+    int x = int(i % 1024);
+    if ((x < 500 || x >= 524) && rng.uniform() < 0.2) p.obstacles[i] = 1;  // ~20 %, passage kept open
+  }
+  uint64_t seed = 1;
+  for (auto _ : s) {
+    if (s.range(0) == 0) {
+      // Uncached: a different obstacle set each iteration (flip one far corner cell).
+      s.PauseTiming();
+      p.obstacles[size_t(1023) * 1024 + size_t(seed % 400)] ^= 1;
+      s.ResumeTiming();
+    }
+    p.seed = seed++;
+    auto b = grow(p);
+    if (!b.ok()) {
+      s.SkipWithError(b.error().message.c_str());
+      return;
+    }
+  }
+  s.SetLabel(s.range(0) == 0 ? "boundary map built every call" : "boundary map cached");
+}
+
+BENCHMARK(BM_Fast)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Charges)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DbmMgpcg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DbmCg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_Fast1024Obstacles)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void fractal() {
+  std::printf("fractal dimension, 128x128, 20 seeds (mean +- sd)\n");
+  for (double eta : {1.0, 2.0}) {
+    for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
+      double sum = 0, sum2 = 0;
+      for (uint64_t seed = 1; seed <= 20; ++seed) {
+        Params p = layout(128, m, seed);
+        p.eta = eta;
+        auto b = grow(p);
+        std::vector<Cell> cells;
+        for (const auto& n : b.value().nodes) cells.push_back(n.cell);
+        double d = fractalDimension(cells, 128, 128);
+        sum += d;
+        sum2 += d * d;
+      }
+      double mean = sum / 20, sd = std::sqrt(std::max(0.0, sum2 / 20 - mean * mean));
+      std::printf("  eta=%.0f %-8s D = %.3f +- %.3f\n", eta, toString(m), mean, sd);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "--fractal") == 0) {
+      fractal();
+      return 0;
+    }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
