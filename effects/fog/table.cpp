@@ -113,13 +113,13 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
     measure(t.value());
     return t;
   };
+  const size_t cap = twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize;  // largest N allowed
   size_t lo = 1, hi = 2;
   auto best = errorFor(hi);
   int measurements = 1;
   while (best.value().maxError > o.maxError) {
     lo = hi;
     if (entries(hi * 2, hi * 2) > o.maxSize) {
-      size_t cap = twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize;
       if (cap <= hi) return unsatisfiable("/maxError", "not reachable within the table size limit");
       hi = cap;
     } else {
@@ -127,7 +127,7 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
     }
     best = errorFor(hi);
     ++measurements;
-    if (best.value().maxError > o.maxError && hi == (twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize))
+    if (best.value().maxError > o.maxError && hi == cap)
       return unsatisfiable("/maxError", "error " + std::to_string(best.value().maxError) +
                                             " at the size limit is above the requested maximum");
   }

@@ -201,18 +201,23 @@ void Grower::logWeights(std::vector<double>& out) {
   }
 }
 
-// Samples index i with probability Phi_i^eta / sum Phi^eta (seed 002 eqn 2), in log space.
-size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vector<double>& w) {
+// Unnormalised p_i = Phi_i^eta (seed 002 eqn 2) from log Phi, scaled by the largest so that
+// nothing overflows; eta = 0 or all Phi = 0 gives uniform weights (0^0 = 1). Returns the sum.
+double candidateWeights(const std::vector<double>& logPhi, double eta, std::vector<double>& w) {
   w.resize(logPhi.size());
   double top = kNegInf;
   for (double l : logPhi) top = std::max(top, l);
   double sum = 0;
   for (size_t i = 0; i < logPhi.size(); ++i) {
-    // eta = 0 or all Phi = 0: uniform (0^0 = 1).
     w[i] = (eta == 0.0 || top == kNegInf) ? 1.0 : std::exp(eta * (logPhi[i] - top));
     sum += w[i];
   }
-  double u = rng.uniform() * sum;
+  return sum;
+}
+
+// Samples index i with probability Phi_i^eta / sum Phi^eta.
+size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vector<double>& w) {
+  double u = rng.uniform() * candidateWeights(logPhi, eta, w);
   for (size_t i = 0; i < w.size(); ++i) {
     u -= w[i];
     if (u < 0) return i;
@@ -227,19 +232,10 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   // converged Laplace solution gives on the same bolt state (over all free bolt neighbours).
   double res = 0;
   reference_->solve(Solver::kMgpcg, 1e-10, &res);
-  std::vector<double> p(cands_.size());
-  {
-    double top = kNegInf, sum = 0;
-    for (double l : logPhi) top = std::max(top, l);
-    for (size_t i = 0; i < p.size(); ++i) {
-      p[i] = (p_.eta == 0 || top == kNegInf) ? 1.0 : std::exp(p_.eta * (logPhi[i] - top));
-      sum += p[i];
-    }
-    for (double& v : p) v /= sum;
-  }
-  // Reference support: every free cell next to a bolt cell of this segment.
-  std::vector<std::pair<size_t, double>> ref;  // cell index, weight
-  double refSum = 0;
+  std::vector<double> p;
+  const double pSum = candidateWeights(logPhi, p_.eta, p);
+  for (double& v : p) v /= pSum;
+  // Reference support: every free cell next to a bolt cell.
   std::vector<size_t> cells;
   for (const Node& n : bolt_.nodes)
     for (int k = 0; k < 8; ++k) {
@@ -248,13 +244,16 @@ double Grower::stepError(const std::vector<double>& logPhi) {
     }
   std::sort(cells.begin(), cells.end());
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  std::vector<double> refPhi(cells.size());
   double top = 0;
-  for (size_t i : cells) top = std::max(top, reference_->phi(int(i % size_t(g_.width)), int(i / size_t(g_.width))));
-  for (size_t i : cells) {
-    double phi = std::max(0.0, reference_->phi(int(i % size_t(g_.width)), int(i / size_t(g_.width))));
-    double wgt = (p_.eta == 0 || top <= 0) ? 1.0 : std::pow(phi / top, p_.eta);
-    ref.push_back({i, wgt});
-    refSum += wgt;
+  for (size_t k = 0; k < cells.size(); ++k) {
+    refPhi[k] = std::max(0.0, reference_->phi(int(cells[k] % size_t(g_.width)), int(cells[k] / size_t(g_.width))));
+    top = std::max(top, refPhi[k]);
+  }
+  double refSum = 0;
+  for (double& phi : refPhi) {
+    phi = (p_.eta == 0 || top <= 0) ? 1.0 : std::pow(phi / top, p_.eta);  // now the weight
+    refSum += phi;
   }
   double tv = 0;
   std::vector<double> mine(cells.size(), 0.0);
@@ -264,7 +263,7 @@ double Grower::stepError(const std::vector<double>& logPhi) {
     if (it2 != cells.end() && *it2 == g_.index(cands_[i].cell)) mine[size_t(it2 - cells.begin())] += p[i];
     else outside += p[i];
   }
-  for (size_t k = 0; k < cells.size(); ++k) tv += std::fabs(mine[k] - ref[k].second / refSum);
+  for (size_t k = 0; k < cells.size(); ++k) tv += std::fabs(mine[k] - refPhi[k] / refSum);
   return 0.5 * (tv + outside);
 }
 
