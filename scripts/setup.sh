@@ -8,8 +8,12 @@ PACKAGES=(
   libcpp-httplib-dev nlohmann-json3-dev libglm-dev
   libopenimageio-dev libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev libbenchmark-dev
-  glslang-tools libtinygltf-dev
+  glslang-tools
+  assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
 )
+# Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node
+# (e.g. from NodeSource) keep it; otherwise Debian's.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then PACKAGES+=(nodejs npm); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

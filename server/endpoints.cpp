@@ -7,6 +7,7 @@ namespace effectd {
 void addEffectEndpoints(Service& service) {
   addFogEndpoints(service);
   addLightningEndpoints(service);
+  addTangentsEndpoints(service);
 }
 
 glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }

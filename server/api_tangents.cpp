@@ -1,0 +1,232 @@
+// POST /v1/tangents — indexed triangle mesh (JSON) or binary glTF -> vertex tangents.
+#include <cstring>
+
+#include <effects/tangents.h>
+
+#include "endpoints.h"
+#include "glb.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace tg = effects::tangents;
+
+tg::Options options(const Config& config, tg::Mode mode) {
+  tg::Options o;
+  o.mode = mode;
+  o.maxVertices = config.limits.maxMeshVertices;
+  o.maxTriangles = config.limits.maxMeshTriangles;
+  return o;
+}
+
+template <class V, int N>
+std::vector<V> unflatten(const json& a, const std::string& pointer) {
+  if (a.size() % N != 0)
+    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": length must be a multiple of " + std::to_string(N),
+                   {{pointer, "length must be a multiple of " + std::to_string(N)}}, {}};
+  std::vector<V> out(a.size() / N);
+  for (size_t i = 0; i < out.size(); ++i)
+    for (int c = 0; c < N; ++c) out[i][c] = a[i * N + size_t(c)].get<float>();
+  return out;
+}
+
+// Library fields name vertices; the wire has flat arrays ("/positions/7" -> "/mesh/positions/21").
+std::string meshPointer(const std::string& field) {
+  for (auto [name, width] : {std::pair{"/positions/", 3}, {"/normals/", 3}, {"/uvs/", 2}})
+    if (field.rfind(name, 0) == 0) return "/mesh" + std::string(name) + std::to_string(std::stoull(field.substr(std::strlen(name))) * width);
+  return "/mesh" + field;
+}
+
+void flipW(tg::Output& out) {
+  for (auto& t : out.tangents) t.w = -t.w;
+}
+
+template <class V, int N>
+json flat(const std::vector<V>& v) {
+  json a = json::array();
+  a.get_ref<json::array_t&>().reserve(v.size() * N);
+  for (const V& x : v)
+    for (int c = 0; c < N; ++c) a.push_back(x[c]);
+  return a;
+}
+
+JsonReply handleTangents(const json& body, const RequestContext& ctx) {
+  Includes include(body, {"tangents", "remap", "indices"});
+  const json& m = body["mesh"];
+  tg::Mesh mesh;
+  mesh.positions = unflatten<glm::vec3, 3>(m["positions"], "/mesh/positions");
+  if (m.contains("normals")) mesh.normals = unflatten<glm::vec3, 3>(m["normals"], "/mesh/normals");
+  mesh.uvs = unflatten<glm::vec2, 2>(m["uvs"], "/mesh/uvs");
+  mesh.indices = m["indices"].get<std::vector<uint32_t>>();
+  const std::string modeName = body.value("mode", "mikktspace");
+  tg::Options opt = options(ctx.config, modeName == "perTriangle" ? tg::Mode::kPerTriangle : tg::Mode::kMikkTSpace);
+  opt.measureError = include.has("error") && opt.mode == tg::Mode::kPerTriangle;
+  opt.triangleFrames = include.has("triangleFrames");
+  auto r = tg::generate(mesh, opt);
+  if (!r.ok()) {
+    effects::Error e = r.error();
+    e.field = meshPointer(e.field);
+    throwError(e);
+  }
+  tg::Output& out = r.value();
+  if (body.value("uvOrigin", "bottom-left") == "top-left") flipW(out);
+
+  JsonReply reply;
+  reply.method = out.stats.method;
+  reply.computeMs = out.stats.elapsedMs;
+  json res = {{"method", reply.method}, {"vertexCount", out.remap.size()}};
+  if (include.has("tangents")) res["tangents"] = flat<glm::vec4, 4>(out.tangents);
+  if (include.has("remap")) res["remap"] = out.remap;
+  if (include.has("indices")) res["indices"] = out.indices;
+  if (include.has("normals")) res["normals"] = flat<glm::vec3, 3>(out.normals);
+  if (include.has("triangleFrames")) {
+    json t = json::array(), b = json::array(), n = json::array(), w = json::array(), degenerate = json::array();
+    for (size_t i = 0; i < out.triangleFrames.size(); ++i) {
+      const tg::Frame& f = out.triangleFrames[i];
+      for (int c = 0; c < 3; ++c) t.push_back(f.tangent[c]), b.push_back(f.bitangent[c]), n.push_back(f.normal[c]);
+      w.push_back(f.w);
+      if (f.degenerate) degenerate.push_back(i);
+    }
+    res["triangleFrames"] = {{"tangents", t}, {"bitangents", b}, {"normals", n}, {"w", w}, {"degenerate", degenerate}};
+  }
+  if (include.has("error")) {
+    if (out.stats.error)
+      res["error"] = {{"meanAngleDeg", *out.stats.error},
+                      {"maxAngleDeg", out.stats.counters["maxAngleDeg"]},
+                      {"handednessMismatches", out.stats.counters["handednessMismatches"]},
+                      {"metric", out.stats.errorMetric},
+                      {"reference", out.stats.reference}};
+    else
+      res["error"] = {{"meanAngleDeg", 0.0}, {"maxAngleDeg", 0.0}, {"handednessMismatches", 0},
+                      {"metric", "mean angle between corner tangents, degrees"}, {"reference", "mikktspace (this is it)"}};
+  }
+  if (include.has("stats")) res["stats"] = statsJson(out.stats);
+  reply.body = std::move(res);
+  return reply;
+}
+
+// ---- binary glTF ---------------------------------------------------------------------------
+
+ApiError gltfProblem(int status, const glb::Problem& p) {
+  std::string where = p.pointer.empty() ? "body" : p.pointer;
+  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-gltf",
+                  status == 413 ? "Request exceeds a configured limit" : "Unusable glTF", where + ": " + p.message,
+                  {{p.pointer, p.message}}, {}};
+}
+
+void check(const std::optional<glb::Problem>& p, int status = 422) {
+  if (p) throw gltfProblem(status, *p);
+}
+
+// Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
+// Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
+bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const Config& config, double& ms) {
+  json& attrs = prim["attributes"];
+  if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
+  tg::Mesh mesh;
+  std::vector<float> pos, nrm, uv;
+  check(glb::readFloats(asset, attrs["POSITION"].get<int>(), 3, pos));
+  check(glb::readFloats(asset, attrs["TEXCOORD_0"].get<int>(), 2, uv));
+  const bool hadNormals = attrs.contains("NORMAL");
+  if (hadNormals) check(glb::readFloats(asset, attrs["NORMAL"].get<int>(), 3, nrm));
+  const size_t n = pos.size() / 3;
+  if (uv.size() / 2 != n || (hadNormals && nrm.size() / 3 != n))
+    throw gltfProblem(422, {at + "/attributes", "attribute accessors must have the same count"});
+  if (n > config.limits.maxMeshVertices)
+    throw gltfProblem(413, {at + "/attributes/POSITION", std::to_string(n) + " vertices exceed the limit of " +
+                                                              std::to_string(config.limits.maxMeshVertices)});
+  mesh.positions.resize(n);
+  mesh.uvs.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    mesh.positions[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
+    mesh.uvs[i] = {uv[2 * i], uv[2 * i + 1]};
+  }
+  if (hadNormals) {
+    mesh.normals.resize(n);
+    for (size_t i = 0; i < n; ++i) mesh.normals[i] = {nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]};
+  }
+  if (prim.contains("indices")) {
+    check(glb::readIndices(asset, prim["indices"].get<int>(), mesh.indices));
+  } else {
+    mesh.indices.resize(n - n % 3);
+    for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+  }
+  tg::Options opt = options(config, tg::Mode::kMikkTSpace);
+  opt.missingNormals = tg::NormalRule::kFlat;
+  auto r = tg::generate(mesh, opt);
+  if (!r.ok()) {
+    const effects::Error& e = r.error();
+    std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION" : e.field.rfind("/uvs", 0) == 0 ? "TEXCOORD_0"
+                       : e.field.rfind("/normals", 0) == 0                ? "NORMAL" : "";
+    std::string pointer = attr.empty() ? at + "/indices" : at + "/attributes/" + attr;
+    throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422, {pointer, e.message});
+  }
+  tg::Output& out = r.value();
+  flipW(out);  // glTF's UV origin is top-left
+  ms += out.stats.elapsedMs;
+
+  std::vector<float> tangents;
+  tangents.reserve(out.tangents.size() * 4);
+  for (const auto& t : out.tangents) tangents.insert(tangents.end(), {t.x, t.y, t.z, t.w});
+  const bool identity = out.remap.size() == n;
+  if (!identity) {  // every vertex attribute (and morph target) follows the split
+    for (auto& [name, index] : attrs.items()) {
+      if (name == "TANGENT" || (name == "NORMAL" && !hadNormals)) continue;
+      int copy = 0;
+      check(glb::addRemappedAccessor(asset, index.get<int>(), out.remap, copy));
+      index = copy;
+    }
+    if (prim.contains("targets") && prim["targets"].is_array())
+      for (auto& target : prim["targets"])
+        for (auto& [name, index] : target.items()) {
+          int copy = 0;
+          check(glb::addRemappedAccessor(asset, index.get<int>(), out.remap, copy));
+          index = copy;
+        }
+    prim["indices"] = glb::addIndexAccessor(asset, out.indices);
+  }
+  if (!hadNormals) {
+    std::vector<float> normals;
+    for (const auto& v : out.normals) normals.insert(normals.end(), {v.x, v.y, v.z});
+    attrs["NORMAL"] = glb::addFloatAccessor(asset, normals, 3, true);
+  }
+  attrs["TANGENT"] = glb::addFloatAccessor(asset, tangents, 4, true);
+  return true;
+}
+
+BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
+  glb::Asset asset;
+  check(glb::parse(body, asset), 400);
+  BinaryReply reply;
+  reply.method = "mikktspace";
+  size_t done = 0;
+  try {
+    if (asset.gltf.contains("meshes"))
+      for (size_t mi = 0; mi < asset.gltf["meshes"].size(); ++mi) {
+        json& prims = asset.gltf["meshes"][mi]["primitives"];
+        if (!prims.is_array()) continue;
+        for (size_t pi = 0; pi < prims.size(); ++pi) {
+          if (prims[pi].value("mode", 4) != 4) continue;  // TRIANGLES only
+          std::string at = "/meshes/" + std::to_string(mi) + "/primitives/" + std::to_string(pi);
+          done += processPrimitive(asset, prims[pi], at, ctx.config, reply.computeMs);
+        }
+      }
+  } catch (const json::exception& e) {
+    throw gltfProblem(422, {"", std::string("malformed glTF JSON: ") + e.what()});
+  }
+  if (done == 0)
+    throw gltfProblem(422, {"/meshes", "no triangle primitive with POSITION and TEXCOORD_0: nothing can have tangents"});
+  reply.body = glb::serialize(asset);
+  reply.contentType = "model/gltf-binary";
+  return reply;
+}
+
+}  // namespace
+
+void addTangentsEndpoints(Service& service) {
+  service.addJsonEndpoint("/v1/tangents", "tangents.json", handleTangents);
+  service.addBinaryAlternative("/v1/tangents", "model/gltf-binary", handleGlb);
+}
+
+}  // namespace effectd

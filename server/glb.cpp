@@ -1,0 +1,252 @@
+#include "glb.h"
+
+#include <cstring>
+
+namespace effectd::glb {
+namespace {
+
+using nlohmann::json;
+
+constexpr uint32_t kMagic = 0x46546C67, kJson = 0x4E4F534A, kBin = 0x004E4942;
+
+uint32_t u32(const std::string& s, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, s.data() + at, 4);
+  return v;
+}
+void put32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+
+int componentSize(int type) {
+  switch (type) {
+    case 5120: case 5121: return 1;  // BYTE, UNSIGNED_BYTE
+    case 5122: case 5123: return 2;  // SHORT, UNSIGNED_SHORT
+    case 5125: case 5126: return 4;  // UNSIGNED_INT, FLOAT
+    default: return 0;
+  }
+}
+int componentCount(const std::string& type) {
+  if (type == "SCALAR") return 1;
+  if (type == "VEC2") return 2;
+  if (type == "VEC3") return 3;
+  if (type == "VEC4" || type == "MAT2") return 4;
+  if (type == "MAT3") return 9;
+  if (type == "MAT4") return 16;
+  return 0;
+}
+const char* typeName(int components) {
+  static const char* names[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
+  return names[components];
+}
+
+const json& member(const json& root, const char* key);
+
+// Where accessor `index`'s elements lie in the BIN chunk.
+struct View {
+  const json* accessor = nullptr;
+  size_t count = 0, offset = 0, stride = 0, elementSize = 0;
+  int componentType = 0, components = 0;
+  bool zeros = false;  // no bufferView: all elements are zero
+};
+
+std::optional<Problem> view(const Asset& a, int index, View& v) {
+  std::string at = "/accessors/" + std::to_string(index);
+  const json& accessors = member(a.gltf, "accessors");
+  if (index < 0 || size_t(index) >= accessors.size()) return Problem{at, "does not exist"};
+  const json& acc = accessors[size_t(index)];
+  v.accessor = &acc;
+  if (acc.contains("sparse")) return Problem{at + "/sparse", "sparse accessors are not supported"};
+  v.componentType = acc.value("componentType", 0);
+  v.components = componentCount(acc.value("type", ""));
+  int cs = componentSize(v.componentType);
+  if (!cs || !v.components) return Problem{at, "has an unknown componentType or type"};
+  v.count = acc.value("count", size_t(0));
+  v.elementSize = size_t(cs) * size_t(v.components);
+  if (!acc.contains("bufferView")) {
+    v.zeros = true;
+    return std::nullopt;
+  }
+  size_t bvIndex = acc["bufferView"].get<size_t>();
+  const json& views = member(a.gltf, "bufferViews");
+  if (bvIndex >= views.size()) return Problem{at + "/bufferView", "does not exist"};
+  const json& bv = views[bvIndex];
+  if (bv.value("buffer", 0) != 0)
+    return Problem{"/bufferViews/" + std::to_string(bvIndex) + "/buffer", "only the GLB binary chunk (buffer 0) is supported"};
+  const json& buffers = member(a.gltf, "buffers");
+  if (buffers.empty() || buffers[0].contains("uri"))
+    return Problem{"/buffers/0", "must be the GLB binary chunk (no uri)"};
+  v.stride = bv.value("byteStride", size_t(0));
+  if (v.stride == 0) v.stride = v.elementSize;
+  v.offset = bv.value("byteOffset", size_t(0)) + acc.value("byteOffset", size_t(0));
+  size_t bvEnd = bv.value("byteOffset", size_t(0)) + bv.value("byteLength", size_t(0));
+  if (v.stride < v.elementSize) return Problem{"/bufferViews/" + std::to_string(bvIndex) + "/byteStride", "is smaller than an element"};
+  if (v.count > 0 && (v.count - 1 > (SIZE_MAX - v.elementSize - v.offset) / v.stride ||
+                      v.offset + (v.count - 1) * v.stride + v.elementSize > std::min(bvEnd, a.bin.size())))
+    return Problem{at, "reaches past the end of its bufferView or of the binary chunk"};
+  return std::nullopt;
+}
+
+double component(const char* p, int type, bool normalized) {
+  switch (type) {
+    case 5120: { int8_t x; std::memcpy(&x, p, 1); return normalized ? std::max(x / 127.0, -1.0) : x; }
+    case 5121: { uint8_t x; std::memcpy(&x, p, 1); return normalized ? x / 255.0 : x; }
+    case 5122: { int16_t x; std::memcpy(&x, p, 2); return normalized ? std::max(x / 32767.0, -1.0) : x; }
+    case 5123: { uint16_t x; std::memcpy(&x, p, 2); return normalized ? x / 65535.0 : x; }
+    case 5125: { uint32_t x; std::memcpy(&x, p, 4); return x; }
+    default: { float x; std::memcpy(&x, p, 4); return x; }
+  }
+}
+
+size_t appendBin(Asset& a, const std::string& bytes, int target, size_t stride) {
+  while (a.bin.size() % 4) a.bin.push_back('\0');
+  size_t offset = a.bin.size();
+  a.bin += bytes;
+  json bv = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}, {"target", target}};
+  if (stride) bv["byteStride"] = stride;
+  a.gltf["bufferViews"].push_back(bv);
+  return a.gltf["bufferViews"].size() - 1;
+}
+
+const json& member(const json& root, const char* key) {
+  static const json empty = json::array();
+  auto it = root.find(key);
+  return it == root.end() ? empty : *it;
+}
+
+int pushAccessor(Asset& a, json accessor) {
+  a.gltf["accessors"].push_back(std::move(accessor));
+  return int(a.gltf["accessors"].size() - 1);
+}
+
+}  // namespace
+
+std::optional<Problem> parse(const std::string& b, Asset& out) {
+  if (b.size() < 20 || u32(b, 0) != kMagic) return Problem{"", "is not a binary glTF (magic 'glTF' missing)"};
+  if (u32(b, 4) != 2) return Problem{"", "must be glTF version 2"};
+  if (u32(b, 8) != b.size()) return Problem{"", "header length " + std::to_string(u32(b, 8)) + " does not match the body (" + std::to_string(b.size()) + " bytes)"};
+  size_t at = 12;
+  bool haveJson = false;
+  while (at + 8 <= b.size()) {
+    size_t len = u32(b, at), type = u32(b, at + 4);
+    if (len > b.size() - at - 8) return Problem{"", "a chunk runs past the end of the body"};
+    std::string data = b.substr(at + 8, len);
+    if (!haveJson) {
+      if (type != kJson) return Problem{"", "the first chunk must be JSON"};
+      out.gltf = json::parse(data, nullptr, false);
+      if (out.gltf.is_discarded() || !out.gltf.is_object()) return Problem{"", "the JSON chunk is not a JSON object"};
+      haveJson = true;
+    } else if (type == kBin) {
+      out.bin = std::move(data);
+    }
+    at += 8 + len;
+  }
+  if (!haveJson) return Problem{"", "has no JSON chunk"};
+  if (!out.gltf.contains("asset") || !out.gltf["asset"].is_object() || out.gltf["asset"].value("version", "") != "2.0")
+    return Problem{"/asset/version", "must be \"2.0\""};
+  // Trust nothing structural: the arrays we index must be arrays of objects.
+  for (const char* key : {"accessors", "bufferViews", "buffers", "meshes"}) {
+    if (!out.gltf.contains(key)) continue;
+    if (!out.gltf[key].is_array()) return Problem{std::string("/") + key, "must be an array"};
+    for (size_t i = 0; i < out.gltf[key].size(); ++i)
+      if (!out.gltf[key][i].is_object()) return Problem{std::string("/") + key + "/" + std::to_string(i), "must be an object"};
+  }
+  return std::nullopt;
+}
+
+std::string serialize(const Asset& a) {
+  json gltf = a.gltf;
+  if (!a.bin.empty()) {
+    if (!gltf.contains("buffers") || gltf["buffers"].empty()) gltf["buffers"] = json::array({json::object()});
+    gltf["buffers"][0]["byteLength"] = a.bin.size();
+  }
+  std::string js = gltf.dump(-1, ' ', false, json::error_handler_t::replace);
+  while (js.size() % 4) js += ' ';
+  std::string bin = a.bin;
+  while (bin.size() % 4) bin.push_back('\0');
+  std::string out;
+  put32(out, kMagic);
+  put32(out, 2);
+  put32(out, uint32_t(12 + 8 + js.size() + (bin.empty() ? 0 : 8 + bin.size())));
+  put32(out, uint32_t(js.size()));
+  put32(out, kJson);
+  out += js;
+  if (!bin.empty()) {
+    put32(out, uint32_t(bin.size()));
+    put32(out, kBin);
+    out += bin;
+  }
+  return out;
+}
+
+std::optional<Problem> readFloats(const Asset& a, int index, int components, std::vector<float>& out) {
+  View v;
+  if (auto p = view(a, index, v)) return p;
+  std::string at = "/accessors/" + std::to_string(index);
+  if (v.components != components) return Problem{at + "/type", std::string("must be ") + typeName(components)};
+  bool normalized = v.accessor->value("normalized", false);
+  if (v.componentType != 5126 && !normalized) return Problem{at + "/componentType", "must be FLOAT or normalized"};
+  out.assign(v.count * size_t(components), 0.0f);
+  if (v.zeros) return std::nullopt;
+  int cs = componentSize(v.componentType);
+  for (size_t k = 0; k < v.count; ++k)
+    for (int c = 0; c < components; ++c)
+      out[k * size_t(components) + size_t(c)] =
+          float(component(a.bin.data() + v.offset + k * v.stride + size_t(c * cs), v.componentType, normalized));
+  return std::nullopt;
+}
+
+std::optional<Problem> readIndices(const Asset& a, int index, std::vector<uint32_t>& out) {
+  View v;
+  if (auto p = view(a, index, v)) return p;
+  std::string at = "/accessors/" + std::to_string(index);
+  if (v.components != 1 || (v.componentType != 5121 && v.componentType != 5123 && v.componentType != 5125))
+    return Problem{at, "indices must be SCALAR unsigned byte, short or int"};
+  out.assign(v.count, 0);
+  if (v.zeros) return std::nullopt;
+  for (size_t k = 0; k < v.count; ++k)
+    out[k] = uint32_t(component(a.bin.data() + v.offset + k * v.stride, v.componentType, false));
+  return std::nullopt;
+}
+
+int addFloatAccessor(Asset& a, const std::vector<float>& data, int components, bool vertexAttribute) {
+  std::string bytes(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
+  size_t bv = appendBin(a, bytes, vertexAttribute ? 34962 : 0, 0);
+  return pushAccessor(a, {{"bufferView", bv}, {"componentType", 5126}, {"count", data.size() / size_t(components)},
+                          {"type", typeName(components)}});
+}
+
+int addIndexAccessor(Asset& a, const std::vector<uint32_t>& indices) {
+  size_t maxIndex = 0;
+  for (uint32_t i : indices) maxIndex = std::max<size_t>(maxIndex, i);
+  std::string bytes;
+  int type = maxIndex < 65535 ? 5123 : 5125;
+  for (uint32_t i : indices) {
+    if (type == 5123) {
+      uint16_t s = uint16_t(i);
+      bytes.append(reinterpret_cast<const char*>(&s), 2);
+    } else {
+      bytes.append(reinterpret_cast<const char*>(&i), 4);
+    }
+  }
+  size_t bv = appendBin(a, bytes, 34963, 0);
+  return pushAccessor(a, {{"bufferView", bv}, {"componentType", type}, {"count", indices.size()}, {"type", "SCALAR"}});
+}
+
+std::optional<Problem> addRemappedAccessor(Asset& a, int index, const std::vector<uint32_t>& remap, int& newIndex) {
+  View v;
+  if (auto p = view(a, index, v)) return p;
+  const size_t row = (v.elementSize + 3) / 4 * 4;  // vertex attributes stay 4-byte aligned
+  std::string bytes(remap.size() * row, '\0');
+  for (size_t k = 0; k < remap.size(); ++k) {
+    if (remap[k] >= v.count) return Problem{"/accessors/" + std::to_string(index) + "/count", "is smaller than the vertex count"};
+    if (!v.zeros) std::memcpy(bytes.data() + k * row, a.bin.data() + v.offset + remap[k] * v.stride, v.elementSize);
+  }
+  size_t bv = appendBin(a, bytes, 34962, row != v.elementSize ? row : 0);
+  json acc = *v.accessor;
+  acc.erase("byteOffset");
+  acc["bufferView"] = bv;
+  acc["count"] = remap.size();
+  newIndex = pushAccessor(a, std::move(acc));
+  return std::nullopt;
+}
+
+}  // namespace effectd::glb

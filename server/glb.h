@@ -1,0 +1,40 @@
+// Binary glTF 2.0 (GLB) container: the JSON chunk as a document, the BIN chunk as bytes, and
+// typed access to accessors. Written for /v1/tangents instead of using tinygltf so that a
+// round trip is lossless (unknown extensions, images and extras pass through untouched),
+// nothing is decoded that is not needed, and no external URI is ever followed.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace effectd::glb {
+
+struct Asset {
+  nlohmann::json gltf;
+  std::string bin;  // buffer 0's bytes (the BIN chunk), possibly empty
+};
+
+// Problems carry a JSON pointer into the glTF document ("" = the container itself).
+struct Problem {
+  std::string pointer, message;
+};
+
+std::optional<Problem> parse(const std::string& bytes, Asset& out);
+std::string serialize(const Asset& asset);
+
+// Accessor `index` as floats, `components` per element (normalized integers scaled to [0, 1]
+// or [-1, 1] as the spec has it). Fails for sparse accessors, other buffers, out-of-range views.
+std::optional<Problem> readFloats(const Asset& asset, int index, int components, std::vector<float>& out);
+std::optional<Problem> readIndices(const Asset& asset, int index, std::vector<uint32_t>& out);
+
+// New accessors over data appended to the BIN chunk (tightly packed, 4-byte aligned rows).
+int addFloatAccessor(Asset& asset, const std::vector<float>& data, int components, bool vertexAttribute);
+int addIndexAccessor(Asset& asset, const std::vector<uint32_t>& indices);
+// A copy of accessor `index` with element k = original element remap[k] (any type).
+std::optional<Problem> addRemappedAccessor(Asset& asset, int index, const std::vector<uint32_t>& remap, int& newIndex);
+
+}  // namespace effectd::glb
