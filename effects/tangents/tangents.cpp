@@ -11,9 +11,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
+#include <thread>
 #include <unordered_map>
 
 #include <glm/geometric.hpp>
@@ -48,41 +51,45 @@ dvec3 orthogonalFallback(const dvec3& n, std::initializer_list<dvec3> candidates
   return glm::normalize(projectToPlane(a, n));
 }
 
-// Exact-match key for welding (float bits, with -0 == +0 as float comparison has it).
-struct WeldKey {
-  float v[8];
-  bool operator==(const WeldKey& o) const {
-    for (int i = 0; i < 8; ++i)
-      if (!(v[i] == o.v[i])) return false;
-    return true;
+// Welding: rep[i] = the first index whose key equals key(i) (up to 8 floats, compared as
+// floats, so -0 == +0). Open addressing over the indices themselves, no per-entry allocation.
+template <int N, class KeyFn>
+std::vector<uint32_t> weld(size_t count, KeyFn key) {
+  std::vector<std::array<float, N>> keys(count);
+  for (size_t i = 0; i < count; ++i) {
+    key(i, keys[i].data());
+    for (float& f : keys[i]) f = f == 0.0f ? 0.0f : f;
   }
-};
-struct WeldHash {
-  size_t operator()(const WeldKey& k) const {
+  size_t cap = 16;
+  while (cap < 2 * count) cap <<= 1;
+  std::vector<uint32_t> table(cap, UINT32_MAX), rep(count);
+  for (size_t i = 0; i < count; ++i) {
     uint64_t h = 1469598103934665603ull;
-    for (float f : k.v) {
+    for (float f : keys[i]) {
       uint32_t b;
-      f = f == 0.0f ? 0.0f : f;
       std::memcpy(&b, &f, 4);
       h = (h ^ b) * 1099511628211ull;
     }
-    return size_t(h ^ (h >> 29));
-  }
-};
-
-// First index of every run of equal keys; key(i) fills the first `len` floats.
-template <class KeyFn>
-std::vector<uint32_t> weld(size_t count, KeyFn key) {
-  std::unordered_map<WeldKey, uint32_t, WeldHash> seen;
-  seen.reserve(count);
-  std::vector<uint32_t> rep(count);
-  for (size_t i = 0; i < count; ++i) {
-    WeldKey k{};
-    key(i, k.v);
-    for (float& f : k.v) f = f == 0.0f ? 0.0f : f;
-    rep[i] = seen.emplace(k, uint32_t(i)).first->second;
+    size_t slot = size_t(h ^ (h >> 31)) & (cap - 1);
+    while (table[slot] != UINT32_MAX && keys[table[slot]] != keys[i]) slot = (slot + 1) & (cap - 1);
+    if (table[slot] == UINT32_MAX) table[slot] = uint32_t(i);
+    rep[i] = table[slot];
   }
   return rep;
+}
+
+// Runs fn(begin, end) over [0, n) on up to hardware_concurrency threads (one when n is small).
+// Each index is written by exactly one thread, so the result does not depend on the split.
+template <class Fn>
+void parallelFor(size_t n, Fn fn) {
+  size_t threads = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 8);
+  if (n < 20000 || threads == 1) return fn(size_t(0), n);
+  std::vector<std::thread> pool;
+  size_t chunk = (n + threads - 1) / threads;
+  for (size_t t = 1; t < threads; ++t)
+    pool.emplace_back([&, t] { fn(std::min(n, t * chunk), std::min(n, (t + 1) * chunk)); });
+  fn(0, std::min(n, chunk));
+  for (auto& th : pool) th.join();
 }
 
 // Unit normals per vertex: given ones normalised; missing ones angle-weighted over all
@@ -97,7 +104,7 @@ std::vector<dvec3> vertexNormals(const Mesh& mesh) {
     }
     return out;
   }
-  std::vector<uint32_t> at = weld(n, [&](size_t i, float* k) {
+  std::vector<uint32_t> at = weld<3>(n, [&](size_t i, float* k) {
     k[0] = mesh.positions[i].x, k[1] = mesh.positions[i].y, k[2] = mesh.positions[i].z;
   });
   std::vector<dvec3> sum(n, dvec3(0));
@@ -126,6 +133,7 @@ struct TriInfo {
   dvec3 os{0}, ot{0};   // unit first-order derivatives, sign-adjusted by orientation
   bool orientPreserving = false;
   bool groupWithAny = true;  // UV area or a derivative is zero: joins any group, adds nothing
+  bool zeroUvArea = false;
   int neighbor[3] = {-1, -1, -1};  // across edge (i, i+1)
   int group[3] = {-1, -1, -1};
 };
@@ -138,7 +146,7 @@ struct Group {
 
 struct Corners {
   std::vector<dvec3> tangent;  // per corner, zero where no frame
-  std::vector<bool> orient;
+  std::vector<uint8_t> orient;
   size_t degenerateTriangles = 0, zeroUvArea = 0, groups = 0;
 };
 
@@ -150,7 +158,7 @@ class Mikk {
     const size_t triCount = mesh_.indices.size() / 3;
     out_.tangent.assign(triCount * 3, dvec3(0));
     out_.orient.assign(triCount * 3, false);
-    std::vector<uint32_t> rep = weld(mesh_.positions.size(), [&](size_t i, float* k) {
+    std::vector<uint32_t> rep = weld<8>(mesh_.positions.size(), [&](size_t i, float* k) {
       const glm::vec3& p = mesh_.positions[i];
       glm::vec3 n = glm::vec3(normals_[i]);
       const glm::vec2& t = mesh_.uvs[i];
@@ -183,7 +191,11 @@ class Mikk {
   uint32_t corner(size_t g, int i) const { return vert_[3 * size_t(good_[g]) + size_t(i)]; }
 
   void initTriInfo() {
-    for (size_t g = 0; g < good_.size(); ++g) {
+    parallelFor(good_.size(), [this](size_t begin, size_t end) { initTriInfo(begin, end); });
+    for (const TriInfo& ti : info_) out_.zeroUvArea += ti.zeroUvArea;
+  }
+  void initTriInfo(size_t begin, size_t end) {
+    for (size_t g = begin; g < end; ++g) {
       TriInfo& ti = info_[g];
       dvec3 v1 = pos(corner(g, 0)), v2 = pos(corner(g, 1)), v3 = pos(corner(g, 2));
       dvec2 t1 = uv(corner(g, 0)), t2 = uv(corner(g, 1)), t3 = uv(corner(g, 2));
@@ -199,7 +211,7 @@ class Mikk {
         if (lenOt > 0) ti.ot = (s / lenOt) * ot;
         if (lenOs > 0 && lenOt > 0) ti.groupWithAny = false;
       } else {
-        ++out_.zeroUvArea;
+        ti.zeroUvArea = true;
       }
     }
   }
@@ -287,51 +299,66 @@ class Mikk {
 
   dvec3 projected(const dvec3& v, const dvec3& n) const { return normalizeOrZero(projectToPlane(v, n)); }
 
-  // Reference: GenerateTSpaces + EvalTspace.
+  // Reference: GenerateTSpaces + EvalTspace. A face's sub-group is the set of group faces
+  // whose projected frames are not opposite to its own; nearly always the whole group, so
+  // that case is evaluated once per group and other sets are compared as sorted lists.
   void generateTSpaces() {
+    parallelFor(groups_.size(), [this](size_t begin, size_t end) { generateTSpaces(begin, end); });
+  }
+  void generateTSpaces(size_t begin, size_t end) {
+    std::vector<dvec3> os, ot;
     std::vector<uint32_t> members;
     std::vector<std::pair<std::vector<uint32_t>, dvec3>> subgroups;
-    for (const Group& grp : groups_) {
+    for (size_t g = begin; g < end; ++g) {
+      const Group& grp = groups_[g];
       const dvec3 n = normals_[grp.vertex];
       const uint32_t* faces = faces_.data() + grp.first;
+      const size_t k = grp.count;
+      os.resize(k);
+      ot.resize(k);
+      for (size_t a = 0; a < k; ++a) os[a] = projected(info_[faces[a]].os, n), ot[a] = projected(info_[faces[a]].ot, n);
       subgroups.clear();
-      for (size_t a = 0; a < grp.count; ++a) {
+      std::optional<dvec3> whole;
+      for (size_t a = 0; a < k; ++a) {
         const uint32_t f = faces[a];
-        const TriInfo& fi = info_[f];
-        dvec3 os = projected(fi.os, n), ot = projected(fi.ot, n);
         members.clear();
-        for (size_t b = 0; b < grp.count; ++b) {
-          const uint32_t t = faces[b];
-          const TriInfo& tj = info_[t];
-          bool any = fi.groupWithAny || tj.groupWithAny;
-          if (any || f == t || (glm::dot(os, projected(tj.os, n)) > -1.0 && glm::dot(ot, projected(tj.ot, n)) > -1.0))
-            members.push_back(t);
+        for (size_t b = 0; b < k; ++b) {
+          bool any = info_[f].groupWithAny || info_[faces[b]].groupWithAny;
+          if (any || a == b || (glm::dot(os[a], os[b]) > -1.0 && glm::dot(ot[a], ot[b]) > -1.0)) members.push_back(faces[b]);
         }
-        std::sort(members.begin(), members.end());
-        const dvec3* tangent = nullptr;
-        for (const auto& [set, t] : subgroups)
-          if (set == members) tangent = &t;
-        if (!tangent) {
-          subgroups.emplace_back(members, evalTSpace(members, grp.vertex, n));
-          tangent = &subgroups.back().second;
+        dvec3 tangent;
+        if (members.size() == k) {
+          if (!whole) whole = evalTSpace(faces, k, os.data(), grp.vertex, n);
+          tangent = *whole;
+        } else {
+          std::sort(members.begin(), members.end());
+          auto it = std::find_if(subgroups.begin(), subgroups.end(), [&](const auto& sg) { return sg.first == members; });
+          if (it == subgroups.end()) {
+            std::vector<dvec3> memberOs(members.size());
+            for (size_t i = 0; i < members.size(); ++i) memberOs[i] = projected(info_[members[i]].os, n);
+            subgroups.emplace_back(members, evalTSpace(members.data(), members.size(), memberOs.data(), grp.vertex, n));
+            it = subgroups.end() - 1;
+          }
+          tangent = it->second;
         }
         size_t c = 3 * size_t(good_[f]) + size_t(cornerOf(f, grp.vertex));
-        out_.tangent[c] = *tangent;
+        out_.tangent[c] = tangent;
         out_.orient[c] = grp.orientPreserving;
       }
     }
   }
 
-  dvec3 evalTSpace(const std::vector<uint32_t>& faces, uint32_t vertex, const dvec3& n) const {
+  // Angle-weighted average of the faces' tangents `os` (already projected into n's plane).
+  dvec3 evalTSpace(const uint32_t* faces, size_t count, const dvec3* os, uint32_t vertex, const dvec3& n) const {
     dvec3 sum(0);
-    for (uint32_t f : faces) {
+    for (size_t a = 0; a < count; ++a) {
+      const uint32_t f = faces[a];
       if (info_[f].groupWithAny) continue;
       int i = cornerOf(f, vertex);
-      dvec3 os = projected(info_[f].os, n);
       dvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
       dvec3 v1 = projected(p0 - p1, n), v2 = projected(p2 - p1, n);
       double angle = std::acos(std::clamp(glm::dot(v1, v2), -1.0, 1.0));
-      sum += angle * os;
+      sum += angle * os[a];
     }
     return normalizeOrZero(sum);
   }
@@ -478,7 +505,6 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
 
   Output out;
   std::vector<glm::vec4> corner(triCount * 3);
-  size_t fallbacks = 0;
   auto triFrame = [&](size_t t, const dvec3& n) {
     dvec3 p[3];
     dvec2 uv[3];
@@ -491,24 +517,32 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   Corners mikk;
   if (options.mode == Mode::kMikkTSpace || options.measureError) mikk = Mikk(mesh, normals).run();
   std::vector<glm::vec4> mikkCorner;
+  std::vector<uint8_t> fellBack(corner.size(), 0);
   if (options.mode == Mode::kMikkTSpace || options.measureError) {
     mikkCorner.resize(triCount * 3);
-    for (size_t c = 0; c < corner.size(); ++c) {
-      bool fellBack = false;
-      mikkCorner[c] = finishTangent(mikk.tangent[c], mikk.orient[c], normals[mesh.indices[c]], fellBack);
-      fallbacks += fellBack;
-    }
+    parallelFor(corner.size(), [&](size_t begin, size_t end) {
+      for (size_t c = begin; c < end; ++c) {
+        bool fb = false;
+        // Mikk's tangent is already unit and in the plane of this corner's normal.
+        const dvec3& t = mikk.tangent[c];
+        if (notZero(t)) mikkCorner[c] = {glm::vec3(t), mikk.orient[c] ? 1.0f : -1.0f};
+        else mikkCorner[c] = finishTangent(t, mikk.orient[c] != 0, normals[mesh.indices[c]], fb);
+        fellBack[c] = fb;
+      }
+    });
   }
   if (options.mode == Mode::kMikkTSpace) {
-    corner = mikkCorner;
+    corner = std::move(mikkCorner);
   } else {
-    fallbacks = 0;
-    for (size_t c = 0; c < corner.size(); ++c) {
-      Frame f = triFrame(c / 3, normals[mesh.indices[c]]);
-      corner[c] = glm::vec4(f.tangent, f.w);
-      fallbacks += f.degenerate;
-    }
+    parallelFor(corner.size(), [&](size_t begin, size_t end) {
+      for (size_t c = begin; c < end; ++c) {
+        Frame f = triFrame(c / 3, normals[mesh.indices[c]]);
+        corner[c] = glm::vec4(f.tangent, f.w);
+        fellBack[c] = f.degenerate;
+      }
+    });
   }
+  const size_t fallbacks = size_t(std::count(fellBack.begin(), fellBack.end(), uint8_t(1)));
   const double computeMs = watch.ms();
 
   // Split vertices whose corners disagree; output vertex v < n is input vertex v.

@@ -1,0 +1,75 @@
+// Tangent figures of issue 5: a 100k-triangle mesh (UV sphere 250 x 200 segments, seam and
+// poles included, normals given) in each mode (target: MikkTSpace <= 30 ms), and the
+// per-triangle mode's angle error against MikkTSpace on the same mesh, printed as counters
+// (meanAngleDeg, maxAngleDeg) for the error-against-run-time report.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include <effects/tangents.h>
+
+namespace {
+
+using namespace effects::tangents;
+
+Mesh sphere(int rings, int segments) {
+  Mesh m;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s <= segments; ++s) {
+      double th = M_PI * r / rings, ph = 2 * M_PI * s / segments;
+      double st = r == 0 || r == rings ? 0.0 : std::sin(th);
+      glm::vec3 p(float(st * std::cos(ph)), float(std::cos(th)), float(st * std::sin(ph)));
+      m.positions.push_back(p);
+      m.normals.push_back(p);
+      m.uvs.push_back({float(s) / float(segments), 1.0f - float(r) / float(rings)});
+    }
+  const uint32_t row = uint32_t(segments) + 1;
+  for (uint32_t r = 0; r < uint32_t(rings); ++r)
+    for (uint32_t s = 0; s < uint32_t(segments); ++s) {
+      uint32_t a = r * row + s, b = a + row;
+      if (r > 0) m.indices.insert(m.indices.end(), {a, a + 1, b});
+      if (r + 1 < uint32_t(rings)) m.indices.insert(m.indices.end(), {a + 1, b + 1, b});
+    }
+  return m;
+}
+
+const Mesh& mesh100k() {
+  static const Mesh m = sphere(200, 250);  // 99 500 triangles
+  return m;
+}
+
+void run(benchmark::State& state, Mode mode, bool measure) {
+  Options o;
+  o.mode = mode;
+  o.measureError = measure;
+  effects::Stats last;
+  for (auto _ : state) {
+    auto r = generate(mesh100k(), o);
+    if (!r.ok()) {
+      state.SkipWithError(r.error().message.c_str());
+      return;
+    }
+    last = r.value().stats;
+    benchmark::DoNotOptimize(r.value().tangents.data());
+  }
+  double tris = double(mesh100k().indices.size() / 3);
+  state.counters["triangles"] = tris;
+  state.counters["tris_per_s"] = benchmark::Counter(tris * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["outVertices"] = last.counters["outputVertices"];
+  if (last.error) {
+    state.counters["meanAngleDeg"] = *last.error;
+    state.counters["maxAngleDeg"] = last.counters["maxAngleDeg"];
+  }
+}
+
+void BM_MikkTSpace100k(benchmark::State& s) { run(s, Mode::kMikkTSpace, false); }
+void BM_PerTriangle100k(benchmark::State& s) { run(s, Mode::kPerTriangle, false); }
+void BM_PerTriangleErrorVsMikk100k(benchmark::State& s) { run(s, Mode::kPerTriangle, true); }
+
+BENCHMARK(BM_MikkTSpace100k)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PerTriangle100k)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PerTriangleErrorVsMikk100k)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
