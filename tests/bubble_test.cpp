@@ -1,0 +1,266 @@
+// effects/bubble: seed 000's eqns 3-11 by hand, extreme cases, long times, shader variants
+// (compiled with glslangValidator), thin-film physics.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <effects/bubble.h>
+
+namespace effects::bubble {
+namespace {
+
+using glm::dvec3;
+
+void expectVec(const dvec3& a, const dvec3& b, double tol = 1e-9) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+bool finite(const dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+TEST(Bubble, FilmThicknessEqn3) {
+  Params p;  // muSpeed 0.05
+  EXPECT_DOUBLE_EQ(film(p, 0).top, 1.0);
+  EXPECT_DOUBLE_EQ(film(p, 0).bottom, 0.1);
+  EXPECT_DOUBLE_EQ(film(p, 10).top, 0.55);  // alpha = 0.5
+  EXPECT_DOUBLE_EQ(film(p, 10).bottom, 0.55);
+  EXPECT_DOUBLE_EQ(film(p, 1e9).top, 0.1);  // saturated
+  EXPECT_DOUBLE_EQ(film(p, -5).top, 1.0);
+}
+
+TEST(Bubble, InterfaceEqns4And5ByHand) {
+  Params p;
+  Interface s = interface(p, 0.6);  // nu_out = 0.8, nu_in = 0.8 / 1.33
+  EXPECT_NEAR(s.nuOut, 0.8, 1e-12);
+  EXPECT_NEAR(s.nuIn, 0.8 / 1.33, 1e-12);
+  EXPECT_NEAR(s.gammaIn, std::sqrt(1 - std::pow(0.8 / 1.33, 2)), 1e-12);
+  EXPECT_FALSE(s.totalInternalReflection);
+  for (double g : {-1.0, 0.0, 1.0}) {  // N.V at the extremes
+    Interface e = interface(p, g);
+    EXPECT_TRUE(std::isfinite(e.gammaIn) && std::isfinite(e.nuIn));
+  }
+}
+
+TEST(Bubble, ReflectionRefractionFinalByHand) {
+  Params p;
+  const dvec3 N(0, 0, 1), I = glm::normalize(dvec3(0.6, 0, -0.8));  // gamma_out = 0.8
+  expectVec(reflection(I, N), {0.6, 0, 0.8});                        // eqn 6
+  const double eta = 1 / 1.33, nuIn = eta * 0.6, gIn = std::sqrt(1 - nuIn * nuIn);
+  dvec3 T = refraction(p, I, N, 1.0);                                // eqn 7, vector form
+  expectVec(T, eta * I + (eta * 0.8 - gIn) * N);
+  EXPECT_NEAR(glm::length(T), 1.0, 1e-12);     // a unit refracted ray
+  EXPECT_NEAR(T.x / glm::length(T), nuIn, 1e-12);  // Snell: sin(theta_t) = eta sin(theta_i)
+  // Eqn 8 at t = 0: mu_top = 1, mu_bottom = 0.1.
+  expectVec(finalVector(p, I, N, 0), reflection(I, N) + 0.1 * T);
+  // Rim (eqn 10).
+  EXPECT_NEAR(rim(p, 0.8), std::pow(0.2, 2.8), 1e-12);
+  EXPECT_EQ(rim(p, 0.0), 1.0);
+  EXPECT_EQ(rim(p, 1.0), 0.0);
+  EXPECT_EQ(rim(p, -1.0), 1.0);  // back-facing: saturated
+}
+
+TEST(Bubble, TotalInternalReflectionAtGrazingIsFiniteAndReflects) {
+  Params p;
+  p.n1 = 1.33;  // from inside the film outwards
+  p.n2 = 1.0;
+  const dvec3 N(0, 0, 1), I = glm::normalize(dvec3(1, 0, -0.05));  // grazing
+  Interface s = interface(p, glm::dot(N, -I));
+  EXPECT_TRUE(s.totalInternalReflection);
+  expectVec(refraction(p, I, N, 1.0), {0, 0, 0});
+  dvec3 f = finalVector(p, I, N, 0);
+  ASSERT_TRUE(finite(f));
+  expectVec(f, reflection(I, N) * film(p, 0).top);  // the reflection branch alone
+}
+
+TEST(Bubble, DegenerateInputsStayFinite) {
+  Params p;
+  Params same;
+  same.n2 = 1.0;  // n1 = n2: refraction passes straight through
+  const dvec3 N(0, 0, 1), I = glm::normalize(dvec3(0.3, 0.4, -0.866));
+  expectVec(refraction(same, I, N, 1.0), I, 1e-9);
+  for (const dvec3& n : {dvec3(0), N, -N, dvec3(1, 0, 0)})
+    for (const dvec3& i : {dvec3(0), I, -I, dvec3(1, 0, 0)})
+      for (double t : {0.0, 1e-300, 1e9, 1e300}) EXPECT_TRUE(finite(finalVector(p, i, n, t)));
+  Params zero = p;
+  zero.muSpeed = 0;  // film never drains
+  EXPECT_DOUBLE_EQ(film(zero, 1e12).top, 1.0);
+}
+
+TEST(Bubble, PhasesAtHugeTimesEqualTheReducedSmallTime) {
+  Params p;
+  const double t = 1e9;
+  // The equivalent small time: t minus whole periods, in exact integer arithmetic for omega = 2
+  // (period pi): t mod pi = 1e9 - floor(1e9 / pi) * pi, with pi in long double.
+  const long double pi = 3.14159265358979323846264338327950288L;
+  const double small = double(static_cast<long double>(t) - std::floor(static_cast<long double>(t) / pi) * pi);
+  EXPECT_NEAR(reducedPhase(p.deltaSpeed, t), reducedPhase(p.deltaSpeed, small), 1e-6);
+  const dvec3 x(0.3, -0.2, 0.9);
+  expectVec(wobble(p, x, t), wobble(p, x, small), 1e-6);
+  // Naive float evaluation is far off: delta * t = 2e9 + 1 rounds to 2e9 in a float.
+  const double t2 = 1e9 + 0.5;
+  double naivePhase = double(float(p.deltaSpeed * t2));
+  EXPECT_GT(std::abs(std::remainder(naivePhase - reducedPhase(p.deltaSpeed, t2), 2 * M_PI)), 0.5);
+  for (double big : {1e12, 1e15, -1e9}) {
+    double ph = reducedPhase(p.betaSpeed, big);
+    EXPECT_TRUE(ph >= 0 && ph < 2 * M_PI) << big;
+  }
+}
+
+TEST(Bubble, WobbleAndMotionByHand) {
+  Params p;
+  p.wobbleAmplitude = 0.5;
+  const double t = 0.25;  // phase 0.5
+  dvec3 w = wobble(p, {0.1, 0.2, 0.3}, t);
+  expectVec(w, {0.1 + 0.5 * std::sin(0.6), 0.2 + 0.5 * std::cos(0.7), 0.3 + 0.5 * std::sin(0.8)}, 1e-12);
+  expectVec(moveTowards({0, 0, 0}, {2, 4, 6}, 0.5), {1, 2, 3});
+  expectVec(moveTowards({0, 0, 0}, {2, 4, 6}, 7), {2, 4, 6});
+  EXPECT_TRUE(finite(moveTowards({0, 0, 0}, {2, 4, 6}, NAN)));
+}
+
+TEST(Bubble, IcosphereLevelsAndFrames) {
+  Params p;
+  for (int level : {0, 1, 3}) {
+    MeshOptions o;
+    o.level = level;
+    o.wobble = false;
+    o.camera = dvec3(0, 0, 5);
+    auto r = icosphere(p, o);
+    ASSERT_TRUE(r.ok());
+    const Mesh& m = r.value();
+    EXPECT_EQ(m.indices.size() / 3, size_t(20) << (2 * level));
+    ASSERT_EQ(m.tangents.size(), m.positions.size());
+    ASSERT_EQ(m.finalVectors.size(), m.positions.size());
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+      EXPECT_NEAR(glm::length(dvec3(m.positions[i])), 1.0, 1e-6);
+      EXPECT_NEAR(glm::length(dvec3(m.tangents[i])), 1.0, 1e-5);
+      EXPECT_LE(std::abs(glm::dot(dvec3(m.tangents[i]), dvec3(m.normals[i]))), 1e-5);
+      EXPECT_GE(m.uvs[i].x, 0.0f);
+      EXPECT_LT(m.uvs[i].x, 1.5f);  // seam triangles continue past 1 (sample with REPEAT)
+    }
+  }
+  MeshOptions tooBig;
+  tooBig.level = 8;
+  EXPECT_EQ(icosphere(p, tooBig).error().kind, ErrorKind::kLimitExceeded);
+}
+
+TEST(Bubble, WobbledMeshAtHugeTimeEqualsReducedTime) {
+  Params p;
+  p.wobbleAmplitude = 0.05;
+  MeshOptions a, b;
+  a.level = b.level = 2;
+  a.t = 1e9;
+  const long double pi = 3.14159265358979323846264338327950288L;
+  b.t = double(1e9L - std::floor(1e9L / pi) * pi);
+  auto ma = icosphere(p, a), mb = icosphere(p, b);
+  ASSERT_TRUE(ma.ok() && mb.ok());
+  ASSERT_EQ(ma.value().positions.size(), mb.value().positions.size());
+  for (size_t i = 0; i < ma.value().positions.size(); ++i)
+    EXPECT_LT(glm::length(dvec3(ma.value().positions[i]) - dvec3(mb.value().positions[i])), 1e-5);
+}
+
+// ---- shaders ----
+
+bool compiles(const std::string& source, const char* stage, std::string& log) {
+  auto dir = std::filesystem::temp_directory_path();
+  std::string path = (dir / ("effectd_bubble_" + std::to_string(::getpid()) + "." + stage)).string();
+  std::ofstream(path) << source;
+  std::string cmd = "glslangValidator " + path + " > " + path + ".log 2>&1";
+  int rc = std::system(cmd.c_str());
+  std::ifstream in(path + ".log");
+  log.assign(std::istreambuf_iterator<char>(in), {});
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".log");
+  return rc == 0;
+}
+
+TEST(BubbleShader, EveryVariantCompilesAndHoldsOnlyItsFeatures) {
+  ASSERT_EQ(std::system("glslangValidator -v > /dev/null 2>&1"), 0) << "glslang-tools missing: scripts/setup.sh";
+  const std::vector<std::pair<std::string, std::vector<std::string>>> featureMarks = {
+      {"reflection", {"uFilmTop"}},
+      {"refraction", {"uFilmBottom", "uEta", "nuIn"}},
+      {"rim", {"uRimPower"}},
+      {"textureFlow", {"uFlowTexture", "uFlowPhase", "vUv", "aUv"}},
+      {"wobble", {"uWobblePhase", "uWobbleAmplitude"}},
+      {"iridescence", {"uThinFilm", "uThickness"}}};
+  for (int mask = 0; mask < 64; ++mask) {
+    Features f{bool(mask & 1), bool(mask & 2), bool(mask & 4), bool(mask & 8), bool(mask & 16), bool(mask & 32)};
+    for (Glsl v : {Glsl::kEs300, Glsl::kCore330}) {
+      ShaderSource s = shader(f, v);
+      std::string log;
+      EXPECT_TRUE(compiles(s.vertex, "vert", log)) << mask << "\n" << s.vertex << log;
+      EXPECT_TRUE(compiles(s.fragment, "frag", log)) << mask << "\n" << s.fragment << log;
+      for (size_t k = 0; k < featureMarks.size(); ++k) {
+        bool on = mask & (1 << k);
+        for (const auto& mark : featureMarks[k].second) {
+          bool present = (s.vertex + s.fragment).find(mark) != std::string::npos;
+          EXPECT_EQ(present, on) << featureMarks[k].first << " " << mark << " mask " << mask;
+        }
+      }
+      if (!(mask & 3)) {
+        EXPECT_EQ(s.fragment.find("uEnvironment"), std::string::npos);
+      }
+    }
+  }
+}
+
+// ---- thin film ----
+
+TEST(ThinFilm, ZeroThicknessIsThePlainAirInterface) {
+  // A film of thickness 0 is no film: air against air, reflectance 0, at every angle.
+  for (double c : {1.0, 0.5, 0.01}) EXPECT_EQ(filmReflectance(1.33, 0, c, 550), 0.0);
+  EXPECT_EQ(filmColor(1.33, 0, 1.0, 16), glm::dvec3(0));
+  // The interference maximum is the coherent sum of two interfaces: 4 R12 / (1 + R12)^2.
+  const double r = (1.33 - 1) / (1.33 + 1), R12 = r * r;
+  const double quarterWave = 550 / (4 * 1.33);
+  EXPECT_NEAR(filmReflectance(1.33, quarterWave, 1.0, 550), 4 * R12 / ((1 + R12) * (1 + R12)), 1e-12);
+  EXPECT_NEAR(filmReflectance(1.33, 2 * quarterWave, 1.0, 550), 0.0, 1e-12);  // half wave: dark
+  EXPECT_NEAR(filmReflectance(1.33, 100, 0.0, 550), 1.0, 1e-12);  // grazing: total reflection
+}
+
+// Hue class of a linear sRGB colour.
+std::string hue(const glm::dvec3& c) {
+  double mx = std::max({c.r, c.g, c.b}), mn = std::min({c.r, c.g, c.b});
+  if (mx - mn < 0.2 * mx) return "white";
+  if (c.r >= c.g && c.g > c.b) return "yellow";
+  if (c.r > c.g && c.b > c.g) return "magenta";
+  if (c.b >= c.r && c.b >= c.g) return "blue";
+  return "other";
+}
+
+TEST(ThinFilm, KnownColourOrderWithGrowingThickness) {
+  // Newton's series in reflection: black, first-order white, yellow, magenta, blue.
+  EXPECT_LT(glm::length(filmColor(1.33, 10, 1.0, 400)), 0.01);  // thinner than ~30 nm: black
+  std::vector<std::string> seen;
+  for (double d = 80; d <= 300; d += 5) {  // below ~80 nm the film is a dark grey
+    std::string h = hue(filmColor(1.33, d, 1.0, 400));
+    if (h != "other" && (seen.empty() || seen.back() != h)) seen.push_back(h);
+  }
+  std::vector<std::string> expected = {"white", "yellow", "magenta", "blue"};
+  ASSERT_GE(seen.size(), expected.size());
+  EXPECT_EQ(std::vector<std::string>(seen.begin(), seen.begin() + 4), expected) << ::testing::PrintToString(seen);
+}
+
+TEST(ThinFilm, ErrorFallsAsWavelengthSamplesGrow) {
+  double previous = 1e9;
+  for (int w : {3, 8, 16, 32, 81}) {
+    ThinFilmOptions o;
+    o.width = o.height = 32;
+    o.wavelengths = w;
+    auto t = thinFilmTable(o);
+    ASSERT_TRUE(t.ok());
+    EXPECT_LT(t.value().meanDeltaE, previous) << w;
+    previous = t.value().meanDeltaE;
+    for (float v : t.value().rgb) EXPECT_TRUE(std::isfinite(v));
+  }
+  EXPECT_LT(previous, 0.1);
+}
+
+}  // namespace
+}  // namespace effects::bubble
