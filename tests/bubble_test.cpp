@@ -227,7 +227,7 @@ TEST(ThinFilm, ZeroThicknessIsThePlainAirInterface) {
 // Hue class of a linear sRGB colour.
 std::string hue(const glm::dvec3& c) {
   double mx = std::max({c.r, c.g, c.b}), mn = std::min({c.r, c.g, c.b});
-  if (mx - mn < 0.2 * mx) return "white";
+  if (mx - mn < 0.35 * mx) return "white";  // greys and near-greys
   if (c.r >= c.g && c.g > c.b) return "yellow";
   if (c.r > c.g && c.b > c.g) return "magenta";
   if (c.b >= c.r && c.b >= c.g) return "blue";
