@@ -17,6 +17,7 @@ void addEffectEndpoints(Service& service);
 void addFogEndpoints(Service& service);
 void addLightningEndpoints(Service& service);
 void addTangentsEndpoints(Service& service);
+void addBubbleEndpoints(Service& service);
 
 // --- helpers shared by the api_*.cpp files ---
 glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers

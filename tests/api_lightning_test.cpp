@@ -24,7 +24,9 @@ TEST(LightningApi, OnlyWhatIsIncluded) {
   const json& main = j["polylines"][0];
   EXPECT_EQ(main["channel"], "main");
   EXPECT_EQ(main["points"].size(), 2 * main["step"].size());
-  if (j["polylines"].size() > 1) EXPECT_EQ(main["width"].get<double>(), 2 * j["polylines"][1]["width"].get<double>());
+  if (j["polylines"].size() > 1) {
+    EXPECT_EQ(main["width"].get<double>(), 2 * j["polylines"][1]["width"].get<double>());
+  }
 
   json req = request(48);
   req["include"] = {"cells", "tree", "fractalDimension", "stats"};

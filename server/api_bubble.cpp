@@ -1,0 +1,191 @@
+// POST /v1/bubble — seed 000's bubble: mesh, uniforms, GLSL variants, thin-film table, glTF.
+#include <algorithm>
+
+#include <effects/bubble.h>
+
+#include "codec.h"
+#include "endpoints.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace bb = effects::bubble;
+
+constexpr int kMaxIcosphereLevel = 7;  // 327 680 triangles
+
+bb::Params parseParams(const json& j) {
+  bb::Params p;
+  p.n1 = j.value("n1", p.n1);
+  p.n2 = j.value("n2", p.n2);
+  p.deltaSpeed = j.value("deltaSpeed", p.deltaSpeed);
+  p.betaSpeed = j.value("betaSpeed", p.betaSpeed);
+  p.rimPower = j.value("rimPower", p.rimPower);
+  p.muSpeed = j.value("muSpeed", p.muSpeed);
+  p.wobbleAmplitude = j.value("wobbleAmplitude", p.wobbleAmplitude);
+  if (auto e = bb::validate(p)) throwError(*e, "/params");
+  return p;
+}
+
+bb::Features parseFeatures(const json& j) {
+  bb::Features f;
+  f.reflection = j.value("reflection", f.reflection);
+  f.refraction = j.value("refraction", f.refraction);
+  f.rim = j.value("rim", f.rim);
+  f.textureFlow = j.value("textureFlow", f.textureFlow);
+  f.wobble = j.value("wobble", f.wobble);
+  f.iridescence = j.value("iridescence", f.iridescence);
+  return f;
+}
+
+template <class V, int N>
+json flat(const std::vector<V>& v) {
+  json a = json::array();
+  a.get_ref<json::array_t&>().reserve(v.size() * N);
+  for (const V& x : v)
+    for (int c = 0; c < N; ++c) a.push_back(x[c]);
+  return a;
+}
+
+// Values for the uniforms the CPU owns; only those the shader variant declares are sent.
+json uniforms(const bb::Params& p, const bb::Features& f, double t) {
+  const bb::Film film = bb::film(p, t);
+  const double flow = bb::reducedPhase(p.betaSpeed, t);
+  json all = {{"uWobblePhase", bb::reducedPhase(p.deltaSpeed, t)},
+              {"uWobbleAmplitude", p.wobbleAmplitude},
+              {"uFilmTop", film.top},
+              {"uFilmBottom", film.bottom},
+              {"uEta", p.n1 / p.n2},
+              {"uFlowPhase", flow},
+              {"uRimPower", p.rimPower},
+              {"uThickness", film.top}};
+  json out = json::object();
+  for (const std::string& name : bb::shader(f, bb::Glsl::kEs300).uniforms)
+    if (all.contains(name)) out[name] = all[name];
+  if (f.textureFlow) {
+    glm::dvec2 off = bb::flowOffset(p, t);
+    out["flowOffset"] = {off.x, off.y};  // eqn 9, for clients that offset on the CPU
+  }
+  return out;
+}
+
+JsonReply handleBubble(const json& body, const RequestContext&) {
+  Includes include(body, {"uniforms", "shader"});
+  const bb::Params params = parseParams(body.value("params", json::object()));
+  const bb::Features features = parseFeatures(body.value("features", json::object()));
+  const double t = body.value("time", 0.0);
+  JsonReply reply;
+  reply.method = "seed000";
+  json out = {{"method", reply.method}};
+  json stats = json::array();
+  effects::Stopwatch watch;
+
+  if (body.contains("motion")) {
+    const json& m = body["motion"];
+    glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
+    out["position"] = {c.x, c.y, c.z};
+  }
+  if (include.has("uniforms")) out["uniforms"] = uniforms(params, features, t);
+  if (include.has("shader")) {
+    const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
+    bb::ShaderSource s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
+    out["shader"] = {{"language", es ? "glsl-es-300" : "glsl-330"},
+                     {"vertex", s.vertex},
+                     {"fragment", s.fragment},
+                     {"uniforms", s.uniforms},
+                     {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
+  }
+  reply.computeMs += watch.ms();
+  if (include.has("mesh")) {
+    const json m = body.value("mesh", json::object());
+    bb::MeshOptions o;
+    o.level = m.value("level", 3);
+    o.maxLevel = kMaxIcosphereLevel;
+    o.radius = m.value("radius", 1.0);
+    o.t = t;
+    o.wobble = features.wobble;
+    if (body.contains("camera")) o.camera = toVec3(body["camera"]);
+    auto r = bb::icosphere(params, o);
+    if (!r.ok()) {
+      effects::Error e = r.error();
+      throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
+    }
+    const bb::Mesh& mesh = r.value();
+    json mj = {{"vertexCount", mesh.positions.size()},
+               {"positions", flat<glm::vec3, 3>(mesh.positions)},
+               {"normals", flat<glm::vec3, 3>(mesh.normals)},
+               {"uvs", flat<glm::vec2, 2>(mesh.uvs)},
+               {"tangents", flat<glm::vec4, 4>(mesh.tangents)},
+               {"indices", mesh.indices}};
+    if (o.camera) {
+      mj["finalVectors"] = flat<glm::vec3, 3>(mesh.finalVectors);
+      mj["rim"] = mesh.rim;
+    }
+    out["mesh"] = std::move(mj);
+    reply.computeMs += mesh.stats.elapsedMs;
+    stats.push_back(statsJson(mesh.stats));
+  }
+  const json tf = body.value("thinFilm", json::object());
+  const json range = tf.value("thicknessRange", json{0, 1000});
+  if (include.has("thinFilm")) {
+    bb::ThinFilmOptions o;
+    o.ior = params.n2;
+    o.wavelengths = tf.value("wavelengths", 16);
+    o.width = tf.value("width", 256);
+    o.height = tf.value("height", 256);
+    o.thicknessMinNm = range[0].get<double>();
+    o.thicknessMaxNm = range[1].get<double>();
+    auto r = bb::thinFilmTable(o);
+    if (!r.ok()) {
+      effects::Error e = r.error();
+      throwError(e, "/thinFilm");
+    }
+    const bb::ThinFilmTable& table = r.value();
+    json j = {{"width", table.width},
+              {"height", table.height},
+              {"axes", "u: thickness from thicknessRange[0] (column 0) to [1] nm; v: cos(theta) from 0 (row 0) to 1"},
+              {"thicknessRange", range},
+              {"wavelengths", o.wavelengths},
+              {"colorSpace", "linear sRGB, D65, reflectance of the film (white-balanced: R = 1 gives 1)"},
+              {"meanDeltaE", table.meanDeltaE},
+              {"maxDeltaE", table.maxDeltaE},
+              {"errorMetric", table.stats.errorMetric},
+              {"reference", table.stats.reference}};
+    if (tf.value("encoding", "json") == "json") {
+      json rgb = json::array();
+      for (float v : table.rgb) rgb.push_back(v);
+      j["rgb"] = std::move(rgb);
+    } else {
+      std::string bytes;
+      for (size_t i = 0; i < table.rgb.size(); i += 3)
+        for (float c : {table.rgb[i], table.rgb[i + 1], table.rgb[i + 2], 1.0f}) {
+          uint16_t h = floatToHalf(c);
+          bytes += char(h & 0xFF);
+          bytes += char(h >> 8);
+        }
+      j["encoding"] = "rgba16f";
+      j["data"] = base64Encode(bytes);
+    }
+    out["thinFilm"] = std::move(j);
+    reply.computeMs += table.stats.elapsedMs;
+    stats.push_back(statsJson(table.stats));
+  }
+  if (include.has("gltf")) {
+    // glTF's default range is 100-400 nm; a request's thicknessRange overrides it.
+    const bool given = tf.contains("thicknessRange");
+    out["gltf"] = {{"KHR_materials_iridescence",
+                    {{"iridescenceFactor", 1.0},
+                     {"iridescenceIor", params.n2},
+                     {"iridescenceThicknessMinimum", given ? range[0].get<double>() : 100.0},
+                     {"iridescenceThicknessMaximum", given ? range[1].get<double>() : 400.0}}}};
+  }
+  if (include.has("stats")) out["stats"] = std::move(stats);
+  reply.body = std::move(out);
+  return reply;
+}
+
+}  // namespace
+
+void addBubbleEndpoints(Service& service) { service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble); }
+
+}  // namespace effectd
