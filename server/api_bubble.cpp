@@ -38,15 +38,6 @@ bb::Features parseFeatures(const json& j) {
   return f;
 }
 
-template <class V, int N>
-json flat(const std::vector<V>& v) {
-  json a = json::array();
-  a.get_ref<json::array_t&>().reserve(v.size() * N);
-  for (const V& x : v)
-    for (int c = 0; c < N; ++c) a.push_back(x[c]);
-  return a;
-}
-
 // Values for the uniforms the CPU owns; only those the shader variant declares are sent.
 json uniforms(const bb::Params& p, const bb::Features& f, double t) {
   const bb::Film film = bb::film(p, t);
@@ -112,13 +103,13 @@ JsonReply handleBubble(const json& body, const RequestContext&) {
     }
     const bb::Mesh& mesh = r.value();
     json mj = {{"vertexCount", mesh.positions.size()},
-               {"positions", flat<glm::vec3, 3>(mesh.positions)},
-               {"normals", flat<glm::vec3, 3>(mesh.normals)},
-               {"uvs", flat<glm::vec2, 2>(mesh.uvs)},
-               {"tangents", flat<glm::vec4, 4>(mesh.tangents)},
+               {"positions", flat<3>(mesh.positions)},
+               {"normals", flat<3>(mesh.normals)},
+               {"uvs", flat<2>(mesh.uvs)},
+               {"tangents", flat<4>(mesh.tangents)},
                {"indices", mesh.indices}};
     if (o.camera) {
-      mj["finalVectors"] = flat<glm::vec3, 3>(mesh.finalVectors);
+      mj["finalVectors"] = flat<3>(mesh.finalVectors);
       mj["rim"] = mesh.rim;
     }
     out["mesh"] = std::move(mj);

@@ -42,15 +42,6 @@ void flipW(tg::Output& out) {
   for (auto& t : out.tangents) t.w = -t.w;
 }
 
-template <class V, int N>
-json flat(const std::vector<V>& v) {
-  json a = json::array();
-  a.get_ref<json::array_t&>().reserve(v.size() * N);
-  for (const V& x : v)
-    for (int c = 0; c < N; ++c) a.push_back(x[c]);
-  return a;
-}
-
 JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   Includes include(body, {"tangents", "remap", "indices"});
   const json& m = body["mesh"];
@@ -76,10 +67,10 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   reply.method = out.stats.method;
   reply.computeMs = out.stats.elapsedMs;
   json res = {{"method", reply.method}, {"vertexCount", out.remap.size()}};
-  if (include.has("tangents")) res["tangents"] = flat<glm::vec4, 4>(out.tangents);
+  if (include.has("tangents")) res["tangents"] = flat<4>(out.tangents);
   if (include.has("remap")) res["remap"] = out.remap;
   if (include.has("indices")) res["indices"] = out.indices;
-  if (include.has("normals")) res["normals"] = flat<glm::vec3, 3>(out.normals);
+  if (include.has("normals")) res["normals"] = flat<3>(out.normals);
   if (include.has("triangleFrames")) {
     json t = json::array(), b = json::array(), n = json::array(), w = json::array(), degenerate = json::array();
     for (size_t i = 0; i < out.triangleFrames.size(); ++i) {

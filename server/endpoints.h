@@ -30,6 +30,15 @@ class Includes {
  private:
   std::vector<std::string> items_;
 };
+// glm vectors as one flat JSON array (x0, y0, z0, x1, ...): the compact form meshes use.
+template <int N, class V>
+nlohmann::json flat(const std::vector<V>& v) {
+  nlohmann::json a = nlohmann::json::array();
+  a.get_ref<nlohmann::json::array_t&>().reserve(v.size() * N);
+  for (const V& x : v)
+    for (int c = 0; c < N; ++c) a.push_back(x[c]);
+  return a;
+}
 // Rounds to float precision for the wire (geometry is float; see architecture.md).
 inline double wire(double v) { return static_cast<double>(static_cast<float>(v)); }
 
