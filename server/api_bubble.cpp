@@ -39,7 +39,7 @@ bb::Features parseFeatures(const json& j) {
 }
 
 // Values for the uniforms the CPU owns; only those the shader variant declares are sent.
-json uniforms(const bb::Params& p, const bb::Features& f, double t) {
+json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std::string>& declared, double t) {
   const bb::Film film = bb::film(p, t);
   const double flow = bb::reducedPhase(p.betaSpeed, t);
   json all = {{"uWobblePhase", bb::reducedPhase(p.deltaSpeed, t)},
@@ -51,7 +51,7 @@ json uniforms(const bb::Params& p, const bb::Features& f, double t) {
               {"uRimPower", p.rimPower},
               {"uThickness", film.top}};
   json out = json::object();
-  for (const std::string& name : bb::shader(f, bb::Glsl::kEs300).uniforms)
+  for (const std::string& name : declared)
     if (all.contains(name)) out[name] = all[name];
   if (f.textureFlow) {
     glm::dvec2 off = bb::flowOffset(p, t);
@@ -76,10 +76,12 @@ JsonReply handleBubble(const json& body, const RequestContext&) {
     glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
     out["position"] = {c.x, c.y, c.z};
   }
-  if (include.has("uniforms")) out["uniforms"] = uniforms(params, features, t);
+  // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
+  const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
+  bb::ShaderSource s;
+  if (include.has("uniforms") || include.has("shader")) s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
+  if (include.has("uniforms")) out["uniforms"] = uniforms(params, features, s.uniforms, t);
   if (include.has("shader")) {
-    const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
-    bb::ShaderSource s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
     out["shader"] = {{"language", es ? "glsl-es-300" : "glsl-330"},
                      {"vertex", s.vertex},
                      {"fragment", s.fragment},

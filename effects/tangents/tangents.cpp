@@ -36,18 +36,12 @@ dvec3 normalizeOrZero(const dvec3& v) {
 }
 dvec3 projectToPlane(const dvec3& v, const dvec3& n) { return v - glm::dot(n, v) * n; }
 
-// A unit vector orthogonal to unit `n`: the first candidate with a clear component in n's
-// plane, else the world axis least aligned with n.
-dvec3 orthogonalFallback(const dvec3& n, std::initializer_list<dvec3> candidates) {
-  for (const dvec3& c : candidates) {
-    double len = glm::length(c);
-    if (!(len > 0) || !std::isfinite(len)) continue;
-    dvec3 t = projectToPlane(c / len, n);
-    if (glm::length(t) > 1e-6) return glm::normalize(t);
-  }
-  dvec3 a = std::abs(n.x) <= std::abs(n.y) && std::abs(n.x) <= std::abs(n.z) ? dvec3(1, 0, 0)
-            : std::abs(n.y) <= std::abs(n.z)                                  ? dvec3(0, 1, 0)
-                                                                              : dvec3(0, 0, 1);
+// The x axis projected into the plane of unit `n`; when n lies along x, the world axis least
+// aligned with n, projected.
+dvec3 inPlaneAxis(const dvec3& n) {
+  dvec3 t = projectToPlane(dvec3(1, 0, 0), n);
+  if (glm::length(t) > 1e-6) return glm::normalize(t);
+  dvec3 a = std::abs(n.y) <= std::abs(n.z) ? dvec3(0, 1, 0) : dvec3(0, 0, 1);
   return glm::normalize(projectToPlane(a, n));
 }
 
@@ -92,6 +86,12 @@ void parallelFor(size_t n, Fn fn) {
   for (auto& th : pool) th.join();
 }
 
+dvec3 trianglePoint(const Mesh& m, size_t t, int c) { return dvec3(m.positions[m.indices[3 * t + size_t(c)]]); }
+// Unit face normal of triangle t, zero when its area is zero.
+dvec3 faceNormal(const Mesh& m, size_t t) {
+  return normalizeOrZero(glm::cross(trianglePoint(m, t, 1) - trianglePoint(m, t, 0), trianglePoint(m, t, 2) - trianglePoint(m, t, 0)));
+}
+
 // Unit normals per vertex: given ones normalised; missing ones angle-weighted over all
 // corners at the same position. A vertex with no usable triangle gets +z.
 std::vector<dvec3> vertexNormals(const Mesh& mesh) {
@@ -111,7 +111,7 @@ std::vector<dvec3> vertexNormals(const Mesh& mesh) {
   for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
     dvec3 p[3];
     for (int c = 0; c < 3; ++c) p[c] = dvec3(mesh.positions[mesh.indices[t + c]]);
-    dvec3 fn = normalizeOrZero(glm::cross(p[1] - p[0], p[2] - p[0]));
+    dvec3 fn = faceNormal(mesh, t / 3);
     if (!notZero(fn)) continue;
     for (int c = 0; c < 3; ++c) {
       dvec3 a = normalizeOrZero(p[(c + 1) % 3] - p[c]), b = normalizeOrZero(p[(c + 2) % 3] - p[c]);
@@ -390,12 +390,10 @@ class Mikk {
 
 // ---- output assembly ---------------------------------------------------------------------
 
-dvec3 trianglePoint(const Mesh& m, size_t t, int c) { return dvec3(m.positions[m.indices[3 * t + size_t(c)]]); }
-
 // Where no frame exists (no UV-valid triangle at the vertex) the reference emits its default
 // (1, 0, 0) with w = -1, which is not orthogonal to N; effectd emits that default projected
 // into N's plane, so it stays the nearest valid tangent to what every MikkTSpace tool writes.
-glm::vec4 fallbackTangent(const dvec3& n) { return {glm::vec3(orthogonalFallback(n, {dvec3(1, 0, 0)})), -1.0f}; }
+glm::vec4 fallbackTangent(const dvec3& n) { return {glm::vec3(inPlaneAxis(n)), -1.0f}; }
 
 // A unit tangent in n's plane from `t` (any length), or the fallback.
 glm::vec4 finishTangent(const dvec3& t, bool positive, const dvec3& n, bool& fellBack) {
@@ -414,8 +412,7 @@ Mesh flatExpanded(const Mesh& mesh, std::vector<uint32_t>& cornerToInput) {
   out.indices.resize(corners);
   cornerToInput = mesh.indices;
   for (size_t t = 0; t < corners / 3; ++t) {
-    dvec3 fn = normalizeOrZero(glm::cross(trianglePoint(mesh, t, 1) - trianglePoint(mesh, t, 0),
-                                          trianglePoint(mesh, t, 2) - trianglePoint(mesh, t, 0)));
+    dvec3 fn = faceNormal(mesh, t);
     if (!notZero(fn)) fn = dvec3(0, 0, 1);
     for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
       out.positions[c] = mesh.positions[mesh.indices[c]];
@@ -584,8 +581,7 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   if (options.triangleFrames) {
     out.triangleFrames.resize(triCount);
     for (size_t t = 0; t < triCount; ++t) {
-      dvec3 fn = normalizeOrZero(glm::cross(trianglePoint(mesh, t, 1) - trianglePoint(mesh, t, 0),
-                                            trianglePoint(mesh, t, 2) - trianglePoint(mesh, t, 0)));
+      dvec3 fn = faceNormal(mesh, t);
       out.triangleFrames[t] = triFrame(t, notZero(fn) ? fn : normals[mesh.indices[3 * t]]);
       if (!notZero(fn)) out.triangleFrames[t].degenerate = true;
     }
