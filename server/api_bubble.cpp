@@ -7,14 +7,15 @@
 #include "endpoints.h"
 
 namespace effectd {
-namespace {
 
 using nlohmann::json;
 namespace bb = effects::bubble;
 
+namespace {
 constexpr int kMaxIcosphereLevel = 7;  // 327 680 triangles
+}  // namespace
 
-bb::Params parseParams(const json& j) {
+bb::Params parseBubbleParams(const json& j) {
   bb::Params p;
   p.n1 = j.value("n1", p.n1);
   p.n2 = j.value("n2", p.n2);
@@ -27,7 +28,7 @@ bb::Params parseParams(const json& j) {
   return p;
 }
 
-bb::Features parseFeatures(const json& j) {
+bb::Features parseBubbleFeatures(const json& j) {
   bb::Features f;
   f.reflection = j.value("reflection", f.reflection);
   f.refraction = j.value("refraction", f.refraction);
@@ -37,6 +38,21 @@ bb::Features parseFeatures(const json& j) {
   f.iridescence = j.value("iridescence", f.iridescence);
   return f;
 }
+
+bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params) {
+  const json tf = body.value("thinFilm", json::object());
+  const json range = tf.value("thicknessRange", json{0, 1000});
+  bb::ThinFilmOptions o;
+  o.ior = params.n2;
+  o.wavelengths = tf.value("wavelengths", 16);
+  o.width = tf.value("width", 256);
+  o.height = tf.value("height", 256);
+  o.thicknessMinNm = range[0].get<double>();
+  o.thicknessMaxNm = range[1].get<double>();
+  return o;
+}
+
+namespace {
 
 // Values for the uniforms the CPU owns; only those the shader variant declares are sent.
 json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std::string>& declared, double t) {
@@ -60,10 +76,12 @@ json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std:
   return out;
 }
 
+}  // namespace
+
 JsonReply handleBubble(const json& body, const RequestContext&) {
   Includes include(body, {"uniforms", "shader"});
-  const bb::Params params = parseParams(body.value("params", json::object()));
-  const bb::Features features = parseFeatures(body.value("features", json::object()));
+  const bb::Params params = parseBubbleParams(body.value("params", json::object()));
+  const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
   const double t = body.value("time", 0.0);
   JsonReply reply;
   reply.method = "seed000";
@@ -121,13 +139,7 @@ JsonReply handleBubble(const json& body, const RequestContext&) {
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
   if (include.has("thinFilm")) {
-    bb::ThinFilmOptions o;
-    o.ior = params.n2;
-    o.wavelengths = tf.value("wavelengths", 16);
-    o.width = tf.value("width", 256);
-    o.height = tf.value("height", 256);
-    o.thicknessMinNm = range[0].get<double>();
-    o.thicknessMaxNm = range[1].get<double>();
+    const bb::ThinFilmOptions o = thinFilmOptions(body, params);
     auto r = bb::thinFilmTable(o);
     if (!r.ok()) {
       effects::Error e = r.error();
@@ -176,8 +188,6 @@ JsonReply handleBubble(const json& body, const RequestContext&) {
   reply.body = std::move(out);
   return reply;
 }
-
-}  // namespace
 
 void addBubbleEndpoints(Service& service) { service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble); }
 

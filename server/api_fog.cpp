@@ -7,7 +7,6 @@
 #include "endpoints.h"
 
 namespace effectd {
-namespace {
 
 using nlohmann::json;
 namespace fog = effects::fog;
@@ -46,6 +45,8 @@ fog::Region parseRegion(const json& j, const std::string& pointer) {
   if (auto e = fog::validate(r)) throwError(*e, pointer);
   return r;
 }
+
+namespace {
 
 std::string encodeTexels(const fog::Table& t, const fog::Fog& f, const std::string& encoding) {
   // Texel = ((1 - f) * fogColor, f): the shader computes objectColour * a + rgb.
@@ -120,6 +121,8 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
   return opt;
 }
 
+}  // namespace
+
 JsonReply handleFog(const json& body, const RequestContext& ctx) {
   Includes include(body, {"table"});
   fog::Fog global = parseFog(body["fog"], "/fog");
@@ -181,8 +184,6 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
   reply.body = std::move(out);
   return reply;
 }
-
-}  // namespace
 
 void addFogEndpoints(Service& service) { service.addJsonEndpoint("/v1/fog", "fog.json", handleFog); }
 

@@ -56,15 +56,17 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
 
 lt::Cell cellOf(const json& j) { return {j[0].get<int>(), j[1].get<int>()}; }
 
-JsonReply handleLightning(const json& body, const RequestContext& ctx) {
-  Includes include(body, {"polylines"});
-  lt::Params p;
+}  // namespace
+
+LightningRequest parseLightning(const json& body, const Config& config) {
+  LightningRequest r;
+  lt::Params& p = r.params;
   p.width = body["grid"]["width"];
   p.height = body["grid"]["height"];
   const size_t cells = size_t(p.width) * size_t(p.height);
-  if (cells > ctx.config.limits.maxGridCells)
+  if (cells > config.limits.maxGridCells)
     throw fieldError(413, "/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
-                                       std::to_string(ctx.config.limits.maxGridCells) + " (--max-grid-cells)");
+                                       std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
   if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height);
   p.start = cellOf(body["start"]);
   p.targets.clear();
@@ -78,16 +80,33 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   const std::string guide = body.value("guide", "auto");
   p.guide = guide == "astar" ? lt::Guide::kAstar : guide == "none" ? lt::Guide::kNone : lt::Guide::kAuto;
   p.seed = body.value("seed", uint64_t(1));
-  p.maxSteps = std::min<size_t>(body.value("maxSteps", ctx.config.limits.maxGrowthSteps), ctx.config.limits.maxGrowthSteps);
-  p.measureError = include.has("error");
+  p.maxSteps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
+  lt::ShapeParams& shape = r.shape;
+  const json s = body.value("shape", json::object());
+  shape.jitter = s.value("jitter", shape.jitter);
+  shape.jitterSeed = s.value("jitterSeed", p.seed);
+  shape.branchWidth = s.value("branchWidth", shape.branchWidth);
+  shape.branchIntensity = s.value("branchIntensity", shape.branchIntensity);
+  shape.branchFalloff = s.value("branchFalloff", shape.branchFalloff);
+  return r;
+}
 
+lt::Bolt growBolt(const lt::Params& p) {
   auto grown = lt::grow(p);
   if (!grown.ok()) {
     effects::Error e = grown.error();
     if (e.field == "/maxSteps") e.message += " (--max-growth-steps / maxSteps)";
     throwError(e);
   }
-  const lt::Bolt& bolt = grown.value();
+  return std::move(grown.value());
+}
+
+JsonReply handleLightning(const json& body, const RequestContext& ctx) {
+  Includes include(body, {"polylines"});
+  LightningRequest request = parseLightning(body, ctx.config);
+  const lt::Params& p = request.params;
+  request.params.measureError = include.has("error");
+  const lt::Bolt bolt = growBolt(p);
   JsonReply reply;
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;
@@ -97,15 +116,8 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   out["steps"] = bolt.nodes.back().step;
 
   if (include.has("polylines")) {
-    lt::ShapeParams shape;
-    const json s = body.value("shape", json::object());
-    shape.jitter = s.value("jitter", shape.jitter);
-    shape.jitterSeed = s.value("jitterSeed", p.seed);
-    shape.branchWidth = s.value("branchWidth", shape.branchWidth);
-    shape.branchIntensity = s.value("branchIntensity", shape.branchIntensity);
-    shape.branchFalloff = s.value("branchFalloff", shape.branchFalloff);
     json lines = json::array();
-    for (const auto& l : lt::polylines(bolt, shape)) {
+    for (const auto& l : lt::polylines(bolt, request.shape)) {
       json xy = json::array(), step = json::array(), intensity = json::array();
       for (const auto& v : l.vertices) {
         xy.push_back(v.x);
@@ -156,8 +168,6 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   reply.body = std::move(out);
   return reply;
 }
-
-}  // namespace
 
 void addLightningEndpoints(Service& service) {
   service.addJsonEndpoint("/v1/lightning", "lightning.json", handleLightning);

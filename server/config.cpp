@@ -72,6 +72,17 @@ const std::vector<Option>& options() {
        limitField(&Limits::maxMeshVertices, 3, 1LL << 28)},
       {"max-mesh-triangles", "EFFECTD_MAX_MESH_TRIANGLES", "triangles per mesh (default 4000000)",
        limitField(&Limits::maxMeshTriangles, 1, 1LL << 28)},
+      {"max-render-pixels", "EFFECTD_MAX_RENDER_PIXELS", "render width*height and decoded image pixels (default 16777216)",
+       limitField(&Limits::maxRenderPixels, 1, 1LL << 28)},
+      {"render-threads", "EFFECTD_RENDER_THREADS", "render threads, one EGL context each (default 2)",
+       intField(&Config::renderThreads, 1, 64)},
+      {"render-queue", "EFFECTD_RENDER_QUEUE", "renders waiting beyond the running ones before 503 (default 8)",
+       intField(&Config::renderQueue, 0, 10000)},
+      {"egl-platform", "EFFECTD_EGL_PLATFORM", "auto (device, then surfaceless), device or surfaceless (default auto)",
+       [](const std::string& s, Config& c) {
+         c.eglPlatform = s;
+         return s == "auto" || s == "device" || s == "surfaceless";
+       }},
   };
   return opts;
 }

@@ -15,6 +15,7 @@ struct Limits {
   size_t maxTableSize = 65536;         // fog table entries (all dimensions together)
   size_t maxMeshVertices = 2'000'000;  // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;
+  size_t maxRenderPixels = 4096u * 4096u;  // render width*height, and decoded background images
 };
 
 struct Config {
@@ -26,6 +27,9 @@ struct Config {
   int keepAliveTimeoutS = 5;
   int keepAliveMaxCount = 100;
   bool accessLog = true;
+  int renderThreads = 2;      // render pool: threads, one EGL context each
+  int renderQueue = 8;        // renders waiting beyond the running ones; more -> 503
+  std::string eglPlatform;    // auto | device | surfaceless; "" = EFFECTD_EGL_PLATFORM or auto
   Limits limits;
 };
 

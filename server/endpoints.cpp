@@ -9,6 +9,7 @@ void addEffectEndpoints(Service& service) {
   addLightningEndpoints(service);
   addTangentsEndpoints(service);
   addBubbleEndpoints(service);
+  addRenderEndpoints(service);
 }
 
 glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }

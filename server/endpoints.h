@@ -9,6 +9,10 @@
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
+#include <effects/bubble.h>
+#include <effects/fog.h>
+#include <effects/lightning.h>
+
 #include "service.h"
 
 namespace effectd {
@@ -18,6 +22,23 @@ void addFogEndpoints(Service& service);
 void addLightningEndpoints(Service& service);
 void addTangentsEndpoints(Service& service);
 void addBubbleEndpoints(Service& service);
+void addRenderEndpoints(Service& service);
+
+// --- the effects' request handlers and parsers, reused by /v1/scene and /v1/render ---
+JsonReply handleFog(const nlohmann::json& body, const RequestContext& ctx);
+JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx);
+JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
+effects::fog::Fog parseFog(const nlohmann::json& j, const std::string& pointer);
+effects::fog::Region parseRegion(const nlohmann::json& j, const std::string& pointer);
+struct LightningRequest {
+  effects::lightning::Params params;
+  effects::lightning::ShapeParams shape;
+};
+LightningRequest parseLightning(const nlohmann::json& body, const Config& config);
+effects::lightning::Bolt growBolt(const effects::lightning::Params& params);  // throws ApiError
+effects::bubble::Params parseBubbleParams(const nlohmann::json& j);
+effects::bubble::Features parseBubbleFeatures(const nlohmann::json& j);
+effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params);
 
 // --- helpers shared by the api_*.cpp files ---
 glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers

@@ -1,5 +1,6 @@
 // effectd: the effect-generation HTTP service.
-//   effectd [serve] [flags]   serve HTTP until SIGTERM/SIGINT (in-flight requests finish)
+//   effectd [serve] [flags]                          serve HTTP until SIGTERM/SIGINT
+//   effectd render SCENE.json -o OUT.png [flags]     render a scene without a server
 //   effectd --help
 #include <signal.h>
 #include <unistd.h>
@@ -7,14 +8,89 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 #include "config.h"
 #include "endpoints.h"
+#include "scene.h"
 #include "service.h"
+
+namespace {
+
+// `effectd render scene.json -o out.png`: the same validation, scene building and renderer
+// as POST /v1/render, on this thread. Exit 0 written, 1 render failure, 2 bad input.
+int renderCommand(std::vector<std::string> args) {
+  std::string scenePath, outPath;
+  std::vector<std::string> flags;
+  for (size_t i = 0; i < args.size(); ++i) {
+    if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size())
+      outPath = args[++i];
+    else if (args[i].rfind("--", 0) == 0)
+      flags.push_back(args[i]);
+    else if (scenePath.empty())
+      scenePath = args[i];
+    else
+      flags.push_back(args[i]);
+  }
+  if (scenePath.empty() || outPath.empty()) {
+    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n", stderr);
+    return 2;
+  }
+  effectd::Config config;
+  bool help = false;
+  if (std::string err = effectd::parseConfig(flags, config, help); !err.empty()) {
+    std::fprintf(stderr, "effectd render: %s\n", err.c_str());
+    return 2;
+  }
+  std::ifstream in(scenePath, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "effectd render: cannot read %s\n", scenePath.c_str());
+    return 2;
+  }
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  nlohmann::json body = nlohmann::json::parse(text, nullptr, false);
+  if (body.is_discarded()) {
+    std::fprintf(stderr, "effectd render: %s is not valid JSON\n", scenePath.c_str());
+    return 2;
+  }
+  effectd::Service service(config);  // for its schemas; it never listens
+  auto violations = service.schemas().validate("scene.json", body);
+  if (!violations.empty()) {
+    for (const auto& v : violations) std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
+    return 2;
+  }
+  try {
+    effects::render::Scene scene = effectd::buildScene(body, config);
+    auto renderer = effects::render::Renderer::create(config.eglPlatform);
+    if (!renderer.ok()) throw effectd::toApiError(renderer.error());
+    auto frame = renderer.value()->render(scene);
+    if (!frame.ok()) throw effectd::toApiError(frame.error());
+    auto png = effects::render::encodePng(frame.value().image, scene.bitDepth);
+    if (!png.ok()) throw effectd::toApiError(png.error());
+    std::ofstream out(outPath, std::ios::binary);
+    out << png.value();
+    if (!out.flush()) {
+      std::fprintf(stderr, "effectd render: cannot write %s\n", outPath.c_str());
+      return 1;
+    }
+    std::string passes;
+    for (const auto& p : frame.value().passes) passes += (passes.empty() ? "" : ",") + p;
+    std::fprintf(stderr, "{\"renderer\":\"%s\",\"passes\":\"%s\",\"renderMs\":%.2f,\"bytes\":%zu}\n",
+                 renderer.value()->description().c_str(), passes.c_str(), frame.value().ms, png.value().size());
+    return 0;
+  } catch (const effectd::ApiError& e) {
+    std::fprintf(stderr, "effectd render: %s\n", e.detail.c_str());
+    return e.status >= 500 || e.status == 422 ? 1 : 2;
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+  if (!args.empty() && args.front() == "render") return renderCommand({args.begin() + 1, args.end()});
   if (!args.empty() && args.front() == "serve") args.erase(args.begin());
 
   effectd::Config config;

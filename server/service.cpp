@@ -186,9 +186,10 @@ void Service::installCore() {
       components[name] = why.empty() ? json("ready") : json(why);
       ready = ready && why.empty();
     }
+    json out = {{"status", ready ? "ready" : "not ready"}, {"components", components}};
+    for (const auto& [name, value] : info_) out["info"][name] = value();
     res.status = ready ? 200 : 503;
-    res.set_content(json{{"status", ready ? "ready" : "not ready"}, {"components", components}}.dump(),
-                    "application/json");
+    res.set_content(out.dump(), "application/json");
   });
   addGet("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
@@ -342,6 +343,10 @@ void Service::addReadinessCheck(const std::string& name, std::function<std::stri
   readiness_.emplace_back(name, std::move(probe));
 }
 
+void Service::addReadinessInfo(const std::string& name, std::function<std::string()> value) {
+  info_.emplace_back(name, std::move(value));
+}
+
 void Service::handleJson(const Route& route, const httplib::Request& req, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_};
   try {
@@ -363,7 +368,11 @@ void Service::handleJson(const Route& route, const httplib::Request& req, httpli
     JsonReply reply = route.json(body, ctx);
     res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
     if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
-    res.set_content(reply.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+    for (const auto& [name, value] : reply.headers) res.set_header(name, value);
+    if (!reply.contentType.empty())
+      res.set_content(std::move(reply.binary), reply.contentType);
+    else
+      res.set_content(reply.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
   } catch (const ApiError& e) {
     writeProblem(res, e, ctx.requestId);
   }

@@ -41,6 +41,9 @@ struct JsonReply {
   nlohmann::json body;
   double computeMs = 0;
   std::string method;  // the method that ran, echoed in the X-Effect-Method header
+  // A JSON request may answer with bytes of another media type instead (e.g. image/png).
+  std::string binary, contentType;
+  std::map<std::string, std::string> headers;
 };
 
 struct RequestContext {
@@ -71,6 +74,8 @@ class Service {
   void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler);
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
+  // A fact /readyz reports under "info" (e.g. which renderer is in use).
+  void addReadinessInfo(const std::string& name, std::function<std::string()> value);
 
   int bind();        // binds host:port from the config; returns the port, or -1
   bool run();        // serves until stop(); in-flight requests finish before it returns
@@ -92,7 +97,7 @@ class Service {
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
   std::vector<std::unique_ptr<Route>> routes_;
-  std::vector<std::pair<std::string, std::function<std::string()>>> readiness_;
+  std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
 };
 
 // Writes `problem` into `res` as application/problem+json with the request id.

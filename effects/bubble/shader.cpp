@@ -27,7 +27,8 @@ std::string header(Glsl v, bool fragment) {
 
 }  // namespace
 
-ShaderSource shader(const Features& f, Glsl version) {
+ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude,
+                    const std::string& fragmentFinish) {
   ShaderSource out;
   const bool env = f.reflection || f.refraction;
   const bool needsView = env || f.rim || f.iridescence;
@@ -73,7 +74,7 @@ ShaderSource shader(const Features& f, Glsl version) {
     fs.uniform("sampler2D", "uThinFilm", "thin-film table: u = thickness, v = cos(theta)");
     fs.uniform("float", "uThickness", "film thickness as the table's u coordinate");
   }
-  fs << "void main() {\n  vec4 color = uBaseColor;\n";
+  fs << fragmentPrelude << "void main() {\n  vec4 color = uBaseColor;\n";
   if (needsView)
     fs << "  vec3 N = normalize(vNormal);\n  vec3 V = normalize(uCameraPosition - vWorld);\n"
           "  float gammaOut = dot(N, V);  // eqn 4\n";
@@ -89,7 +90,7 @@ ShaderSource shader(const Features& f, Glsl version) {
   if (f.textureFlow) fs << "  color.rgb *= texture(uFlowTexture, vUv + vec2(sin(uFlowPhase), cos(uFlowPhase))).rgb;  // eqn 9\n";
   if (f.iridescence) fs << "  color.rgb += texture(uThinFilm, vec2(uThickness, abs(gammaOut))).rgb;\n";
   if (f.rim) fs << "  color.a *= clamp(pow(max(1.0 - gammaOut, 0.0), uRimPower), 0.0, 1.0);  // eqn 10\n";
-  fs << "  fragColor = color;\n}\n";
+  fs << fragmentFinish << "  fragColor = color;\n}\n";
   out.fragment = fs.src.str();
   return out;
 }

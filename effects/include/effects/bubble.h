@@ -95,7 +95,11 @@ struct ShaderSource {
   std::string vertex, fragment;
   std::vector<std::string> uniforms;  // every uniform the two stages declare
 };
-ShaderSource shader(const Features& f, Glsl version);
+// A renderer may splice its own code into the fragment stage: `fragmentPrelude` goes after
+// the declarations, `fragmentFinish` runs just before the write and may change `color`
+// (vec4, straight alpha); both see vWorld (world position).
+ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
+                    const std::string& fragmentFinish = "");
 
 // ---- thin film ----------------------------------------------------------------------------
 // Reflectance of an air/film/air film (Airy), mean of s and p, at wavelength `nm`.

@@ -1,0 +1,228 @@
+// GLSL ES 3.00 for the render passes. Every function returns only the code its variant
+// needs: a fog variant holds the formulas of the fog types the scene uses and nothing else.
+#include <algorithm>
+#include <sstream>
+
+#include "internal.h"
+
+namespace effects::render::detail {
+
+std::string FogVariant::key() const {
+  std::string k = "fog";
+  for (fog::FogType t : types) k += std::string(":") + fog::toString(t);
+  return k + ":r" + std::to_string(regions);
+}
+
+FogVariant fogVariant(const Fog& f) {
+  FogVariant v;
+  v.types.push_back(f.global.type);
+  for (const auto& r : f.regions) v.types.push_back(r.fog.type);
+  std::sort(v.types.begin(), v.types.end());
+  v.types.erase(std::unique(v.types.begin(), v.types.end()), v.types.end());
+  v.regions = f.regions.size();
+  return v;
+}
+
+std::string fogGlsl(const FogVariant& v) {
+  using T = fog::FogType;
+  auto has = [&](T t) { return std::find(v.types.begin(), v.types.end(), t) != v.types.end(); };
+  const size_t slots = v.regions + 1;
+  std::ostringstream s;
+  s << "// fog: " << v.key() << " (effects::fog::factor, per fragment)\n"
+    << "uniform vec3 uFogCamera;\n"
+    << "uniform int uFogType[" << slots << "];\n"
+    << "uniform vec4 uFogParams[" << slots << "];\n"
+    << "uniform vec3 uFogColor[" << slots << "];\n";
+  if (v.regions) s << "uniform vec4 uRegionLo[" << v.regions << "];  // box min | sphere centre; w: 0 box, 1 sphere\n"
+                   << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
+  if (has(T::kHeight))
+    s << "float fogLogG(float x) {  // log((1 - e^-x) / x), stable for every x\n"
+         "  if (abs(x) < 1e-3) return -0.5 * x + x * x / 24.0;\n"
+         "  if (x > 0.0) return log(1.0 - exp(-x)) - log(x);\n"
+         "  if (x > -80.0) return log(exp(-x) - 1.0) - log(-x);\n"
+         "  return -x - log(-x);\n"
+         "}\n";
+  s << "float fogFactor(int slot, vec3 world) {\n"
+       "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
+       "  vec4 q = uFogParams[slot];\n  int type = uFogType[slot];\n";
+  for (T t : v.types) {
+    s << "  if (type == " << int(t) << ") {  // " << fog::toString(t) << "\n";
+    switch (t) {
+      case T::kX3dLinear: s << "    return q.x <= 0.0 ? 1.0 : (d >= q.x ? 0.0 : (q.x - d) / q.x);\n"; break;
+      case T::kX3dExponential: s << "    return q.x <= 0.0 ? 1.0 : (d >= q.x ? 0.0 : exp(-d / (q.x - d)));\n"; break;
+      case T::kGlLinear: s << "    return clamp((q.y - d) / (q.y - q.x), 0.0, 1.0);\n"; break;
+      case T::kGlExp: s << "    return exp(-q.x * d);\n"; break;
+      case T::kGlExp2: s << "    return exp(-(q.x * d) * (q.x * d));\n"; break;
+      case T::kDistanceExp2: s << "    return exp(-q.x * d * d);  // seed 003 eqn 1\n"; break;
+      case T::kDistanceGaussian: s << "    return q.y * exp(-q.x * d * d);  // seed 003 eqn 2\n"; break;
+      case T::kHeight:
+        // q = (log a, b, h, a > 0): tau = a e^{-b(oy-h)} t g(b dirY t) in log space.
+        s << "    if (q.w < 0.5 || d == 0.0) return 1.0;\n"
+             "    if (q.y == 0.0) return exp(-exp(min(q.x + log(d), 80.0)));\n"
+             "    float logTau = q.x - q.y * (uFogCamera.y - q.z) + log(d) + fogLogG(q.y * (ray.y / d) * d);\n"
+             "    return exp(-exp(min(logTau, 80.0)));\n";
+        break;
+    }
+    s << "  }\n";
+  }
+  s << "  return 1.0;\n}\n";
+  s << "int fogSlot(vec3 p) {\n";
+  if (v.regions)
+    s << "  for (int i = 0; i < " << v.regions << "; ++i) {\n"
+      << "    vec4 lo = uRegionLo[i], hi = uRegionHi[i];\n"
+      << "    bool inside = lo.w < 0.5 ? all(greaterThanEqual(p, lo.xyz)) && all(lessThanEqual(p, hi.xyz))\n"
+      << "                             : dot(p - lo.xyz, p - lo.xyz) <= hi.x * hi.x;\n"
+      << "    if (inside) return i + 1;\n  }\n";
+  s << "  return 0;\n}\n"
+       "vec3 applyFog(vec3 rgb, vec3 world) {\n"
+       "  int slot = fogSlot(world);\n"
+       "  return mix(uFogColor[slot], rgb, fogFactor(slot, world));\n}\n";
+  return s.str();
+}
+
+std::string backgroundGlsl(Background::Kind kind) {
+  switch (kind) {
+    case Background::Kind::kColor: return "uniform vec4 uColor;\nvec4 backgroundAt(vec2 uv) { return uColor; }\n";
+    case Background::Kind::kGradient:
+      return "uniform vec4 uTop;\nuniform vec4 uBottom;\n"
+             "vec4 backgroundAt(vec2 uv) { return mix(uBottom, uTop, clamp(uv.y, 0.0, 1.0)); }\n";
+    case Background::Kind::kImage:
+      return "uniform sampler2D uImage;  // premultiplied, row 0 = top\n"
+             "vec4 backgroundAt(vec2 uv) { return texture(uImage, vec2(uv.x, 1.0 - uv.y)); }\n";
+  }
+  return "";
+}
+
+std::string screenVertex() {
+  return std::string(kVertexHeader) +
+         "out vec2 vUv;\n"
+         "void main() {  // one triangle over the whole target\n"
+         "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+         "  vUv = 0.5 * p + 0.5;\n"
+         "  gl_Position = vec4(p, 1.0, 1.0);\n}\n";
+}
+
+std::string backgroundFragment(Background::Kind kind) {
+  return std::string(kFragmentHeader) + "in vec2 vUv;\nout vec4 fragColor;\n" + backgroundGlsl(kind) +
+         "void main() { fragColor = backgroundAt(vUv); }\n";
+}
+
+std::string environmentFragment(Background::Kind kind) {
+  // GL cube-map face conventions: (s, t) in [-1, 1] on the face -> direction.
+  return std::string(kFragmentHeader) + "in vec2 vUv;\nout vec4 fragColor;\n" + backgroundGlsl(kind) +
+         "uniform int uFace;\n"
+         "uniform mat3 uView;        // world -> view rotation\n"
+         "uniform vec2 uTanHalfFov;  // x: horizontal, y: vertical\n"
+         "void main() {\n"
+         "  float s = 2.0 * vUv.x - 1.0, t = 2.0 * vUv.y - 1.0;\n"
+         "  vec3 dir = uFace == 0 ? vec3(1.0, -t, -s) : uFace == 1 ? vec3(-1.0, -t, s)\n"
+         "           : uFace == 2 ? vec3(s, 1.0, t) : uFace == 3 ? vec3(s, -1.0, -t)\n"
+         "           : uFace == 4 ? vec3(s, -t, 1.0) : vec3(-s, -t, -1.0);\n"
+         "  vec3 v = uView * normalize(dir);\n"
+         "  v.z = -abs(v.z);  // behind the camera: the backdrop's mirror image\n"
+         "  vec2 ndc = v.xy / max(-v.z, 1e-6) / uTanHalfFov;\n"
+         "  fragColor = backgroundAt(clamp(0.5 * ndc + 0.5, 0.0, 1.0));\n"
+         "}\n";
+}
+
+std::string waveVertex() {
+  return std::string(kVertexHeader) +
+         "layout(location = 0) in vec2 aPosition;  // NDC\n"
+         "layout(location = 1) in vec2 aUv;\n"
+         "layout(location = 2) in vec3 aNormal;\n"
+         "layout(location = 3) in vec4 aTangent;  // MikkTSpace, w = handedness\n"
+         "out vec2 vUv;\nout vec3 vNormal;\nout vec4 vTangent;\n"
+         "void main() {\n  vUv = aUv;\n  vNormal = aNormal;\n  vTangent = aTangent;\n"
+         "  gl_Position = vec4(aPosition, 1.0, 1.0);\n}\n";
+}
+
+std::string waveFragment() {
+  return std::string(kFragmentHeader) +
+         "in vec2 vUv;\nin vec3 vNormal;\nin vec4 vTangent;\nout vec4 fragColor;\n"
+         "uniform sampler2D uNormalA;\nuniform sampler2D uNormalB;\nuniform sampler2D uAlpha;\n"
+         "uniform vec2 uOffsetA;  // scroll offsets, reduced modulo 1 on the CPU\n"
+         "uniform vec2 uOffsetB;\n"
+         "uniform float uScale;\nuniform float uStrength;\nuniform vec3 uLightColor;\nuniform vec3 uLight;\n"
+         "void main() {\n"
+         "  vec3 a = texture(uNormalA, vUv * uScale + uOffsetA).xyz * 2.0 - 1.0;\n"
+         "  vec3 b = texture(uNormalB, vUv * uScale * 0.73 + uOffsetB).xyz * 2.0 - 1.0;\n"
+         "  vec3 nt = normalize(vec3(a.xy + b.xy, a.z * b.z));  // the two maps combined (whiteout)\n"
+         "  vec3 N = normalize(vNormal);\n"
+         "  vec3 T = normalize(vTangent.xyz - N * dot(N, vTangent.xyz));\n"
+         "  vec3 B = vTangent.w * cross(N, T);\n"
+         "  vec3 n = normalize(mat3(T, B, N) * nt);  // seed 004: [r g b] [T; B; N]\n"
+         "  float light = pow(max(dot(n, normalize(uLight)), 0.0), 24.0);\n"
+         "  float alpha = texture(uAlpha, vUv * 0.5 + 0.5 * uOffsetB).r;\n"
+         "  fragColor = vec4(uLightColor * (uStrength * light * alpha), 0.0);  // added to the backdrop\n"
+         "}\n";
+}
+
+std::string quadVertex() {
+  return std::string(kVertexHeader) +
+         "layout(location = 0) in vec3 aPosition;\nlayout(location = 1) in vec3 aColor;\n"
+         "uniform mat4 uViewProjection;\nout vec3 vWorld;\nout vec3 vColor;\n"
+         "void main() {\n  vWorld = aPosition;\n  vColor = aColor;\n"
+         "  gl_Position = uViewProjection * vec4(aPosition, 1.0);\n}\n";
+}
+
+std::string quadFragment(const FogVariant* fog) {
+  std::string s = std::string(kFragmentHeader) + "in vec3 vWorld;\nin vec3 vColor;\nout vec4 fragColor;\n";
+  if (fog) s += fogGlsl(*fog);
+  s += "void main() {\n  vec3 c = vColor;\n";
+  if (fog) s += "  c = applyFog(c, vWorld);\n";
+  return s + "  fragColor = vec4(c, 1.0);\n}\n";
+}
+
+std::string boltVertex() {
+  return std::string(kVertexHeader) +
+         "layout(location = 0) in vec2 aPixel;\n"
+         "layout(location = 1) in vec3 aLine;  // x: intensity, y: signed distance across (px), z: half width\n"
+         "uniform vec2 uSize;\nout vec3 vLine;\n"
+         "void main() {\n  vLine = aLine;\n"
+         "  gl_Position = vec4(2.0 * aPixel.x / uSize.x - 1.0, 1.0 - 2.0 * aPixel.y / uSize.y, 0.0, 1.0);\n}\n";
+}
+
+std::string boltFragment() {
+  return std::string(kFragmentHeader) +
+         "in vec3 vLine;\nout vec4 fragColor;\n"
+         "void main() {  // a one-pixel anti-aliased edge\n"
+         "  float cover = clamp(vLine.z + 0.5 - abs(vLine.y), 0.0, 1.0);\n"
+         "  fragColor = vec4(vec3(vLine.x * cover), cover);\n}\n";
+}
+
+std::string blurFragment() {
+  return std::string(kFragmentHeader) +
+         "uniform sampler2D uSource;\n"
+         "uniform ivec2 uStep;        // (1, 0) horizontal, (0, 1) vertical\n"
+         "uniform int uRadius;\n"
+         "uniform float uWeights[65];  // normalised Gaussian, centre first\n"
+         "out vec4 fragColor;\n"
+         "void main() {\n"
+         "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+         "  ivec2 last = textureSize(uSource, 0) - 1;\n"
+         "  vec4 sum = uWeights[0] * texelFetch(uSource, p, 0);\n"
+         "  for (int i = 1; i <= uRadius; ++i) {\n"
+         "    sum += uWeights[i] * (texelFetch(uSource, clamp(p + i * uStep, ivec2(0), last), 0) +\n"
+         "                          texelFetch(uSource, clamp(p - i * uStep, ivec2(0), last), 0));\n"
+         "  }\n"
+         "  fragColor = sum;\n}\n";
+}
+
+std::string compositeFragment(bool glow) {
+  std::string s = std::string(kFragmentHeader) + "uniform sampler2D uCore;\n";
+  if (glow) s += "uniform sampler2D uGlow;\nuniform float uGlowStrength;\n";
+  s += "uniform vec3 uColor;\nout vec4 fragColor;\n"
+       "void main() {  // added over the scene\n"
+       "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+       "  float light = texelFetch(uCore, p, 0).r;\n";
+  if (glow) s += "  light += uGlowStrength * texelFetch(uGlow, p, 0).r;\n";
+  return s + "  fragColor = vec4(uColor * light, min(light, 1.0));\n}\n";
+}
+
+std::string blendFragment() {
+  return std::string(kFragmentHeader) +
+         "uniform vec3 uColor;\nuniform float uAmount;\nout vec4 fragColor;\n"
+         "void main() { fragColor = vec4(uColor * uAmount, uAmount); }  // eqn 12 via blending\n";
+}
+
+}  // namespace effects::render::detail

@@ -1,0 +1,212 @@
+// render/render.h — headless previews of effectd scenes through EGL + OpenGL ES 3.
+//
+// A Scene holds the effect data the effects library computed (lightning polylines, fog
+// definitions, the bubble's mesh and parameters) plus a camera and a background. Passes are
+// built only for what the scene contains, from shader variants composed per feature set and
+// cached per context: a scene without lightning runs no blur pass, a scene without fog has
+// no fog code in any shader. Frame::passes and Frame::variantsCompiled say what ran.
+//
+// Colours are written as given (no sRGB transfer is applied): the fog colours in a render
+// are the numbers /v1/fog's tables give. Internally colours are premultiplied by alpha; the
+// output is straight alpha, rows top to bottom.
+//
+// Contexts: EGL_EXT_platform_device is preferred (it lists GPUs when there are any); Mesa's
+// surfaceless platform is the fallback (llvmpipe on machines without a GPU). The environment
+// variable EFFECTD_EGL_PLATFORM=device|surfaceless forces one. A Renderer's context is bound
+// to the thread that created it; RenderPool owns one Renderer per worker thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <effects/bubble.h>
+#include <effects/common.h>
+#include <effects/fog.h>
+#include <effects/lightning.h>
+
+namespace effects::render {
+
+// Straight-alpha RGBA, rows top to bottom, float in [0, 1].
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgba;
+};
+
+struct Camera {
+  glm::dvec3 position{0, 1, 6}, target{0, 0.5, 0}, up{0, 1, 0};
+  double fovYDeg = 45, nearPlane = 0.05, farPlane = 1000;
+};
+
+// The backdrop as a function of view direction: a direction in front of the camera maps to
+// the screen point it projects to, one behind it to the mirror image. So the image fills the
+// screen exactly, and the bubble's environment lookups see the same backdrop.
+struct Background {
+  enum class Kind { kColor, kGradient, kImage } kind = Kind::kColor;
+  glm::dvec4 color{0.02, 0.03, 0.05, 1};
+  glm::dvec4 top{0.25, 0.45, 0.8, 1}, bottom{0.85, 0.9, 0.95, 1};  // gradient, screen top -> bottom
+  Image image;
+};
+
+// Seed 000 section 2.2: a quad in front of the backdrop with two normal maps scrolling in
+// different directions, lit through the quad's MikkTSpace TBN frame (seed 004), and an alpha
+// texture: "sunlight under water".
+struct SurfaceWave {
+  double strength = 0.35;   // brightness of the ripple highlights
+  double scale = 3;         // normal-map repeats across the quad
+  double speed = 0.03;      // uv units per second
+  glm::dvec3 lightColor{1.0, 0.97, 0.85};
+  glm::dvec3 lightDirection{0.2, 0.6, 1.0};  // in the quad's tangent space, towards the light
+};
+
+// Seed 000 eqn 12: renderTex = lerp(renderTex, blend, epsilon), last pass over the frame.
+struct CameraBlend {
+  glm::dvec3 color{0, 0, 0};
+  double amount = 0;  // epsilon in [0, 1]
+};
+
+// An opaque rectangle in the world (a wall, a floor): geometry for fog to act on.
+struct Quad {
+  glm::dvec3 center{0, 0, 0}, normal{0, 0, 1}, up{0, 1, 0};
+  glm::dvec2 size{1, 1};
+  glm::dvec3 color{0.5, 0.5, 0.5};
+};
+
+// Seed 002 section 3.3: the bolt into its own framebuffer (main channel twice as wide,
+// branches dimmer), a separable Gaussian blur (horizontal, then vertical), added over the scene.
+// The grid maps onto `rect` = (x0, y0, x1, y1) in image fractions, y down like the grid.
+struct Lightning {
+  std::vector<lightning::Polyline> polylines;
+  int gridWidth = 0, gridHeight = 0;
+  glm::dvec4 rect{0, 0, 1, 1};
+  glm::dvec3 color{0.75, 0.85, 1.0};
+  double coreWidth = 1.5;     // pixels per unit of polyline width (main 2, branch 1)
+  double glowSigma = 6;       // Gaussian sigma in pixels; 0 = no glow (no blur pass)
+  double glowStrength = 1.5;
+};
+
+struct Fog {
+  fog::Fog global;
+  std::vector<fog::Region> regions;  // at most kMaxFogRegions
+};
+inline constexpr size_t kMaxFogRegions = 16;
+
+// Seed 000's bubble with effectd's shader (bubble::shader) for `features`; wobble runs in
+// the vertex shader, so the mesh is the undisturbed icosphere of `radius` around `center`.
+struct Bubble {
+  bubble::Params params;
+  bubble::Features features;
+  bubble::Mesh mesh;
+  glm::dvec3 center{0, 0, 0};
+  double time = 0;              // seconds (eqns 3, 9, 11)
+  glm::dvec4 baseColor{1, 1, 1, 1};
+  std::vector<float> thinFilm;  // iridescence: RGB table (bubble::ThinFilmTable::rgb)
+  int thinFilmWidth = 0, thinFilmHeight = 0;
+  Image flowTexture;            // eqn 9's texture; empty = a generated soft swirl
+};
+
+struct Scene {
+  int width = 512, height = 512;
+  int bitDepth = 8;  // PNG bits per channel: 8 or 16
+  double time = 0;
+  Camera camera;
+  Background background;
+  std::optional<SurfaceWave> wave;
+  std::vector<Quad> quads;
+  std::optional<Fog> fog;
+  std::optional<Bubble> bubble;
+  std::optional<Lightning> lightning;
+  std::optional<CameraBlend> blend;
+};
+
+struct Frame {
+  int width = 0, height = 0, bitDepth = 8;
+  Image image;
+  std::vector<std::string> passes;  // in the order they ran
+  int variantsCompiled = 0;         // shader programs compiled for this frame (0 when all cached)
+  int variantsCached = 0;           // programs in this context's cache afterwards
+  double ms = 0;                    // GPU work including read-back
+};
+
+// Which EGL platform to use: "auto" (device, then surfaceless), "device" or "surfaceless".
+// Empty = the EFFECTD_EGL_PLATFORM environment variable, else "auto".
+class Renderer {
+ public:
+  static Result<std::unique_ptr<Renderer>> create(const std::string& platform = "");
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Call on the creating thread only.
+  Result<Frame> render(const Scene& scene);
+  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless"
+  const std::string& description() const;
+  int maxTextureSize() const;
+
+ private:
+  Renderer();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// PNG bytes of `frame` (8 or 16 bits per channel, straight alpha) via OpenImageIO.
+Result<std::string> encodePng(const Image& image, int bitDepth);
+// Decodes PNG/JPEG/anything OpenImageIO reads from memory into straight-alpha RGBA float.
+// Images with more than maxPixels pixels are refused before their pixels are decoded.
+Result<Image> decodeImage(const std::string& bytes, size_t maxPixels);
+
+// A fixed pool of render threads, one Renderer each, fed by a bounded queue.
+struct PoolOptions {
+  int threads = 2;
+  int queue = 8;          // waiting jobs beyond the running ones
+  std::string platform;   // as for Renderer::create
+};
+
+class RenderPool {
+ public:
+  explicit RenderPool(PoolOptions options);
+  ~RenderPool();  // finishes queued jobs, joins the threads
+  RenderPool(const RenderPool&) = delete;
+  RenderPool& operator=(const RenderPool&) = delete;
+
+  // nullopt when the queue is full (the caller answers 503 + Retry-After).
+  std::optional<std::future<Result<Frame>>> submit(Scene scene);
+  // Starts the threads if they are not running and waits for the first context; "" when
+  // every context could be created, otherwise why not.
+  std::string start();
+  std::string description();  // the renderer, once started
+  int peakBusy() const { return peakBusy_.load(); }
+  int threads() const { return options_.threads; }
+  int queued();
+
+ private:
+  void worker(int index);
+  struct Job {
+    Scene scene;
+    std::promise<Result<Frame>> done;
+  };
+  PoolOptions options_;
+  std::mutex mu_;
+  std::condition_variable wake_, ready_;
+  std::deque<Job> jobs_;
+  std::vector<std::thread> workers_;
+  int started_ = 0;  // workers that finished creating their context (or failed)
+  std::string startError_, description_;
+  bool stopping_ = false;
+  std::atomic<int> busy_{0}, peakBusy_{0};
+};
+
+}  // namespace effects::render

@@ -1,0 +1,50 @@
+// Pieces of the renderer that are not its public interface: EGL contexts and GLSL text.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "render/render.h"
+
+namespace effects::render::detail {
+
+// ---- EGL -------------------------------------------------------------------------------
+struct EglContext {
+  void* display = nullptr;
+  void* context = nullptr;
+  std::string platform;  // "device" or "surfaceless"
+};
+// Creates an OpenGL ES 3 context without any surface and makes it current on this thread.
+Result<EglContext> createContext(const std::string& platform);
+void destroyContext(EglContext& c);
+
+// ---- GLSL (OpenGL ES 3.00) ---------------------------------------------------------------
+inline constexpr const char* kFragmentHeader = "#version 300 es\nprecision highp float;\nprecision highp int;\n";
+inline constexpr const char* kVertexHeader = "#version 300 es\n";
+
+// Fog: the same formulas as effects::fog::factor, per fragment, for the fog types the scene
+// uses (slot 0 = global fog, slots 1..R = regions sorted by volume so that the first one
+// containing a point is the one regionAt() picks). Defines vec3 applyFog(vec3 rgb, vec3 world).
+struct FogVariant {
+  std::vector<fog::FogType> types;  // distinct, sorted
+  size_t regions = 0;
+  std::string key() const;
+};
+FogVariant fogVariant(const Fog& fog);
+std::string fogGlsl(const FogVariant& v);
+
+std::string backgroundGlsl(Background::Kind kind);  // vec4 backgroundAt(vec2 uv) (premultiplied)
+std::string screenVertex();                          // full-screen triangle, no attributes
+std::string backgroundFragment(Background::Kind kind);
+std::string environmentFragment(Background::Kind kind);  // one cube face: direction -> backdrop
+std::string waveVertex();
+std::string waveFragment();
+std::string quadVertex();
+std::string quadFragment(const FogVariant* fog);
+std::string boltVertex();
+std::string boltFragment();
+std::string blurFragment();
+std::string compositeFragment(bool glow);
+std::string blendFragment();
+
+}  // namespace effects::render::detail

@@ -1,0 +1,267 @@
+// POST /v1/render (scene -> image/png) and POST /v1/scene (scene -> each effect's JSON).
+#include <glm/geometric.hpp>
+
+#include <effects/bubble.h>
+
+#include "codec.h"
+#include "endpoints.h"
+#include "scene.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace rd = effects::render;
+namespace bb = effects::bubble;
+
+// Runs `f`, re-rooting the pointers of any problem it throws under `prefix`.
+template <class F>
+auto within(const std::string& prefix, F&& f) {
+  try {
+    return f();
+  } catch (ApiError e) {
+    for (auto& v : e.errors) v.pointer = prefix + v.pointer;
+    e.detail = (e.detail.rfind("/", 0) == 0 ? prefix : prefix + ": ") + e.detail;
+    throw e;
+  }
+}
+
+glm::dvec4 rgba(const json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j.size() > 3 ? j[3].get<double>() : 1.0}; }
+
+rd::Image image(const json& base64, const std::string& pointer, const Config& config) {
+  auto bytes = base64Decode(base64.get<std::string>());
+  if (!bytes)
+    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": is not valid base64",
+                   {{pointer, "is not valid base64 (standard alphabet, padded)"}}, {}};
+  auto decoded = rd::decodeImage(*bytes, config.limits.maxRenderPixels);
+  if (!decoded.ok()) {
+    effects::Error e = decoded.error();
+    if (e.kind == effects::ErrorKind::kLimitExceeded) e.message += " (--max-render-pixels)";
+    throwError(e, pointer);
+  }
+  return std::move(decoded.value());
+}
+
+void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
+  if (v.x == 0 && v.y == 0 && v.z == 0)
+    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": must not be the zero vector",
+                   {{pointer, "must not be the zero vector"}}, {}};
+}
+
+}  // namespace
+
+rd::Scene buildScene(const json& body, const Config& config, double* computeMs) {
+  effects::Stopwatch watch;
+  rd::Scene s;
+  s.width = body.value("width", 512);
+  s.height = body.value("height", 512);
+  if (size_t(s.width) * size_t(s.height) > config.limits.maxRenderPixels)
+    throw ApiError{413, "limit-exceeded", "Request exceeds a configured limit",
+                   "/width: " + std::to_string(s.width) + "x" + std::to_string(s.height) + " exceeds the limit of " +
+                       std::to_string(config.limits.maxRenderPixels) + " pixels (--max-render-pixels)",
+                   {{"/width", "width*height exceeds the limit of " + std::to_string(config.limits.maxRenderPixels) + " pixels"}},
+                   {}};
+  s.bitDepth = body.value("bitDepth", 8);
+  s.time = body.value("time", 0.0);
+
+  const json cam = body.value("camera", json::object());
+  if (cam.contains("position")) s.camera.position = toVec3(cam["position"]);
+  if (cam.contains("target")) s.camera.target = toVec3(cam["target"]);
+  if (cam.contains("up")) s.camera.up = toVec3(cam["up"]);
+  s.camera.fovYDeg = cam.value("fovY", s.camera.fovYDeg);
+  s.camera.nearPlane = cam.value("near", s.camera.nearPlane);
+  s.camera.farPlane = cam.value("far", s.camera.farPlane);
+  const glm::dvec3 forward = s.camera.target - s.camera.position;
+  if (glm::length(forward) < 1e-12)
+    throw ApiError{400, "invalid-field", "Invalid field", "/camera/target: must differ from the camera position",
+                   {{"/camera/target", "must differ from the camera position"}}, {}};
+  if (glm::length(glm::cross(forward, s.camera.up)) < 1e-12 * glm::length(forward) * glm::length(s.camera.up))
+    throw ApiError{400, "invalid-field", "Invalid field", "/camera/up: must not be parallel to the view direction",
+                   {{"/camera/up", "must not be parallel to the view direction (or zero)"}}, {}};
+  if (!(s.camera.farPlane > s.camera.nearPlane))
+    throw ApiError{400, "invalid-field", "Invalid field", "/camera/far: must be greater than near",
+                   {{"/camera/far", "must be greater than near"}}, {}};
+
+  if (body.contains("background")) {
+    const json& b = body["background"];
+    if (b.contains("color")) s.background.color = rgba(b["color"]);
+    if (b.contains("gradient")) {
+      s.background.kind = rd::Background::Kind::kGradient;
+      s.background.top = rgba(b["gradient"]["top"]);
+      s.background.bottom = rgba(b["gradient"]["bottom"]);
+    }
+    if (b.contains("image")) {
+      s.background.kind = rd::Background::Kind::kImage;
+      s.background.image = image(b["image"], "/background/image", config);
+    }
+  }
+  if (body.contains("surfaceWave")) {
+    const json& w = body["surfaceWave"];
+    rd::SurfaceWave wave;
+    wave.strength = w.value("strength", wave.strength);
+    wave.scale = w.value("scale", wave.scale);
+    wave.speed = w.value("speed", wave.speed);
+    if (w.contains("lightColor")) wave.lightColor = toVec3(w["lightColor"]);
+    if (w.contains("lightDirection")) wave.lightDirection = toVec3(w["lightDirection"]);
+    requireNonZero(wave.lightDirection, "/surfaceWave/lightDirection");
+    s.wave = wave;
+  }
+  if (body.contains("cameraBlend"))
+    s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
+  if (body.contains("quads")) {
+    for (size_t i = 0; i < body["quads"].size(); ++i) {
+      const json& q = body["quads"][i];
+      rd::Quad quad;
+      quad.center = toVec3(q["center"]);
+      if (q.contains("normal")) quad.normal = toVec3(q["normal"]);
+      if (q.contains("up")) quad.up = toVec3(q["up"]);
+      requireNonZero(quad.normal, "/quads/" + std::to_string(i) + "/normal");
+      quad.size = {q["size"][0].get<double>(), q["size"][1].get<double>()};
+      if (q.contains("color")) quad.color = toVec3(q["color"]);
+      s.quads.push_back(quad);
+    }
+  }
+  if (body.contains("fog")) {
+    within("/fog", [&] {
+      const json& f = body["fog"];
+      rd::Fog fog;
+      fog.global = parseFog(f["fog"], "/fog");
+      if (f.contains("regions")) {
+        if (f["regions"].size() > rd::kMaxFogRegions)
+          throw ApiError{422, "invalid-field", "Invalid field", "/regions: a rendered scene takes at most 16 fog regions",
+                         {{"/regions", "a rendered scene takes at most 16 fog regions"}}, {}};
+        for (size_t i = 0; i < f["regions"].size(); ++i)
+          fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
+      }
+      s.fog = std::move(fog);
+      return 0;
+    });
+  }
+  if (body.contains("lightning")) {
+    within("/lightning", [&] {
+      LightningRequest r = parseLightning(body["lightning"], config);
+      const effects::lightning::Bolt bolt = growBolt(r.params);
+      rd::Lightning l;
+      l.polylines = effects::lightning::polylines(bolt, r.shape);
+      l.gridWidth = r.params.width;
+      l.gridHeight = r.params.height;
+      s.lightning = std::move(l);
+      return 0;
+    });
+    const json st = body.value("lightningStyle", json::object());
+    if (st.contains("rect")) {
+      const json& r = st["rect"];
+      s.lightning->rect = {r[0].get<double>(), r[1].get<double>(), r[2].get<double>(), r[3].get<double>()};
+    }
+    if (st.contains("color")) s.lightning->color = toVec3(st["color"]);
+    s.lightning->coreWidth = st.value("coreWidth", s.lightning->coreWidth);
+    s.lightning->glowSigma = st.value("glowSigma", s.lightning->glowSigma);
+    s.lightning->glowStrength = st.value("glowStrength", s.lightning->glowStrength);
+  }
+  if (body.contains("bubble")) {
+    rd::Bubble b;
+    const json& bj = body["bubble"];
+    const double t = bj.value("time", s.time);
+    within("/bubble", [&] {
+      b.params = parseBubbleParams(bj.value("params", json::object()));
+      b.features = parseBubbleFeatures(bj.value("features", json::object()));
+      bb::MeshOptions o;
+      const json m = bj.value("mesh", json::object());
+      o.level = m.value("level", 4);
+      o.maxLevel = 7;
+      o.radius = m.value("radius", 1.0);
+      o.wobble = false;  // the vertex shader wobbles (eqn 11)
+      auto mesh = bb::icosphere(b.params, o);
+      if (!mesh.ok()) {
+        effects::Error e = mesh.error();
+        throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
+      }
+      b.mesh = std::move(mesh.value());
+      if (b.features.iridescence) {
+        bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params);
+        tf.measureError = false;
+        auto table = bb::thinFilmTable(tf);
+        if (!table.ok()) throwError(table.error(), "/thinFilm");
+        b.thinFilm = std::move(table.value().rgb);
+        b.thinFilmWidth = table.value().width;
+        b.thinFilmHeight = table.value().height;
+      }
+      if (bj.contains("motion")) {
+        const json& mo = bj["motion"];
+        b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
+      }
+      return 0;
+    });
+    const json st = body.value("bubbleStyle", json::object());
+    if (st.contains("center") && !bj.contains("motion")) b.center = toVec3(st["center"]);
+    if (st.contains("baseColor")) b.baseColor = rgba(st["baseColor"]);
+    if (st.contains("flowTexture")) b.flowTexture = image(st["flowTexture"], "/bubbleStyle/flowTexture", config);
+    b.time = t;
+    s.bubble = std::move(b);
+  }
+  if (computeMs) *computeMs = watch.ms();
+  return s;
+}
+
+namespace {
+
+JsonReply handleScene(const json& body, const RequestContext& ctx) {
+  JsonReply reply;
+  reply.method = "scene";
+  json out = json::object();
+  auto add = [&](const char* name, JsonReply (*handler)(const json&, const RequestContext&)) {
+    if (!body.contains(name)) return;
+    JsonReply r = within(std::string("/") + name, [&] { return handler(body[name], ctx); });
+    out[name] = std::move(r.body);
+    reply.computeMs += r.computeMs;
+  };
+  add("lightning", handleLightning);
+  add("fog", handleFog);
+  add("bubble", handleBubble);
+  reply.body = std::move(out);
+  return reply;
+}
+
+}  // namespace
+
+void addRenderEndpoints(Service& service) {
+  const Config& config = service.config();
+  auto pool = std::make_shared<rd::RenderPool>(rd::PoolOptions{config.renderThreads, config.renderQueue, config.eglPlatform});
+  service.addReadinessCheck("renderer", [pool] { return pool->start(); });
+  service.addReadinessInfo("renderer", [pool] { return pool->description(); });
+  service.addJsonEndpoint("/v1/scene", "scene.json", handleScene);
+  Metrics* metrics = &service.metrics();
+  service.addJsonEndpoint("/v1/render", "scene.json", [pool, metrics](const json& body, const RequestContext& ctx) {
+    JsonReply reply;
+    reply.method = "render";
+    rd::Scene scene = buildScene(body, ctx.config, &reply.computeMs);
+    const int bitDepth = scene.bitDepth;
+    auto job = pool->submit(std::move(scene));
+    if (!job)
+      throw ApiError{503, "render-queue-full", "Render queue full",
+                     "every render thread is busy and the queue is full; retry shortly (--render-queue)", {},
+                     {{"Retry-After", "1"}}};
+    auto frame = job->get();
+    if (!frame.ok()) throwError(frame.error());
+    const rd::Frame& f = frame.value();
+    effects::Stopwatch encode;
+    auto png = rd::encodePng(f.image, bitDepth);
+    if (!png.ok()) throwError(png.error());
+    std::string passes;
+    for (const auto& p : f.passes) {
+      passes += (passes.empty() ? "" : ",") + p;
+      metrics->count("render_passes", p);
+    }
+    metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
+    reply.computeMs += f.ms + encode.ms();
+    reply.binary = std::move(png.value());
+    reply.contentType = "image/png";
+    reply.headers = {{"X-Renderer", pool->description()},
+                     {"X-Render-Passes", passes},
+                     {"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
+                     {"X-Render-Ms", std::to_string(f.ms)}};
+    return reply;
+  });
+}
+
+}  // namespace effectd
