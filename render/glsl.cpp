@@ -191,20 +191,20 @@ std::string boltFragment() {
 }
 
 std::string blurFragment() {
+  // Runs at half resolution: the glow is low-frequency. Samples sit on half-resolution texel
+  // centres, so bilinear filtering of a full-resolution source averages 2x2 texels for free.
   return std::string(kFragmentHeader) +
          "uniform sampler2D uSource;\n"
-         "uniform ivec2 uStep;        // (1, 0) horizontal, (0, 1) vertical\n"
+         "uniform vec2 uStep;          // one half-resolution texel along the blur axis, in uv\n"
+         "uniform vec2 uTargetSize;\n"
          "uniform int uRadius;\n"
          "uniform float uWeights[65];  // normalised Gaussian, centre first\n"
          "out vec4 fragColor;\n"
          "void main() {\n"
-         "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
-         "  ivec2 last = textureSize(uSource, 0) - 1;\n"
-         "  vec4 sum = uWeights[0] * texelFetch(uSource, p, 0);\n"
-         "  for (int i = 1; i <= uRadius; ++i) {\n"
-         "    sum += uWeights[i] * (texelFetch(uSource, clamp(p + i * uStep, ivec2(0), last), 0) +\n"
-         "                          texelFetch(uSource, clamp(p - i * uStep, ivec2(0), last), 0));\n"
-         "  }\n"
+         "  vec2 uv = gl_FragCoord.xy / uTargetSize;\n"
+         "  vec4 sum = uWeights[0] * texture(uSource, uv);\n"
+         "  for (int i = 1; i <= uRadius; ++i)\n"
+         "    sum += uWeights[i] * (texture(uSource, uv + float(i) * uStep) + texture(uSource, uv - float(i) * uStep));\n"
          "  fragColor = sum;\n}\n";
 }
 
@@ -215,7 +215,7 @@ std::string compositeFragment(bool glow) {
        "void main() {  // added over the scene\n"
        "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
        "  float light = texelFetch(uCore, p, 0).r;\n";
-  if (glow) s += "  light += uGlowStrength * texelFetch(uGlow, p, 0).r;\n";
+  if (glow) s += "  light += uGlowStrength * texture(uGlow, gl_FragCoord.xy / vec2(textureSize(uCore, 0))).r;  // upsampled\n";
   return s + "  fragColor = vec4(uColor * light, min(light, 1.0));\n}\n";
 }
 

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include "render/render.h"
 
@@ -27,7 +28,7 @@ Result<std::string> encodePng(const Image& image, int bitDepth) {
 Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const char* name = nullptr;
-  if (bytes.size() >= 8 && std::equal(data, data + 8, "\x89PNG\r\n\x1a\n"))
+  if (bytes.size() >= 8 && std::memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0)
     name = "image.png";
   else if (bytes.size() >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF)
     name = "image.jpg";
@@ -37,7 +38,7 @@ Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
     OIIO::Filesystem::IOMemReader proxy(data, bytes.size());
     auto in = OIIO::ImageInput::create(name, false, nullptr, &proxy);
     OIIO::ImageSpec spec;
-    if (!in || !in->open(name, spec)) return invalid("", "cannot be decoded: " + (in ? in->geterror() : std::string("no reader")));
+    if (!in || !in->set_ioproxy(&proxy) || !in->open(name, spec)) return invalid("", "cannot be decoded: " + (in ? in->geterror() : std::string("no reader")));
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
       return invalid("", "has no usable pixels");
     const size_t pixels = size_t(spec.width) * size_t(spec.height);

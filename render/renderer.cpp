@@ -622,27 +622,30 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
     const bool glow = l.glowSigma > 0 && l.glowStrength > 0;
     Target blurred, glowTarget;
     if (glow) {
+      // Separable Gaussian at half resolution (sigma in half-resolution pixels).
       TRY(p, program("blur", screenVertex(), blurFragment()));
       glUseProgram(p.id);
-      const int radius = std::min(kMaxBlurRadius, int(std::ceil(3 * l.glowSigma)));
+      const double sigma = l.glowSigma / 2;
+      const int radius = std::min(kMaxBlurRadius, int(std::ceil(3 * sigma)));
       std::vector<float> w(size_t(radius) + 1);
       double sum = 0;
-      for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * l.glowSigma * l.glowSigma))));
+      for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * sigma * sigma))));
       for (float& x : w) x = float(x / sum);
       glUniform1fv(p.at("uWeights[0]"), GLsizei(w.size()), w.data());
       p.set("uRadius", radius);
       p.set("uSource", 0);
-      if (!blurred.create(scene.width, scene.height, GL_RGBA16F, false) ||
-          !glowTarget.create(scene.width, scene.height, GL_RGBA16F, false))
+      const int hw = (scene.width + 1) / 2, hh = (scene.height + 1) / 2;
+      if (!blurred.create(hw, hh, GL_RGBA16F, false) || !glowTarget.create(hw, hh, GL_RGBA16F, false))
         return unsatisfiable("/renderer", "the glow buffers cannot be created");
+      p.set("uTargetSize", glm::vec2(hw, hh));
       blurred.use();
       core.color.bind(0);
-      glUniform2i(p.at("uStep"), 1, 0);
+      p.set("uStep", glm::vec2(1.0f / float(hw), 0));
       glDrawArrays(GL_TRIANGLES, 0, 3);
       frame.passes.push_back("blurHorizontal");
       glowTarget.use();
       blurred.color.bind(0);
-      glUniform2i(p.at("uStep"), 0, 1);
+      p.set("uStep", glm::vec2(0, 1.0f / float(hh)));
       glDrawArrays(GL_TRIANGLES, 0, 3);
       frame.passes.push_back("blurVertical");
     }

@@ -1,4 +1,8 @@
 // POST /v1/render (scene -> image/png) and POST /v1/scene (scene -> each effect's JSON).
+#include <map>
+#include <memory>
+#include <mutex>
+
 #include <glm/geometric.hpp>
 
 #include <effects/bubble.h>
@@ -40,6 +44,25 @@ rd::Image image(const json& base64, const std::string& pointer, const Config& co
     throwError(e, pointer);
   }
   return std::move(decoded.value());
+}
+
+// Thin-film tables are deterministic in their options and cost tens of milliseconds: renders
+// share them through a small process-wide cache.
+std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOptions& o) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<const bb::ThinFilmTable>> cache;
+  const std::string key = json{o.ior, o.thicknessMinNm, o.thicknessMaxNm, o.width, o.height, o.wavelengths}.dump();
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+  }
+  auto table = bb::thinFilmTable(o);
+  if (!table.ok()) throwError(table.error(), "/thinFilm");
+  auto shared = std::make_shared<const bb::ThinFilmTable>(std::move(table.value()));
+  std::lock_guard<std::mutex> lock(mu);
+  if (cache.size() >= 16) cache.clear();
+  cache.emplace(key, shared);
+  return shared;
 }
 
 void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
@@ -180,11 +203,10 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
       if (b.features.iridescence) {
         bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params);
         tf.measureError = false;
-        auto table = bb::thinFilmTable(tf);
-        if (!table.ok()) throwError(table.error(), "/thinFilm");
-        b.thinFilm = std::move(table.value().rgb);
-        b.thinFilmWidth = table.value().width;
-        b.thinFilmHeight = table.value().height;
+        auto table = cachedThinFilm(tf);
+        b.thinFilm = table->rgb;
+        b.thinFilmWidth = table->width;
+        b.thinFilmHeight = table->height;
       }
       if (bj.contains("motion")) {
         const json& mo = bj["motion"];

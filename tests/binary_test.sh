@@ -36,4 +36,19 @@ rm -f /tmp/effectd_inflight.$$ /tmp/effectd_code.$$
 [ "$code" = "200" ] || { echo "in-flight request got $code"; cat "$log"; exit 1; }
 grep -q '"stopped"' "$log"
 grep -q '"path":"/v1/fog","status":200' "$log" || { echo "no access log line"; cat "$log"; exit 1; }
+# The command-line renderer: a scene file to a PNG, no server.
+scene=$(dirname "$0")/../examples/01-lightning.json
+png=/tmp/effectd_render.$$.png
+"$bin" render "$scene" -o "$png" 2>"$log" || { echo "render failed"; cat "$log"; exit 1; }
+[ "$(head -c 8 "$png" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || { echo "not a PNG"; exit 1; }
+grep -q '"passes":"background,lightning,blurHorizontal,blurVertical,lightningComposite"' "$log" || { cat "$log"; exit 1; }
+rm -f "$png"
+echo '{"width": 0}' > /tmp/effectd_bad.$$.json
+set +e
+"$bin" render /tmp/effectd_bad.$$.json -o "$png" 2>"$log"
+rc=$?
+set -e
+rm -f /tmp/effectd_bad.$$.json
+[ "$rc" -eq 2 ] && grep -q '/width' "$log" || { echo "bad scene: exit $rc"; cat "$log"; exit 1; }
+[ ! -e "$png" ] || { echo "wrote a PNG for a bad scene"; exit 1; }
 echo "binary test ok (port $port)"

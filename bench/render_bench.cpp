@@ -1,0 +1,82 @@
+// 512x512 render latency on whatever EGL offers (llvmpipe without a GPU), p50 and p99, for
+// lightning only, fog only, bubble only and all three. Two columns: the frame itself (GPU
+// passes + read-back, variants already compiled) and the whole request path (scene building:
+// bolt growth, icosphere, thin-film table; the frame; PNG encoding).
+//   build/bench/render_bench [iterations=40]
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include <render/render.h>
+
+#include "config.h"
+#include "scene.h"
+
+namespace {
+
+using nlohmann::json;
+namespace rd = effects::render;
+
+const json kLightning = {{"grid", {{"width", 128}, {"height", 128}}}, {"start", {64, 0}}, {"targets", {{64, 127}}}, {"seed", 7}};
+const json kFog = {{"fog", {{"fogType", "HEIGHT"}, {"color", {0.5, 0.55, 0.6}}, {"density", 0.08}, {"heightFalloff", 0.5}}}};
+const json kBubble = {{"features", {{"iridescence", true}}}, {"mesh", {{"level", 4}}}, {"params", {{"wobbleAmplitude", 0.03}}}};
+const json kQuads = {{{"center", {0, -1, -10}}, {"normal", {0, 1, 0}}, {"up", {0, 0, -1}}, {"size", {40, 30}}},
+                     {{"center", {-3, 0.5, -6}}, {"size", {1.5, 3}}}};
+
+json scene(bool lightning, bool fog, bool bubble) {
+  json s = {{"width", 512}, {"height", 512}, {"background", {{"gradient", {{"top", {0.1, 0.1, 0.2}}, {"bottom", {0.4, 0.4, 0.5}}}}}}};
+  if (lightning) s["lightning"] = kLightning;
+  if (fog) s["fog"] = kFog, s["quads"] = kQuads;
+  if (bubble) s["bubble"] = kBubble;
+  return s;
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, size_t(p * double(v.size() - 1) + 0.5))];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int iterations = argc > 1 ? std::max(2, std::atoi(argv[1])) : 40;
+  effectd::Config config;
+  auto renderer = rd::Renderer::create();
+  if (!renderer.ok()) {
+    std::fprintf(stderr, "render_bench: %s\n", renderer.error().message.c_str());
+    return 1;
+  }
+  std::printf("renderer: %s, 512x512, %d iterations each\n\n", renderer.value()->description().c_str(), iterations);
+  std::printf("%-16s %12s %12s %14s %14s  %s\n", "scene", "frame p50", "frame p99", "request p50", "request p99", "passes");
+  struct Case {
+    const char* name;
+    bool lightning, fog, bubble;
+  };
+  for (const Case& c : {Case{"lightning only", true, false, false}, Case{"fog only", false, true, false},
+                        Case{"bubble only", false, false, true}, Case{"all three", true, true, true}}) {
+    const json body = scene(c.lightning, c.fog, c.bubble);
+    std::vector<double> frame, request;
+    std::string passes;
+    for (int i = 0; i <= iterations; ++i) {
+      effects::Stopwatch watch;
+      rd::Scene s = effectd::buildScene(body, config);
+      auto f = renderer.value()->render(s);
+      if (!f.ok()) {
+        std::fprintf(stderr, "%s: %s\n", c.name, f.error().message.c_str());
+        return 1;
+      }
+      auto png = rd::encodePng(f.value().image, 8);
+      if (i == 0) {  // the first frame compiles the variants: not counted
+        for (const auto& p : f.value().passes) passes += (passes.empty() ? "" : ",") + p;
+        continue;
+      }
+      frame.push_back(f.value().ms);
+      request.push_back(watch.ms());
+    }
+    std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", c.name, percentile(frame, 0.5), percentile(frame, 0.99),
+                percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
+  }
+  std::printf("\ntarget: all three, request p50 <= 150 ms on the 2-core CI-class machine\n");
+  return 0;
+}

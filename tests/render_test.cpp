@@ -1,0 +1,391 @@
+// POST /v1/render and /v1/scene on whatever EGL offers (llvmpipe without a GPU): example
+// scenes against golden images, fog against /v1/fog's tables, lightning pixels against the
+// polylines, only-needed passes, concurrency and saturation, bad input.
+//
+// Golden images are the PNGs in examples/. EFFECTD_UPDATE_GOLDEN=1 rewrites them.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <iterator>
+
+#include <glm/geometric.hpp>
+#include <render/render.h>
+
+#include "../render/internal.h"
+#include "codec.h"
+#include "test_server.h"
+
+namespace effectd::testing {
+namespace {
+
+using nlohmann::json;
+namespace rd = effects::render;
+namespace fs = std::filesystem;
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+rd::Image decode(const std::string& png) {
+  auto img = rd::decodeImage(png, size_t(1) << 28);
+  EXPECT_TRUE(img.ok()) << (img.ok() ? "" : img.error().message);
+  return img.ok() ? img.value() : rd::Image{};
+}
+
+glm::vec4 pixel(const rd::Image& img, int x, int y) {
+  const float* p = &img.rgba[(size_t(y) * img.width + x) * 4];
+  return {p[0], p[1], p[2], p[3]};
+}
+
+httplib::Result render(const TestServer& s, const json& scene) { return s.postJson("/v1/render", scene); }
+
+TEST(Render, ExampleScenesMatchTheirGoldenImages) {
+  TestServer s;
+  const bool update = std::getenv("EFFECTD_UPDATE_GOLDEN") != nullptr;
+  int scenes = 0;
+  for (const auto& entry : fs::directory_iterator(EFFECTD_EXAMPLES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    ++scenes;
+    SCOPED_TRACE(entry.path().filename().string());
+    auto r = s.postJson("/v1/render", readFile(entry.path()));
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+    EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+    EXPECT_FALSE(r->get_header_value("X-Renderer").empty());
+    const fs::path golden = fs::path(entry.path()).replace_extension(".png");
+    if (update) {
+      std::ofstream(golden, std::ios::binary) << r->body;
+      continue;
+    }
+    ASSERT_TRUE(fs::exists(golden)) << golden << " is missing: run with EFFECTD_UPDATE_GOLDEN=1";
+    rd::Image got = decode(r->body), want = decode(readFile(golden));
+    ASSERT_EQ(got.width, want.width);
+    ASSERT_EQ(got.height, want.height);
+    // Tolerance: llvmpipe builds and GPUs may differ by rounding at edges, not in content.
+    double sum = 0;
+    size_t far = 0;
+    for (size_t i = 0; i < got.rgba.size(); ++i) {
+      double d = std::abs(got.rgba[i] - want.rgba[i]);
+      sum += d;
+      far += d > 8.0 / 255;
+    }
+    EXPECT_LT(sum / double(got.rgba.size()), 1.0 / 255) << "mean difference";
+    EXPECT_LT(double(far) / double(got.rgba.size()), 0.005) << "share of channels off by more than 8/255";
+  }
+  EXPECT_GE(scenes, 4);
+}
+
+// A camera at the origin looking down -z; small quads facing it at the table's sample
+// distances, spread over the frame. Each quad's centre pixel must show the table's colour.
+void expectFogMatchesTable(const TestServer& s, const json& fogDef, int elevations, double cameraHeight) {
+  const double range = 40;
+  const int size = 9;
+  json tableReq = {{"fog", fogDef},
+                   {"table", {{"size", size}, {"range", {0, range}}}},
+                   {"objectColors", {{0.9, 0.6, 0.2}}}};
+  if (elevations) {
+    tableReq["table"]["elevations"] = elevations;
+    tableReq["table"]["cameraHeight"] = cameraHeight;
+  }
+  auto t = s.postJson("/v1/fog", tableReq);
+  ASSERT_TRUE(t);
+  ASSERT_EQ(t->status, 200) << t->body;
+  const json table = json::parse(t->body)["table"];
+  const json& colors = table["finalColors"][0];
+  const int row = elevations ? elevations / 2 : 0;  // the horizontal ray's row (dirY = 0)
+
+  const int W = 256, H = 128;
+  json scene = {{"width", W},
+                {"height", H},
+                {"camera", {{"position", {0, cameraHeight, 0}}, {"target", {0, cameraHeight, -1}}, {"fovY", 60}}},
+                {"background", {{"color", {0, 0, 0}}}},
+                {"fog", {{"fog", fogDef}}},
+                {"quads", json::array()}};
+  const double aspect = double(W) / H, tanHalf = std::tan(30.0 * M_PI / 180);
+  std::vector<std::pair<int, int>> centres;
+  for (int i = 1; i < size; ++i) {
+    const double d = range * i / (size - 1);
+    const double ndcX = -0.85 + 1.7 * (i - 1) / (size - 2);  // spread across the frame
+    const double angle = std::atan(ndcX * tanHalf * aspect);
+    const glm::dvec3 dir(std::sin(angle), 0, -std::cos(angle));
+    const glm::dvec3 c = glm::dvec3(0, cameraHeight, 0) + dir * d;
+    scene["quads"].push_back({{"center", {c.x, c.y, c.z}},
+                              {"normal", {-dir.x, 0, -dir.z}},
+                              {"size", {0.02 * d, 0.02 * d}},
+                              {"color", {0.9, 0.6, 0.2}}});
+    centres.emplace_back(int(std::floor((ndcX * 0.5 + 0.5) * W)), H / 2);
+  }
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->get_header_value("X-Render-Passes").find("quads+fog"), std::string::npos);
+  rd::Image img = decode(r->body);
+  for (int i = 1; i < size; ++i) {
+    auto [x, y] = centres[size_t(i - 1)];
+    glm::vec4 got = pixel(img, x, y);
+    for (int c = 0; c < 3; ++c) {
+      const double want = colors[size_t(row * size + i) * 3 + size_t(c)].get<double>();
+      EXPECT_NEAR(got[c], want, 2.0 / 255) << fogDef.dump() << " distance " << range * i / (size - 1) << " channel " << c;
+    }
+  }
+}
+
+TEST(Render, FogInARenderMatchesTheFogTableColours) {
+  TestServer s;
+  expectFogMatchesTable(s, {{"fogType", "DISTANCE_EXP2"}, {"color", {0.5, 0.6, 0.7}}, {"distanceCoefficient", 0.002}}, 0, 0);
+  expectFogMatchesTable(s, {{"fogType", "EXPONENTIAL"}, {"color", {0.2, 0.3, 0.4}}, {"visibilityRange", 60}}, 0, 0);
+  expectFogMatchesTable(s, {{"fogType", "GL_LINEAR"}, {"color", {0.8, 0.8, 0.8}}, {"start", 5}, {"end", 35}}, 0, 0);
+  expectFogMatchesTable(s, {{"fogType", "DISTANCE_GAUSSIAN"}, {"color", {0.1, 0.1, 0.1}}, {"distanceCoefficient", 0.001}}, 0, 0);
+  expectFogMatchesTable(s, {{"fogType", "HEIGHT"}, {"color", {0.6, 0.6, 0.7}}, {"density", 0.08}, {"heightFalloff", 0.5},
+                            {"baseHeight", 0}},
+                        3, 1.5);
+}
+
+double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+  glm::dvec2 ab = b - a;
+  double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;
+  return glm::length(p - (a + t * ab));
+}
+
+TEST(Render, LightningBrightPixelsLieAlongThePolyline) {
+  TestServer s;
+  const int W = 256, H = 256;
+  json scene = {{"width", W},
+                {"height", H},
+                {"background", {{"color", {0, 0, 0}}}},
+                {"lightning", {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}, {"seed", 5}}},
+                {"lightningStyle", {{"coreWidth", 1.5}, {"glowSigma", 0}}}};
+  auto data = s.postJson("/v1/scene", scene);
+  ASSERT_TRUE(data);
+  ASSERT_EQ(data->status, 200) << data->body;
+  const json lines = json::parse(data->body)["lightning"]["polylines"];
+  std::vector<std::pair<glm::dvec2, glm::dvec2>> segments;
+  const double scale = double(W) / 64;
+  for (const auto& l : lines)
+    for (size_t i = 2; i + 1 < l["points"].size(); i += 2)
+      segments.push_back({glm::dvec2(l["points"][i - 2], l["points"][i - 1]) * scale,
+                          glm::dvec2(l["points"][i], l["points"][i + 1]) * scale});
+  ASSERT_FALSE(segments.empty());
+
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const std::string passes = r->get_header_value("X-Render-Passes");
+  EXPECT_EQ(passes, "background,lightning,lightningComposite") << "no blur pass without glow";
+  rd::Image img = decode(r->body);
+  int bright = 0;
+  // Main channel half width 1.5 px, plus the anti-aliasing pixel and the half-width caps.
+  const double reach = 1.5 + 1.0 + 0.75;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (pixel(img, x, y).b < 0.25f) continue;
+      ++bright;
+      glm::dvec2 p(x + 0.5, y + 0.5);
+      double best = 1e9;
+      for (const auto& [a, b] : segments) best = std::min(best, segmentDistance(p, a, b));
+      ASSERT_LE(best, reach) << "bright pixel (" << x << ", " << y << ") away from every segment";
+    }
+  // And the bolt is really there: its main channel is bright along its length.
+  EXPECT_GT(bright, H) << "a bolt from top to bottom lights at least one pixel per row";
+  int lit = 0, checked = 0;
+  for (const auto& [a, b] : segments) {
+    glm::dvec2 m = (a + b) * 0.5;
+    ++checked;
+    lit += pixel(img, int(m.x), int(m.y)).b > 0.2f;
+  }
+  EXPECT_GT(lit, checked * 8 / 10) << "segment midpoints lit";
+
+  scene["lightningStyle"]["glowSigma"] = 4;
+  r = render(s, scene);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->get_header_value("X-Render-Passes"), "background,lightning,blurHorizontal,blurVertical,lightningComposite");
+}
+
+TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
+  // No fog: no fog code in any composed shader; fog: only the types used.
+  EXPECT_EQ(rd::detail::quadFragment(nullptr).find("Fog"), std::string::npos);
+  rd::Fog fog;
+  fog.global.type = effects::fog::FogType::kGlExp;
+  auto v = rd::detail::fogVariant(fog);
+  const std::string withFog = rd::detail::quadFragment(&v);
+  EXPECT_NE(withFog.find("applyFog"), std::string::npos);
+  EXPECT_NE(withFog.find("GL_EXP"), std::string::npos);
+  EXPECT_EQ(withFog.find("fogLogG"), std::string::npos) << "height-fog code only for HEIGHT";
+  EXPECT_EQ(withFog.find("uRegionLo"), std::string::npos) << "region code only with regions";
+  EXPECT_EQ(rd::detail::compositeFragment(false).find("uGlow"), std::string::npos);
+
+  TestServer s;
+  json scene = {{"width", 64}, {"height", 64}, {"quads", {{{"center", {0, 0.5, 0}}, {"size", {1, 1}}}}}};
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->get_header_value("X-Render-Passes"), "background,quads");
+  EXPECT_NE(r->get_header_value("X-Shader-Variants-Compiled"), "0");
+  // Variants are cached per context: the same scene again compiles nothing on that thread.
+  // (Two render threads: render until both have served it.)
+  for (int i = 0; i < 4; ++i) r = render(s, scene);
+  EXPECT_EQ(r->get_header_value("X-Shader-Variants-Compiled"), "0");
+  auto m = s.client().Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("render_passes_total{kind=\"quads\"}"), std::string::npos) << m->body;
+  EXPECT_EQ(m->body.find("blurHorizontal"), std::string::npos) << "no lightning, no blur pass";
+
+  scene["fog"] = {{"fog", {{"fogType", "GL_EXP"}, {"density", 0.1}}}};
+  r = render(s, scene);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->get_header_value("X-Render-Passes"), "background,quads+fog");
+
+  auto ready = s.client().Get("/readyz");
+  ASSERT_TRUE(ready);
+  EXPECT_EQ(ready->status, 200);
+  EXPECT_FALSE(json::parse(ready->body)["info"].value("renderer", "").empty()) << ready->body;
+}
+
+TEST(Render, SceneReturnsEachPresentEffectAndNothingElse) {
+  TestServer s;
+  json scene = {{"fog", {{"fog", {{"fogType", "GL_EXP"}, {"density", 0.1}}}}},
+                {"quads", {{{"center", {0, 0, 0}}, {"size", {1, 1}}}}}};
+  auto r = s.postJson("/v1/scene", scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_EQ(j.size(), 1u) << r->body;
+  EXPECT_TRUE(j["fog"].contains("table"));
+}
+
+TEST(Render, SixteenBitPngKeepsTheGradient) {
+  TestServer s;
+  json scene = {{"width", 8}, {"height", 256}, {"bitDepth", 16},
+                {"background", {{"gradient", {{"top", {1, 1, 1}}, {"bottom", {0, 0, 0}}}}}}};
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  ASSERT_GT(r->body.size(), 25u);
+  EXPECT_EQ(uint8_t(r->body[24]), 16) << "IHDR bit depth";
+  rd::Image img = decode(r->body);
+  EXPECT_GT(pixel(img, 0, 0).r, 0.99f) << "row 0 is the top";
+  EXPECT_LT(pixel(img, 0, 255).r, 0.01f);
+  // Adjacent rows differ by 1/256: an 8-bit detour would show steps of 0 or 2/255.
+  for (int y = 1; y < 256; ++y) EXPECT_NEAR(pixel(img, 0, y - 1).r - pixel(img, 0, y).r, 1.0 / 256, 0.6 / 256);
+}
+
+TEST(Render, ConcurrentRendersAreCorrectAndThePoolStaysWithinItsSize) {
+  rd::RenderPool pool({2, 64, ""});
+  ASSERT_EQ(pool.start(), "");
+  rd::Scene scene;
+  scene.width = scene.height = 96;
+  scene.quads.push_back({});
+  scene.lightning = rd::Lightning{};
+  scene.lightning->gridWidth = scene.lightning->gridHeight = 8;
+  effects::lightning::Polyline line;
+  line.main = true;
+  line.width = 2;
+  line.vertices = {{0.5f, 0.5f, 0, 1.0f, 0}, {7.5f, 7.5f, 1, 1.0f, 1}};
+  scene.lightning->polylines = {line};
+  std::vector<std::future<effects::Result<rd::Frame>>> jobs;
+  std::vector<std::thread> clients;
+  std::mutex mu;
+  for (int c = 0; c < 8; ++c)
+    clients.emplace_back([&] {
+      for (int i = 0; i < 4; ++i) {
+        auto f = pool.submit(scene);
+        ASSERT_TRUE(f.has_value());
+        std::lock_guard<std::mutex> lock(mu);
+        jobs.push_back(std::move(*f));
+      }
+    });
+  for (auto& t : clients) t.join();
+  std::vector<float> first;
+  for (auto& j : jobs) {
+    auto frame = j.get();
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    if (first.empty()) first = frame.value().image.rgba;
+    EXPECT_EQ(frame.value().image.rgba, first) << "same scene, same pixels on every thread";
+  }
+  EXPECT_GE(pool.peakBusy(), 1);
+  EXPECT_LE(pool.peakBusy(), 2);
+}
+
+TEST(Render, SaturatedPoolAnswers503WithRetryAfterAndRecovers) {
+  Config c = TestServer::quietConfig();
+  c.threads = 16;
+  c.renderThreads = 1;
+  c.renderQueue = 0;
+  TestServer s(c);
+  json scene = {{"width", 512}, {"height", 512},
+                {"lightning", {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}}},
+                {"lightningStyle", {{"glowSigma", 20}}}};
+  ASSERT_EQ(render(s, scene)->status, 200);  // the context exists before the burst
+  std::vector<std::future<int>> burst;
+  for (int i = 0; i < 8; ++i)
+    burst.push_back(std::async(std::launch::async, [&] {
+      auto r = render(s, scene);
+      if (r && r->status == 503) {
+        EXPECT_EQ(r->get_header_value("Retry-After"), "1");
+      }
+      return r ? r->status : 0;
+    }));
+  int ok = 0, busy = 0;
+  for (auto& f : burst) {
+    int st = f.get();
+    ok += st == 200;
+    busy += st == 503;
+  }
+  EXPECT_EQ(ok + busy, 8);
+  EXPECT_GE(ok, 1);
+  EXPECT_GE(busy, 1) << "one thread, no queue: concurrent renders beyond it are refused";
+  EXPECT_EQ(render(s, scene)->status, 200) << "recovers once the burst is over";
+}
+
+TEST(Render, BadScenesNameTheField) {
+  Config c = TestServer::quietConfig();
+  c.limits.maxRenderPixels = 1000 * 1000;
+  TestServer s(c);
+  auto problem = [&](const json& scene, int status, const std::string& pointer) {
+    auto r = render(s, scene);
+    json p = expectProblem(r, status);
+    EXPECT_TRUE(hasPointer(p, pointer)) << scene.dump().substr(0, 200) << " -> " << (r ? r->body : "");
+  };
+  problem({{"width", 2000}, {"height", 2000}}, 413, "/width");
+  problem({{"width", 0}}, 400, "/width");
+  problem({{"camera", {{"position", {1, 1, 1}}, {"target", {1, 1, 1}}}}}, 400, "/camera/target");
+  problem({{"camera", {{"position", {0, 5, 0}}, {"target", {0, 0, 0}}}}}, 400, "/camera/up");
+  problem({{"background", {{"image", "not base64!"}}}}, 400, "/background/image");
+  problem({{"background", {{"image", base64Encode("GIF89a....")}}}}, 400, "/background/image");
+  problem({{"background", {{"image", base64Encode(std::string("\x89PNG\r\n\x1a\n", 8) + "truncated")}}}}, 400,
+          "/background/image");
+  problem({{"background", {{"color", {0, 0, 0}}, {"gradient", {{"top", {0, 0, 0}}, {"bottom", {1, 1, 1}}}}}}}, 400,
+          "/background");
+  problem({{"lightning", {{"grid", {{"width", 8}, {"height", 8}}}, {"start", {9, 0}}, {"targets", {{1, 7}}}}}}, 400,
+          "/lightning/start");
+  problem({{"fog", {{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 1}}}}}}, 400, "/fog/fog/end");
+  problem({{"bubble", {{"mesh", {{"level", 9}}}}}}, 413, "/bubble/mesh/level");
+  problem({{"quads", {{{"center", {0, 0, 0}}, {"size", {1, 1}}, {"normal", {0, 0, 0}}}}}}, 400, "/quads/0/normal");
+
+  // A PNG larger than the pixel limit is refused from its header, before decoding.
+  rd::Image big{1100, 1000, std::vector<float>(size_t(1100) * 1000 * 4, 0.5f)};
+  auto png = rd::encodePng(big, 8);
+  ASSERT_TRUE(png.ok());
+  problem({{"background", {{"image", base64Encode(png.value())}}}}, 413, "/background/image");
+}
+
+TEST(Render, BackgroundImageFillsTheFrame) {
+  TestServer s;
+  rd::Image img{2, 2, {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1}};  // red green / blue white
+  auto png = rd::encodePng(img, 8);
+  ASSERT_TRUE(png.ok());
+  auto r = render(s, {{"width", 64}, {"height", 64}, {"background", {{"image", base64Encode(png.value())}}}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  rd::Image out = decode(r->body);
+  EXPECT_GT(pixel(out, 2, 2).r, 0.95f);   // top left red
+  EXPECT_GT(pixel(out, 61, 2).g, 0.95f);  // top right green
+  EXPECT_GT(pixel(out, 2, 61).b, 0.95f);  // bottom left blue
+  EXPECT_GT(pixel(out, 61, 61).r + pixel(out, 61, 61).g + pixel(out, 61, 61).b, 2.85f);
+}
+
+}  // namespace
+}  // namespace effectd::testing
