@@ -8,33 +8,14 @@
 
 #include <effects/tangents.h>
 
+#include "meshes.h"
+
 namespace {
 
 using namespace effects::tangents;
 
-Mesh sphere(int rings, int segments) {
-  Mesh m;
-  for (int r = 0; r <= rings; ++r)
-    for (int s = 0; s <= segments; ++s) {
-      double th = M_PI * r / rings, ph = 2 * M_PI * s / segments;
-      double st = r == 0 || r == rings ? 0.0 : std::sin(th);
-      glm::vec3 p(float(st * std::cos(ph)), float(std::cos(th)), float(st * std::sin(ph)));
-      m.positions.push_back(p);
-      m.normals.push_back(p);
-      m.uvs.push_back({float(s) / float(segments), 1.0f - float(r) / float(rings)});
-    }
-  const uint32_t row = uint32_t(segments) + 1;
-  for (uint32_t r = 0; r < uint32_t(rings); ++r)
-    for (uint32_t s = 0; s < uint32_t(segments); ++s) {
-      uint32_t a = r * row + s, b = a + row;
-      if (r > 0) m.indices.insert(m.indices.end(), {a, a + 1, b});
-      if (r + 1 < uint32_t(rings)) m.indices.insert(m.indices.end(), {a + 1, b + 1, b});
-    }
-  return m;
-}
-
 const Mesh& mesh100k() {
-  static const Mesh m = sphere(200, 250);  // 99 500 triangles
+  static const Mesh m = bench::uvSphere(200, 250);  // 99 500 triangles
   return m;
 }
 

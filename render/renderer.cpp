@@ -416,6 +416,8 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   frame.width = scene.width, frame.height = scene.height, frame.bitDepth = scene.bitDepth;
   if (scene.width < 1 || scene.height < 1 || scene.width > maxTextureSize || scene.height > maxTextureSize)
     return overLimit("/width", "the renderer's largest image side is " + std::to_string(maxTextureSize));
+  if (scene.lightning && (scene.lightning->gridWidth < 1 || scene.lightning->gridHeight < 1))
+    return invalid("/lightning/grid", "must have at least one cell");
   const View view = viewOf(scene);
   const GLenum mainFormat = scene.bitDepth == 16 && floatBlend ? GL_RGBA32F : GL_RGBA16F;
   Target main;

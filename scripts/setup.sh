@@ -9,6 +9,7 @@ PACKAGES=(
   libopenimageio-dev libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   libgtest-dev libgmock-dev libbenchmark-dev
   glslang-tools
+  gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node

@@ -51,8 +51,10 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   mesh.uvs = unflatten<glm::vec2, 2>(m["uvs"], "/mesh/uvs");
   mesh.indices = m["indices"].get<std::vector<uint32_t>>();
   const std::string modeName = body.value("mode", "mikktspace");
-  tg::Options opt = options(ctx.config, modeName == "perTriangle" ? tg::Mode::kPerTriangle : tg::Mode::kMikkTSpace);
-  opt.measureError = include.has("error") && opt.mode == tg::Mode::kPerTriangle;
+  tg::Options opt = options(ctx.config, modeName == "perTriangle" ? tg::Mode::kPerTriangle
+                                         : modeName == "perVertex" ? tg::Mode::kPerVertex
+                                                                   : tg::Mode::kMikkTSpace);
+  opt.measureError = include.has("error") && opt.mode != tg::Mode::kMikkTSpace;
   opt.triangleFrames = include.has("triangleFrames");
   auto r = tg::generate(mesh, opt);
   if (!r.ok()) {

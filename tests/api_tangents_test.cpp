@@ -58,6 +58,18 @@ TEST(TangentsApi, PerTriangleWithErrorAndFrames) {
   EXPECT_GT(j["vertexCount"].get<int>(), 4);  // shared vertices split between the two flat frames
 }
 
+TEST(TangentsApi, PerVertexAverageNeverSplits) {
+  TestServer s;
+  json mesh = quadMesh();
+  mesh["positions"][8] = 0.5;
+  auto r = s.postJson("/v1/tangents", json{{"mesh", mesh}, {"mode", "perVertex"}, {"include", {"tangents", "error"}}});
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_EQ(j["method"], "perVertex");
+  EXPECT_EQ(j["vertexCount"].get<int>(), 4);
+  EXPECT_EQ(j["error"]["reference"], "mikktspace");
+}
+
 TEST(TangentsApi, BadMeshesNameTheField) {
   TestServer s;
   json mesh = quadMesh();

@@ -159,7 +159,7 @@ Mesh sphere(int rings, int segments, double radius) {
 
 TEST(Mikk, ExtremeScalesStayFiniteUnitAndOrthogonal) {
   for (double radius : {1e20, 1e-20, 1.0}) {
-    for (Mode mode : {Mode::kMikkTSpace, Mode::kPerTriangle}) {
+    for (Mode mode : {Mode::kMikkTSpace, Mode::kPerTriangle, Mode::kPerVertex}) {
       Options o;
       o.mode = mode;
       auto r = generate(sphere(12, 24, radius), o);
@@ -187,7 +187,7 @@ TEST(Mikk, DegenerateTrianglesHaveDefinedOutput) {
   m.positions.push_back({7, 7, 7});  // 6: used by nothing
   m.uvs.push_back({0, 0});
   for (NormalRule rule : {NormalRule::kSmooth, NormalRule::kFlat})
-    for (Mode mode : {Mode::kMikkTSpace, Mode::kPerTriangle}) {
+    for (Mode mode : {Mode::kMikkTSpace, Mode::kPerTriangle, Mode::kPerVertex}) {
       Options o;
       o.mode = mode;
       o.missingNormals = rule;
@@ -225,6 +225,23 @@ TEST(Mikk, PerTriangleErrorAgainstMikkIsMeasured) {
   EXPECT_LT(*st.error, 20.0);
   EXPECT_EQ(st.reference, "mikktspace");
   EXPECT_GT(r.value().remap.size(), sphere(16, 32, 1.0).positions.size());  // flat frames split
+}
+
+TEST(Mikk, PerVertexAverageIsCloseToMikkOnASmoothSphereAndNeverSplits) {
+  Options o;
+  o.mode = Mode::kPerVertex;
+  o.measureError = true;
+  const Mesh m = sphere(32, 64, 1.0);
+  auto r = generate(m, o);
+  ASSERT_TRUE(r.ok());
+  expectValid(r.value());
+  EXPECT_EQ(r.value().remap.size(), m.positions.size()) << "one tangent per input vertex";
+  const Stats& st = r.value().stats;
+  ASSERT_TRUE(st.error.has_value());
+  o.mode = Mode::kPerTriangle;
+  auto flat = generate(m, o);
+  EXPECT_LT(*st.error, *flat.value().stats.error) << "averaging approaches MikkTSpace's smoothed frames";
+  EXPECT_EQ(st.method, "perVertex");
 }
 
 TEST(Validate, RejectsBadInputNamingTheIndex) {

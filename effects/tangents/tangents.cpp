@@ -426,7 +426,14 @@ Mesh flatExpanded(const Mesh& mesh, std::vector<uint32_t>& cornerToInput) {
 
 }  // namespace
 
-const char* toString(Mode mode) { return mode == Mode::kMikkTSpace ? "mikktspace" : "perTriangle"; }
+const char* toString(Mode mode) {
+  switch (mode) {
+    case Mode::kMikkTSpace: return "mikktspace";
+    case Mode::kPerTriangle: return "perTriangle";
+    case Mode::kPerVertex: return "perVertex";
+  }
+  return "?";
+}
 
 double angleDeg(const glm::vec4& a, const glm::vec4& b) {
   dvec3 x = normalizeOrZero(dvec3(a)), y = normalizeOrZero(dvec3(b));
@@ -530,6 +537,44 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   }
   if (options.mode == Mode::kMikkTSpace) {
     corner = std::move(mikkCorner);
+  } else if (options.mode == Mode::kPerVertex) {
+    std::vector<Frame> frames(triCount);
+    parallelFor(triCount, [&](size_t begin, size_t end) {
+      for (size_t t = begin; t < end; ++t) {
+        dvec3 fn = faceNormal(mesh, t);
+        frames[t] = triFrame(t, notZero(fn) ? fn : normals[mesh.indices[3 * t]]);
+        if (!notZero(fn)) frames[t].degenerate = true;
+      }
+    });
+    std::vector<dvec3> sum(vertCount, dvec3(0));
+    std::vector<double> hand(vertCount, 0.0);
+    for (size_t t = 0; t < triCount; ++t) {
+      if (frames[t].degenerate) continue;
+      for (int c = 0; c < 3; ++c) {
+        dvec3 p = trianglePoint(mesh, t, c);
+        dvec3 a = normalizeOrZero(trianglePoint(mesh, t, (c + 1) % 3) - p), b = normalizeOrZero(trianglePoint(mesh, t, (c + 2) % 3) - p);
+        double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+        uint32_t v = mesh.indices[3 * t + size_t(c)];
+        sum[v] += angle * dvec3(frames[t].tangent);
+        hand[v] += angle * frames[t].w;
+      }
+    }
+    std::vector<glm::vec4> perVertex(vertCount);
+    std::vector<uint8_t> vertexFellBack(vertCount, 0);
+    for (size_t v = 0; v < vertCount; ++v) {
+      dvec3 t = projectToPlane(sum[v], normals[v]);
+      const double len = glm::length(t);
+      if (len > 1e-9 * glm::length(sum[v]) && len > 0) {
+        perVertex[v] = glm::vec4(glm::vec3(t / len), hand[v] < 0 ? -1.0f : 1.0f);
+      } else {  // no healthy frame around the vertex, or they cancel out
+        perVertex[v] = fallbackTangent(normals[v]);
+        vertexFellBack[v] = 1;
+      }
+    }
+    for (size_t c = 0; c < corner.size(); ++c) {
+      corner[c] = perVertex[mesh.indices[c]];
+      fellBack[c] = vertexFellBack[mesh.indices[c]];
+    }
   } else {
     parallelFor(corner.size(), [&](size_t begin, size_t end) {
       for (size_t c = begin; c < end; ++c) {
@@ -600,7 +645,7 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
     st.counters["groups"] = double(mikk.groups);
   }
   if (meshIn.normals.empty()) st.counters["computedNormals"] = 1;
-  if (options.mode == Mode::kPerTriangle && options.measureError && !corner.empty()) {
+  if (options.mode != Mode::kMikkTSpace && options.measureError && !corner.empty()) {
     double sum = 0, worst = 0;
     size_t flips = 0;
     for (size_t c = 0; c < corner.size(); ++c) {

@@ -13,6 +13,11 @@
 //   kPerTriangle  seed 004: [u0 v0; u1 v1][T; B] = [e0; e1], T = normalize(T - (N.T)N),
 //                 B = normalize(N x T), w = sign((N x T) . B_raw), at every corner with that
 //                 corner's normal. Flat per triangle, so corners of a vertex rarely agree.
+//   kPerVertex    the classic per-vertex average (Lengyel 2001): each triangle's frame
+//                 (against its face normal) summed at its vertices weighted by the corner
+//                 angle, then Gram-Schmidt against the vertex normal; w = sign of the
+//                 weighted handedness sum. One tangent per input vertex: nothing is split, so
+//                 mirrored UV seams get an averaged (wrong) tangent — the price of no splits.
 //
 // Output is per vertex: a vertex whose corners get different tangents is split, so the output
 // can have more vertices than the input. `remap[k]` is the input vertex of output vertex k;
@@ -46,7 +51,7 @@
 
 namespace effects::tangents {
 
-enum class Mode { kMikkTSpace, kPerTriangle };
+enum class Mode { kMikkTSpace, kPerTriangle, kPerVertex };
 enum class NormalRule { kSmooth, kFlat };  // how missing normals are computed
 
 const char* toString(Mode mode);
@@ -61,7 +66,7 @@ struct Mesh {
 struct Options {
   Mode mode = Mode::kMikkTSpace;
   NormalRule missingNormals = NormalRule::kSmooth;
-  bool measureError = false;  // kPerTriangle: angle error against MikkTSpace (runs both)
+  bool measureError = false;  // kPerTriangle/kPerVertex: angle error against MikkTSpace (runs both)
   bool triangleFrames = false;  // also return the per-triangle TBN with the face normal
   size_t maxVertices = 2'000'000, maxTriangles = 4'000'000;
 };
@@ -79,7 +84,7 @@ struct Output {
   std::vector<uint32_t> indices;    // the triangles over output vertices
   std::vector<Frame> triangleFrames;  // when Options::triangleFrames
   Stats stats;  // counters: triangles, inputVertices, outputVertices, degenerateTriangles,
-                // zeroUvAreaTriangles, groups; kPerTriangle + measureError: error = mean angle
+                // zeroUvAreaTriangles, groups; kPerTriangle/kPerVertex + measureError: error = mean angle
                 // (degrees) to MikkTSpace, counters maxAngleDeg, handednessMismatches
 };
 

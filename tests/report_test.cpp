@@ -1,0 +1,68 @@
+// The error-against-run-time report tool, on its reduced configuration: it writes the
+// report, the JSON and a plot per section, and wherever a setting converges to the reference
+// (solver tolerance, table size, wavelength samples, ray-march steps) the error shrinks.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The errors of `series` in report order (the order the setting is refined in).
+std::vector<double> errorsOf(const json& section, const std::string& series, const std::string& settingPrefix = "") {
+  std::vector<double> out;
+  for (const auto& p : section["points"])
+    if (p["series"] == series && p["setting"].get<std::string>().rfind(settingPrefix, 0) == 0) out.push_back(p["error"].get<double>());
+  return out;
+}
+
+void expectShrinks(const std::vector<double>& e, const std::string& what, double slack = 1e-9) {
+  ASSERT_GE(e.size(), 3u) << what;
+  for (size_t i = 1; i < e.size(); ++i) EXPECT_LE(e[i], e[i - 1] * (1 + 1e-6) + slack) << what << " at step " << i;
+  EXPECT_LT(e.back(), e.front()) << what;
+}
+
+TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
+  const fs::path out = fs::temp_directory_path() / ("effectd_report_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const bool plots = std::system("gnuplot --version >/dev/null 2>&1") == 0;
+  const std::string cmd = std::string(EFFECTD_ERROR_REPORT) + " --quick --out " + out.string() + (plots ? "" : " --no-plots") + " 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  ASSERT_TRUE(fs::exists(out / "error-vs-time.md"));
+  std::ifstream in(out / "error-vs-time.json");
+  const json r = json::parse(in);
+  for (const char* id : {"lightning-tv", "lightning-fd", "fog-tables", "fog-height-march", "tangents", "thin-film"}) {
+    SCOPED_TRACE(id);
+    ASSERT_TRUE(r.contains(id));
+    EXPECT_FALSE(r[id]["conclusion"].get<std::string>().empty());
+    if (plots) {
+      EXPECT_TRUE(fs::exists(out / "error-vs-time" / (std::string(id) + ".png")));
+    }
+  }
+  // DBM: tighter solver tolerance -> closer to the converged distribution.
+  expectShrinks(errorsOf(r["lightning-tv"], "dbm-mgpcg"), "dbm TV over tolerance 1e-2, 1e-4, 1e-6");
+  // Fog tables: more entries -> smaller interpolation error, for every type.
+  for (const char* type : {"EXPONENTIAL", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2", "DISTANCE_GAUSSIAN", "GL_LINEAR", "HEIGHT"})
+    expectShrinks(errorsOf(r["fog-tables"], type), type);
+  // Height fog: more ray-march steps -> closer to the closed form.
+  expectShrinks(errorsOf(r["fog-height-march"], "ray marching"), "ray marching");
+  // Thin film: more wavelength samples -> smaller Delta E against 1 nm.
+  expectShrinks(errorsOf(r["thin-film"], "Airy + CIE 1931"), "thin film");
+  // Tangents: the approximations have a measured, nonzero error against MikkTSpace.
+  for (const char* m : {"perTriangle", "perVertex"}) {
+    auto e = errorsOf(r["tangents"], m);
+    ASSERT_EQ(e.size(), 2u);
+    EXPECT_GT(e[1], 0.1) << m << " on the mirrored torus";
+  }
+  fs::remove_all(out);
+}
+
+}  // namespace
