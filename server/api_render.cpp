@@ -284,6 +284,8 @@ void addRenderEndpoints(Service& service) {
                      {"X-Render-Ms", std::to_string(f.ms)}};
     return reply;
   });
+  // The same scene renders alike on the same renderer: it is part of the render's ETag.
+  service.setEtagSalt("/v1/render", [pool] { return pool->start().empty() ? pool->description() : std::string(); });
 }
 
 }  // namespace effectd

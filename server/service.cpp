@@ -10,6 +10,7 @@
 
 #include <effects/common.h>
 
+#include "codec.h"
 #include "resources.h"
 
 namespace effectd {
@@ -103,6 +104,7 @@ struct Service::Route {
   std::string schema;                // for JSON POST routes
   JsonHandler json;
   std::map<std::string, BinaryHandler> binary;  // by media type
+  std::function<std::string()> etagSalt;
 };
 
 ApiError toApiError(const effects::Error& error, const std::string& prefix) {
@@ -343,15 +345,70 @@ void Service::addReadinessCheck(const std::string& name, std::function<std::stri
   readiness_.emplace_back(name, std::move(probe));
 }
 
+void Service::setEtagSalt(const std::string& path, std::function<std::string()> salt) {
+  for (auto& r : routes_)
+    if (r->path == path) r->etagSalt = std::move(salt);
+}
+
 void Service::addReadinessInfo(const std::string& name, std::function<std::string()> value) {
   info_.emplace_back(name, std::move(value));
 }
 
+namespace {
+
+// True when the request asks for timings in the body ("stats" in any include list): such a
+// response differs from run to run and gets no ETag.
+bool asksForTimings(const json& j) {
+  if (j.is_object()) {
+    for (const auto& [key, value] : j.items()) {
+      if (key == "include" && value.is_array())
+        for (const auto& v : value)
+          if (v == "stats") return true;
+      if (asksForTimings(value)) return true;
+    }
+  } else if (j.is_array()) {
+    for (const auto& v : j)
+      if (asksForTimings(v)) return true;
+  }
+  return false;
+}
+
+// If-None-Match uses the weak comparison (RFC 9110 13.1.2): W/ prefixes are ignored.
+bool matches(const std::string& ifNoneMatch, const std::string& etag) {
+  if (ifNoneMatch.empty()) return false;
+  size_t pos = 0;
+  while (pos < ifNoneMatch.size()) {
+    size_t end = ifNoneMatch.find(',', pos);
+    if (end == std::string::npos) end = ifNoneMatch.size();
+    std::string tag = ifNoneMatch.substr(pos, end - pos);
+    tag.erase(0, tag.find_first_not_of(" \t"));
+    tag.erase(tag.find_last_not_of(" \t") + 1);
+    if (tag.rfind("W/", 0) == 0) tag.erase(0, 2);
+    if (tag == "*" || tag == etag) return true;
+    pos = end + 1;
+  }
+  return false;
+}
+
+}  // namespace
+
 void Service::handleJson(const Route& route, const httplib::Request& req, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_};
+  // Deterministic answers: a strong validator from what determines them, checked before any work.
+  auto etag = [&](const std::string& canonical) {
+    std::string salt = route.etagSalt ? route.etagSalt() : "";
+    return "\"" + sha256Hex(std::string(EFFECTD_VERSION) + "\n" + route.path + "\n" + salt + "\n" + canonical).substr(0, 32) + "\"";
+  };
+  auto notModified = [&](const std::string& tag) {
+    res.set_header("ETag", tag);
+    if (!matches(req.get_header_value("If-None-Match"), tag)) return false;
+    res.status = 304;
+    return true;
+  };
   try {
     std::string type = mediaType(req.get_header_value("Content-Type"));
     if (auto it = route.binary.find(type); it != route.binary.end()) {
+      if (notModified(etag(type + "\n" + req.body))) return;
       BinaryReply reply = it->second(req.body, ctx);
       res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
       if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
@@ -365,6 +422,7 @@ void Service::handleJson(const Route& route, const httplib::Request& req, httpli
       if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
       throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
     }
+    if (!asksForTimings(body) && notModified(etag(body.dump()))) return;
     JsonReply reply = route.json(body, ctx);
     res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
     if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
@@ -374,6 +432,7 @@ void Service::handleJson(const Route& route, const httplib::Request& req, httpli
     else
       res.set_content(reply.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
   } catch (const ApiError& e) {
+    res.headers.erase("ETag");  // problems are not cacheable representations
     writeProblem(res, e, ctx.requestId);
   }
 }

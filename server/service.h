@@ -74,6 +74,9 @@ class Service {
   void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler);
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
+  // Responses carry a strong ETag: SHA-256 of the version, the route, the canonical request
+  // and `salt()` (e.g. the renderer, when the answer depends on it); If-None-Match -> 304.
+  void setEtagSalt(const std::string& path, std::function<std::string()> salt);
   // A fact /readyz reports under "info" (e.g. which renderer is in use).
   void addReadinessInfo(const std::string& name, std::function<std::string()> value);
 

@@ -259,3 +259,40 @@ TEST(Api, HeadOnGetRoutes) {
 
 }  // namespace
 }  // namespace effectd::testing
+
+namespace effectd::testing {
+namespace {
+
+TEST(Api, StrongEtagsAndNotModified) {
+  TestServer s;
+  const std::string body = R"({"fog": {"fogType": "GL_EXP", "density": 0.1}, "table": {"size": 8}})";
+  auto a = s.postJson("/v1/fog", body);
+  ASSERT_TRUE(a);
+  const std::string tag = a->get_header_value("ETag");
+  ASSERT_EQ(tag.size(), 34u) << "a quoted strong validator";
+  EXPECT_EQ(tag.front(), '"');
+  // The canonical request decides: key order and spacing do not.
+  auto b = s.postJson("/v1/fog", std::string(R"({"table":{"size":8},"fog":{"density":0.1,"fogType":"GL_EXP"}})"));
+  EXPECT_EQ(b->get_header_value("ETag"), tag);
+  EXPECT_NE(s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":0.2}})"))->get_header_value("ETag"), tag);
+  // If-None-Match: 304 without a body; other tags, weak forms and lists behave per RFC 9110.
+  httplib::Headers h = {{"If-None-Match", tag}};
+  auto c = s.client().Post("/v1/fog", h, body, "application/json");
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->status, 304);
+  EXPECT_TRUE(c->body.empty());
+  EXPECT_EQ(c->get_header_value("ETag"), tag);
+  h = {{"If-None-Match", "\"other\", W/" + tag}};
+  EXPECT_EQ(s.client().Post("/v1/fog", h, body, "application/json")->status, 304);
+  h = {{"If-None-Match", "\"other\""}};
+  EXPECT_EQ(s.client().Post("/v1/fog", h, body, "application/json")->status, 200);
+  // Timings in the body make it vary: no ETag. Problems have none either.
+  auto d = s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP"},"include":["table","stats"]})"));
+  EXPECT_FALSE(d->has_header("ETag"));
+  auto e = s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":-1}})"));
+  EXPECT_EQ(e->status, 400);
+  EXPECT_FALSE(e->has_header("ETag"));
+}
+
+}  // namespace
+}  // namespace effectd::testing
