@@ -98,7 +98,7 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
   if (glm::length(forward) < 1e-12)
     throw ApiError{400, "invalid-field", "Invalid field", "/camera/target: must differ from the camera position",
                    {{"/camera/target", "must differ from the camera position"}}, {}};
-  if (glm::length(glm::cross(forward, s.camera.up)) < 1e-12 * glm::length(forward) * glm::length(s.camera.up))
+  if (!(glm::length(glm::cross(forward, s.camera.up)) > 1e-12 * glm::length(forward) * glm::length(s.camera.up)))
     throw ApiError{400, "invalid-field", "Invalid field", "/camera/up: must not be parallel to the view direction",
                    {{"/camera/up", "must not be parallel to the view direction (or zero)"}}, {}};
   if (!(s.camera.farPlane > s.camera.nearPlane))

@@ -226,17 +226,28 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
     if (it == s.end()) continue;
     size_t matches = 0;
     std::vector<SchemaViolation> firstErrors;
+    std::vector<std::string> missing;  // branches that fail only for a missing member
     for (const auto& branch : *it) {
       Ctx sub{{}, 4};
       check(branch, doc, v, ptr, sub);
       if (sub.errors.empty()) ++matches;
       else if (firstErrors.empty() || sub.errors.front().pointer.size() > firstErrors.front().pointer.size())
         firstErrors = sub.errors;  // the branch that got deepest is the one the client meant
+      if (sub.errors.size() == 1 && sub.errors.front().message == "is required" &&
+          sub.errors.front().pointer.rfind(ptr + "/", 0) == 0)
+        missing.push_back(sub.errors.front().pointer.substr(ptr.size() + 1));
     }
     bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
     if (!ok) {
-      if (matches > 1) ctx.add(ptr, "matches more than one alternative");
-      else for (auto& e : firstErrors) ctx.add(e.pointer, e.message);
+      if (matches > 1) {
+        ctx.add(ptr, "matches more than one alternative");
+      } else if (missing.size() == it->size()) {  // none of the alternatives' members given
+        std::string names;
+        for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;
+        ctx.add(ptr, "needs one of: " + names);
+      } else {
+        for (auto& e : firstErrors) ctx.add(e.pointer, e.message);
+      }
     }
   }
   if (auto it = s.find("allOf"); it != s.end()) {

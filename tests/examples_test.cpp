@@ -2,9 +2,14 @@
 //   proto/examples/<endpoint>/*.json  valid bodies for POST /v1/<endpoint> -> 2xx
 //   proto/examples/invalid/*.json     {endpoint, body | rawBody, expect: {status, pointer}}
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <sstream>
 
+#include <malloc.h>
+#include <unistd.h>
+
+#include "codec.h"
 #include "test_server.h"
 
 namespace effectd::testing {
@@ -52,23 +57,59 @@ TEST(Examples, EveryValidExampleIsServed) {
   EXPECT_GE(count, 5u);
 }
 
+// The request bytes of an invalid case: body (JSON), rawBody (text), rawBodyBase64 (any
+// bytes, e.g. invalid UTF-8 or a broken GLB) or generate (prefix + repeat * count + suffix,
+// for 10 MB strings and 10^5-deep nesting without 10 MB files).
+std::string bodyOf(const json& c) {
+  if (c.contains("rawBody")) return c["rawBody"].get<std::string>();
+  if (c.contains("rawBodyBase64")) return *base64Decode(c["rawBodyBase64"].get<std::string>());
+  if (c.contains("generate")) {
+    const json& g = c["generate"];
+    std::string out = g["prefix"].get<std::string>();
+    const std::string unit = g["repeat"].get<std::string>();
+    for (size_t i = 0, n = g["count"].get<size_t>(); i < n; ++i) out += unit;
+    return out + g["suffix"].get<std::string>();
+  }
+  return c["body"].dump();
+}
+
+// Resident set size of this process (the server runs in it), in bytes.
+size_t residentBytes() {
+  std::ifstream statm("/proc/self/statm");
+  size_t pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * size_t(sysconf(_SC_PAGESIZE));
+}
+
 TEST(Examples, EveryInvalidExampleIsRefusedNamingTheField) {
   TestServer s;
   auto files = filesIn(fs::path(EFFECTD_PROTO_DIR) / "examples" / "invalid");
-  ASSERT_FALSE(files.empty());
-  for (const auto& file : files) {
-    SCOPED_TRACE(file.string());
-    json c = json::parse(slurp(file));
-    std::string body = c.contains("rawBody") ? c["rawBody"].get<std::string>() : c["body"].dump();
-    std::string type = c.value("contentType", "application/json");
-    auto r = s.client().Post(c["endpoint"].get<std::string>().c_str(), body, type.c_str());
-    int status = c["expect"]["status"];
-    auto p = expectProblem(r, status);
-    std::string pointer = c["expect"].value("pointer", "");
-    if (!pointer.empty()) {
-      EXPECT_TRUE(hasPointer(p, pointer)) << "expected pointer " << pointer << " in " << p.dump();
+  ASSERT_GE(files.size(), 150u);
+  std::map<std::string, int> perEndpoint;
+  // Twice: the second pass must not grow the process (no leak, no cache growing per request).
+  size_t afterFirst = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const auto& file : files) {
+      SCOPED_TRACE(file.string());
+      json c = json::parse(slurp(file));
+      std::string body = bodyOf(c);
+      std::string type = c.value("contentType", "application/json");
+      auto r = s.client().Post(c["endpoint"].get<std::string>().c_str(), body, type.c_str());
+      int status = c["expect"]["status"];
+      auto p = expectProblem(r, status);
+      std::string pointer = c["expect"].value("pointer", "");
+      if (!pointer.empty()) {
+        EXPECT_TRUE(hasPointer(p, pointer)) << "expected pointer " << pointer << " in " << p.dump().substr(0, 500);
+      }
+      if (pass == 0) ++perEndpoint[c["endpoint"].get<std::string>()];
     }
+    malloc_trim(0);
+    if (pass == 0) afterFirst = residentBytes();
   }
+  const size_t afterSecond = residentBytes();
+  EXPECT_LT(double(afterSecond), double(afterFirst) * 1.10 + 8e6) << afterFirst << " -> " << afterSecond << " bytes";
+  for (const char* ep : {"/v1/fog", "/v1/lightning", "/v1/tangents", "/v1/bubble", "/v1/render", "/v1/scene"})
+    EXPECT_GE(perEndpoint[ep], 10) << ep;
   auto r = s.client().Get("/healthz");  // still serving
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200);
