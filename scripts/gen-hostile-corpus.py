@@ -161,6 +161,7 @@ case("g-bubble-radius-zero", B, 400, "/mesh/radius", body={"mesh": {"radius": 0}
 case("g-bubble-radius-negative-zero", B, 400, "/mesh/radius", rawBody='{"mesh": {"radius": -0.0}, "include": ["mesh"]}')
 case("g-bubble-level-negative", B, 400, "/mesh/level", body={"mesh": {"level": -1}, "include": ["mesh"]})
 case("g-bubble-wavelengths-two", B, 400, "/thinFilm/wavelengths", body={"thinFilm": {"wavelengths": 2}, "include": ["thinFilm"]})
+case("g-bubble-thin-film-over-limit", B, 413, "/thinFilm/width", body={"thinFilm": {"width": 4096, "height": 4096}, "include": ["thinFilm"]})
 case("g-bubble-thin-film-width-huge", B, 400, "/thinFilm/width", body={"thinFilm": {"width": 100000}, "include": ["thinFilm"]})
 case("g-bubble-motion-s-above-one", B, 400, "/motion/s", body={"motion": {"from": [0, 0, 0], "to": [1, 1, 1], "s": 1.5}})
 case("g-bubble-motion-missing-to", B, 400, "/motion/to", body={"motion": {"from": [0, 0, 0], "s": 0.5}})

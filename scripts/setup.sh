@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   glslang-tools
   gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
+  clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node

@@ -39,7 +39,7 @@ bb::Features parseBubbleFeatures(const json& j) {
   return f;
 }
 
-bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params) {
+bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const Config& config) {
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
   bb::ThinFilmOptions o;
@@ -49,6 +49,13 @@ bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params) 
   o.height = tf.value("height", 256);
   o.thicknessMinNm = range[0].get<double>();
   o.thicknessMaxNm = range[1].get<double>();
+  if (size_t(o.width) * size_t(o.height) > config.limits.maxThinFilmTexels)
+    throw ApiError{413, "limit-exceeded", "Request exceeds a configured limit",
+                   "/thinFilm/width: a " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                       " table exceeds the limit of " + std::to_string(config.limits.maxThinFilmTexels) +
+                       " texels (--max-thin-film-texels)",
+                   {{"/thinFilm/width", "width*height exceeds the limit of " + std::to_string(config.limits.maxThinFilmTexels) + " texels"}},
+                   {}};
   return o;
 }
 
@@ -78,7 +85,7 @@ json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std:
 
 }  // namespace
 
-JsonReply handleBubble(const json& body, const RequestContext&) {
+JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   Includes include(body, {"uniforms", "shader"});
   const bb::Params params = parseBubbleParams(body.value("params", json::object()));
   const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
@@ -139,7 +146,7 @@ JsonReply handleBubble(const json& body, const RequestContext&) {
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
   if (include.has("thinFilm")) {
-    const bb::ThinFilmOptions o = thinFilmOptions(body, params);
+    const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config);
     auto r = bb::thinFilmTable(o);
     if (!r.ok()) {
       effects::Error e = r.error();

@@ -201,7 +201,7 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
       }
       b.mesh = std::move(mesh.value());
       if (b.features.iridescence) {
-        bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params);
+        bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config);
         tf.measureError = false;
         auto table = cachedThinFilm(tf);
         b.thinFilm = table->rgb;

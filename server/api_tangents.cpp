@@ -42,6 +42,8 @@ void flipW(tg::Output& out) {
   for (auto& t : out.tangents) t.w = -t.w;
 }
 
+}  // namespace
+
 JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   Includes include(body, {"tangents", "remap", "indices"});
   const json& m = body["mesh"];
@@ -100,6 +102,8 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
 }
 
 // ---- binary glTF ---------------------------------------------------------------------------
+
+namespace {
 
 ApiError gltfProblem(int status, const glb::Problem& p) {
   std::string where = p.pointer.empty() ? "body" : p.pointer;
@@ -188,6 +192,8 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
   return true;
 }
 
+}  // namespace
+
 BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
   glb::Asset asset;
   check(glb::parse(body, asset), 400);
@@ -214,8 +220,6 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
   reply.contentType = "model/gltf-binary";
   return reply;
 }
-
-}  // namespace
 
 void addTangentsEndpoints(Service& service) {
   service.addJsonEndpoint("/v1/tangents", "tangents.json", handleTangents);

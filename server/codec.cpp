@@ -50,6 +50,9 @@ std::optional<std::string> base64Decode(std::string_view in) {
       if (pad || rev[uint8_t(c)] < 0) return std::nullopt;  // data after padding, or bad char
       v = v << 6 | uint32_t(rev[uint8_t(c)]);
     }
+    // Canonical encodings only (RFC 4648 3.5): the bits padding leaves unused must be zero,
+    // so every byte string has exactly one accepted text.
+    if ((pad == 1 && (v & 0xFF)) || (pad == 2 && (v & 0xFFFF))) return std::nullopt;
     out += char(v >> 16);
     if (pad < 2) out += char((v >> 8) & 255);
     if (pad < 1) out += char(v & 255);

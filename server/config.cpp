@@ -74,6 +74,8 @@ const std::vector<Option>& options() {
        limitField(&Limits::maxMeshTriangles, 1, 1LL << 28)},
       {"max-render-pixels", "EFFECTD_MAX_RENDER_PIXELS", "render width*height and decoded image pixels (default 16777216)",
        limitField(&Limits::maxRenderPixels, 1, 1LL << 28)},
+      {"max-thin-film-texels", "EFFECTD_MAX_THIN_FILM_TEXELS", "bubble thin-film table width*height (default 1048576)",
+       limitField(&Limits::maxThinFilmTexels, 4, 1LL << 26)},
       {"render-threads", "EFFECTD_RENDER_THREADS", "render threads, one EGL context each (default 2)",
        intField(&Config::renderThreads, 1, 64)},
       {"render-queue", "EFFECTD_RENDER_QUEUE", "renders waiting beyond the running ones before 503 (default 8)",

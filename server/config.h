@@ -16,6 +16,7 @@ struct Limits {
   size_t maxMeshVertices = 2'000'000;  // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;
   size_t maxRenderPixels = 4096u * 4096u;  // render width*height, and decoded background images
+  size_t maxThinFilmTexels = 1024u * 1024u;  // bubble thin-film table width*height
 };
 
 struct Config {

@@ -28,6 +28,8 @@ void addRenderEndpoints(Service& service);
 JsonReply handleFog(const nlohmann::json& body, const RequestContext& ctx);
 JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx);
 JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
+JsonReply handleTangents(const nlohmann::json& body, const RequestContext& ctx);
+BinaryReply handleGlb(const std::string& body, const RequestContext& ctx);  // model/gltf-binary
 effects::fog::Fog parseFog(const nlohmann::json& j, const std::string& pointer);
 effects::fog::Region parseRegion(const nlohmann::json& j, const std::string& pointer);
 struct LightningRequest {
@@ -38,7 +40,8 @@ LightningRequest parseLightning(const nlohmann::json& body, const Config& config
 effects::lightning::Bolt growBolt(const effects::lightning::Params& params);  // throws ApiError
 effects::bubble::Params parseBubbleParams(const nlohmann::json& j);
 effects::bubble::Features parseBubbleFeatures(const nlohmann::json& j);
-effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params);
+effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
+                                                 const Config& config);  // throws 413 over --max-thin-film-texels
 
 // --- helpers shared by the api_*.cpp files ---
 glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers

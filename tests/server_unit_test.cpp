@@ -68,6 +68,11 @@ TEST(Codec, Base64RoundTripAndStrictness) {
   EXPECT_FALSE(base64Decode("Zm9v YmFy"));
   EXPECT_FALSE(base64Decode("Zm=v"));
   EXPECT_FALSE(base64Decode("Z==="));
+  // Non-canonical: bits left over by the padding must be zero (found by fuzz_base64).
+  EXPECT_TRUE(base64Decode("Zm8="));
+  EXPECT_FALSE(base64Decode("Zm9="));
+  EXPECT_TRUE(base64Decode("Zg=="));
+  EXPECT_FALSE(base64Decode("Zh=="));
 }
 
 TEST(Codec, HalfFloats) {

@@ -1,0 +1,64 @@
+// libFuzzer: a JSON request body through the real path — parse (depth-capped), schema
+// validation, the endpoint's handler — for every JSON endpoint. The first byte picks the
+// endpoint. Limits are small so that valid inputs stay fast; ApiError is the expected way out.
+#include <cstdint>
+#include <string>
+
+#include "endpoints.h"
+#include "scene.h"
+#include "service.h"
+
+namespace {
+
+using nlohmann::json;
+using effectd::JsonReply;
+using effectd::RequestContext;
+
+effectd::Config fuzzConfig() {
+  effectd::Config c;
+  c.limits.maxGridCells = 64 * 64;
+  c.limits.maxGrowthSteps = 20000;
+  c.limits.maxTableSize = 4096;
+  c.limits.maxMeshVertices = 4096;
+  c.limits.maxMeshTriangles = 8192;
+  c.limits.maxRenderPixels = 64 * 64;
+  c.limits.maxThinFilmTexels = 64 * 64;
+  return c;
+}
+
+struct Endpoint {
+  const char* schema;
+  JsonReply (*handle)(const json&, const RequestContext&);
+};
+
+JsonReply buildOnly(const json& body, const RequestContext& ctx) {  // no GL in a fuzzer
+  (void)effectd::buildScene(body, ctx.config);
+  return {};
+}
+
+const Endpoint kEndpoints[] = {{"fog.json", effectd::handleFog},
+                               {"lightning.json", effectd::handleLightning},
+                               {"tangents.json", effectd::handleTangents},
+                               {"bubble.json", effectd::handleBubble},
+                               {"scene.json", buildOnly}};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const effectd::Config config = fuzzConfig();
+  static effectd::Service service(config);  // its schema registry; it never listens
+  if (size < 1) return 0;
+  const Endpoint& e = kEndpoints[data[0] % (sizeof kEndpoints / sizeof kEndpoints[0])];
+  const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
+  json::parser_callback_t depth = [](int d, json::parse_event_t, json&) { return d <= 64; };
+  json body = json::parse(text, depth, /*allow_exceptions=*/false);
+  if (body.is_discarded()) return 0;
+  if (!service.schemas().validate(e.schema, body).empty()) return 0;
+  try {
+    RequestContext ctx{"fuzz", config};
+    JsonReply r = e.handle(body, ctx);
+    (void)r.body.dump(-1, ' ', false, json::error_handler_t::replace);
+  } catch (const effectd::ApiError&) {
+  }
+  return 0;
+}
