@@ -11,6 +11,7 @@ PACKAGES=(
   glslang-tools
   gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
+  wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node

@@ -22,7 +22,8 @@ struct Limits {
 struct Config {
   std::string host = "127.0.0.1";
   int port = 8080;
-  int threads = 8;
+  int threads = 8;            // HTTP threads kept ready
+  int maxConnections = 512;   // connections served at once (one thread each); more wait
   int readTimeoutS = 10;
   int writeTimeoutS = 10;
   int keepAliveTimeoutS = 5;

@@ -18,24 +18,34 @@ grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; ex
 
 curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'
 
-# A request that takes a while (a large fog table with dense error measurement), then SIGTERM.
-body='{"fog":{"fogType":"HEIGHT","density":0.1},"table":{"size":256,"elevations":256}}'
-curl -s -o /tmp/effectd_inflight.$$ -w '%{http_code}' -H 'Content-Type: application/json' \
-  -d "$body" "http://127.0.0.1:$port/v1/fog" > /tmp/effectd_code.$$ &
-curlpid=$!
-sleep 0.05
+# SIGTERM under load: eight slow requests in flight (DBM bolts with plain CG, and renders);
+# once the server has them all, SIGTERM: every one completes with 200 and the process exits 0.
+body='{"grid":{"width":96,"height":96},"start":[48,0],"targets":[[48,95]],"method":"dbm","solver":"cg"}'
+scene='{"width":256,"height":256,"lightning":{"grid":{"width":64,"height":64},"start":[32,0],"targets":[[32,63]]}}'
+curlpids=()
+for i in $(seq 8); do
+  if [ $((i % 2)) -eq 0 ]; then path=/v1/render data=$scene; else path=/v1/lightning data=$body; fi
+  curl -s -o /dev/null -w '%{http_code}' -H 'Content-Type: application/json' \
+    -d "$data" "http://127.0.0.1:$port$path" > /tmp/effectd_code.$$.$i &
+  curlpids+=($!)
+done
+for _ in $(seq 200); do  # the metrics request itself is the ninth
+  inflight=$(curl -s "http://127.0.0.1:$port/metrics" | awk '/^effectd_http_requests_in_flight/ {print $2}')
+  [ "${inflight:-0}" -ge 9 ] && break
+  sleep 0.02
+done
 kill -TERM "$pid"
-wait "$curlpid"
+for c in "${curlpids[@]}"; do wait "$c"; done
 set +e
 wait "$pid"
 rc=$?
 set -e
-code=$(cat /tmp/effectd_code.$$)
-rm -f /tmp/effectd_inflight.$$ /tmp/effectd_code.$$
+codes=$(cat /tmp/effectd_code.$$.* | tr -d '\n')
+rm -f /tmp/effectd_code.$$.*
 [ "$rc" -eq 0 ] || { echo "exit code $rc"; cat "$log"; exit 1; }
-[ "$code" = "200" ] || { echo "in-flight request got $code"; cat "$log"; exit 1; }
+[ "$codes" = "200200200200200200200200" ] || { echo "in-flight requests got $codes"; cat "$log"; exit 1; }
 grep -q '"stopped"' "$log"
-grep -q '"path":"/v1/fog","status":200' "$log" || { echo "no access log line"; cat "$log"; exit 1; }
+grep -q '"path":"/v1/lightning","status":200' "$log" || { echo "no access log line"; cat "$log"; exit 1; }
 # The command-line renderer: a scene file to a PNG, no server.
 scene=$(dirname "$0")/../examples/01-lightning.json
 png=/tmp/effectd_render.$$.png
