@@ -180,7 +180,8 @@ class ElasticPool : public httplib::TaskQueue {
   void enqueue(std::function<void()> fn) override {
     std::unique_lock<std::mutex> lock(mu_);
     jobs_.push_back(std::move(fn));
-    if (idle_ == 0 && threads_.size() < max_) spawn();
+    // Idle threads may not have woken for earlier jobs yet: count jobs, not wake-ups.
+    if (jobs_.size() > idle_ && threads_.size() < max_) spawn();
     cv_.notify_one();
   }
   void shutdown() override {
