@@ -11,7 +11,7 @@
 
 namespace effectd::testing {
 
-std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
+int connectLoopback(int port) {
   int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
@@ -19,8 +19,14 @@ std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
     ::close(fd);
-    return "";
+    return -1;
   }
+  return fd;
+}
+
+std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
+  int fd = connectLoopback(port);
+  if (fd < 0) return "";
   size_t sent = 0;
   while (sent < bytes.size()) {
     ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);

@@ -1,7 +1,5 @@
 // Faults over real sockets: clients that vanish mid-request and mid-response, slow clients
 // (slowloris), and a service that keeps answering everyone else meanwhile.
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -17,19 +15,6 @@ namespace effectd::testing {
 namespace {
 
 using nlohmann::json;
-
-int connectTo(int port) {
-  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
 
 void sendAll(int fd, const std::string& s) {
   for (size_t sent = 0; sent < s.size();) {
@@ -51,12 +36,12 @@ TEST(Faults, ClientsThatVanishMidRequestOrMidResponse) {
   TestServer s;
   for (int i = 0; i < 20; ++i) {
     // Mid-request: headers promise 1000 bytes, 10 arrive, the client leaves.
-    int fd = connectTo(s.port());
+    int fd = connectLoopback(s.port());
     ASSERT_GE(fd, 0);
     sendAll(fd, "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: 1000\r\n\r\n{\"fog\":{\"");
     ::close(fd);
     // Mid-response: a large answer, of which the client reads a few bytes and leaves.
-    fd = connectTo(s.port());
+    fd = connectLoopback(s.port());
     ASSERT_GE(fd, 0);
     sendAll(fd, "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: " +
                     std::to_string(kBigFog.size()) + "\r\n\r\n" + kBigFog);
@@ -79,7 +64,7 @@ TEST(Faults, SlowClientsDoNotStarveOthers) {
   // Slowloris: twice as many slow connections as worker threads, one header byte every 300 ms.
   std::vector<int> slow;
   for (int i = 0; i < 8; ++i) {
-    int fd = connectTo(s.port());
+    int fd = connectLoopback(s.port());
     ASSERT_GE(fd, 0);
     sendAll(fd, "POST /v1/fog HTTP/1.1\r\nHo");
     slow.push_back(fd);

@@ -58,6 +58,8 @@ class TestServer {
 // Sends raw bytes over a fresh TCP connection and returns everything the server answered
 // until it closed the connection or `timeoutMs` passed.
 std::string rawExchange(int port, const std::string& bytes, int timeoutMs = 3000);
+// A TCP connection to 127.0.0.1:port, or -1.
+int connectLoopback(int port);
 
 // Parses a problem+json response and checks the RFC 9457 members.
 inline nlohmann::json expectProblem(const httplib::Result& r, int status) {
