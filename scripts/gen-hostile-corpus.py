@@ -122,7 +122,9 @@ case("g-lightning-shape-falloff-negative", L, 400, "/shape/branchFalloff", body=
 case("g-lightning-solver-unknown", L, 400, "/solver", body=dict(base, method="dbm", solver="jacobi"))
 case("g-lightning-guide-unknown", L, 400, "/guide", body=dict(base, guide="dijkstra"))
 case("g-lightning-seed-float", L, 400, "/seed", body=dict(base, seed=1.5))
-case("g-lightning-too-many-targets", L, 400, "/targets", body=dict(base, targets=[[8, 15]] * 100000))
+case("g-lightning-too-many-targets", L, 400, "/targets",
+     generate={"prefix": '{"grid": {"width": 16, "height": 16}, "start": [8, 0], "targets": [', "repeat": "[8, 15], ",
+               "count": 100000, "suffix": "[8, 15]]}"})
 
 # ---- tangents -----------------------------------------------------------------------------------
 T = "/v1/tangents"
@@ -214,6 +216,6 @@ for name in sorted(os.listdir(OUT)):
         os.remove(os.path.join(OUT, name))
 for name, c in cases.items():
     with open(os.path.join(OUT, name + ".json"), "w") as f:
-        json.dump(c, f, indent=1)
-        f.write("\n")
+        text = json.dumps(c, indent=1)
+        f.write((text if len(text) < 20000 else json.dumps(c, separators=(",", ":"))) + "\n")
 print(f"wrote {len(cases)} cases")
