@@ -105,6 +105,8 @@ base = VALID[L]
 case("g-lightning-grid-1e308", L, 400, "/grid/width", body=dict(base, grid={"width": 1e308, "height": 16}))
 case("g-lightning-grid-negative-zero", L, 400, "/grid/width", rawBody='{"grid": {"width": -0, "height": 16}, "start": [8, 0], "targets": [[8, 15]]}')
 case("g-lightning-grid-huge-cells", L, 413, "/grid", body=dict(base, grid={"width": 65536, "height": 65536}))
+case("g-lightning-dbm-grid-over-solver-limit", L, 413, "/grid", body=dict(base, grid={"width": 1024, "height": 1024}, method="dbm"))
+case("g-lightning-charges-grid-over-solver-limit", L, 413, "/grid", body=dict(base, grid={"width": 512, "height": 512}, method="charges"))
 case("g-lightning-targets-empty", L, 400, "/targets", body=dict(base, targets=[]))
 case("g-lightning-target-outside", L, 400, "/targets/0", body=dict(base, targets=[[8, 16]]))
 case("g-lightning-target-negative", L, 400, "/targets/0/1", body=dict(base, targets=[[8, -1]]))

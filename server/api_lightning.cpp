@@ -73,6 +73,11 @@ LightningRequest parseLightning(const json& body, const Config& config) {
   for (const auto& t : body["targets"]) p.targets.push_back(cellOf(t));
   const std::string method = body.value("method", "fast");
   p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+  if (p.method != lt::Method::kFast && cells > config.limits.maxSolverGridCells)
+    throw fieldError(413, "/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                                       std::to_string(config.limits.maxSolverGridCells) + " for method " + method +
+                                       " (--max-solver-grid-cells); the fast method takes up to " +
+                                       std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
   p.lifetime = body.value("lifetime", p.lifetime);
   p.solver = body.value("solver", "mgpcg") == "cg" ? lt::Solver::kCg : lt::Solver::kMgpcg;
