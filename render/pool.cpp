@@ -30,11 +30,6 @@ std::string RenderPool::description() {
   return description_;
 }
 
-int RenderPool::queued() {
-  std::lock_guard<std::mutex> lock(mu_);
-  return int(jobs_.size());
-}
-
 std::optional<std::future<Result<Frame>>> RenderPool::submit(Scene scene) {
   if (!start().empty()) {
     std::promise<Result<Frame>> failed;

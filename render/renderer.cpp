@@ -413,7 +413,6 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   Stopwatch watch;
   compiled = 0;
   Frame frame;
-  frame.width = scene.width, frame.height = scene.height, frame.bitDepth = scene.bitDepth;
   if (scene.width < 1 || scene.height < 1 || scene.width > maxTextureSize || scene.height > maxTextureSize)
     return overLimit("/width", "the renderer's largest image side is " + std::to_string(maxTextureSize));
   if (scene.lightning && (scene.lightning->gridWidth < 1 || scene.lightning->gridHeight < 1))
@@ -727,6 +726,5 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::string& platform) 
 
 Result<Frame> Renderer::render(const Scene& scene) { return impl_->render(scene); }
 const std::string& Renderer::description() const { return impl_->description; }
-int Renderer::maxTextureSize() const { return impl_->maxTextureSize; }
 
 }  // namespace effects::render

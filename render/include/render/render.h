@@ -132,7 +132,6 @@ struct Scene {
 };
 
 struct Frame {
-  int width = 0, height = 0, bitDepth = 8;
   Image image;
   std::vector<std::string> passes;  // in the order they ran
   int variantsCompiled = 0;         // shader programs compiled for this frame (0 when all cached)
@@ -153,7 +152,6 @@ class Renderer {
   Result<Frame> render(const Scene& scene);
   // e.g. "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless"
   const std::string& description() const;
-  int maxTextureSize() const;
 
  private:
   Renderer();
@@ -188,8 +186,6 @@ class RenderPool {
   std::string start();
   std::string description();  // the renderer, once started
   int peakBusy() const { return peakBusy_.load(); }
-  int threads() const { return options_.threads; }
-  int queued();
 
  private:
   void worker(int index);
