@@ -50,12 +50,9 @@ bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, 
   o.thicknessMinNm = range[0].get<double>();
   o.thicknessMaxNm = range[1].get<double>();
   if (size_t(o.width) * size_t(o.height) > config.limits.maxThinFilmTexels)
-    throw ApiError{413, "limit-exceeded", "Request exceeds a configured limit",
-                   "/thinFilm/width: a " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                       " table exceeds the limit of " + std::to_string(config.limits.maxThinFilmTexels) +
-                       " texels (--max-thin-film-texels)",
-                   {{"/thinFilm/width", "width*height exceeds the limit of " + std::to_string(config.limits.maxThinFilmTexels) + " texels"}},
-                   {}};
+    throw fieldError(413, "/thinFilm/width",
+                     "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " table exceeds the limit of " +
+                         std::to_string(config.limits.maxThinFilmTexels) + " texels (--max-thin-film-texels)");
   return o;
 }
 

@@ -30,8 +30,7 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
 fog::Region parseRegion(const json& j, const std::string& pointer) {
   fog::Region r;
   if (j.contains("box") == j.contains("sphere"))
-    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": give exactly one of box or sphere",
-                   {{pointer, "give exactly one of box or sphere"}}, {}};
+    throw fieldError(400, pointer, "give exactly one of box or sphere");
   if (j.contains("box")) {
     r.shape = fog::Region::Shape::kBox;
     r.min = toVec3(j["box"]["min"]);
@@ -164,8 +163,7 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
   }
   if (include.has("samples")) {
     if (!body.contains("samples"))
-      throw ApiError{400, "invalid-field", "Invalid field", "/samples: required when include has \"samples\"",
-                     {{"/samples", "is required when include has \"samples\""}}, {}};
+      throw fieldError(400, "/samples", "is required when include has \"samples\"");
     effects::Stopwatch watch;
     glm::dvec3 camera = toVec3(body["samples"]["camera"]);
     json list = json::array();

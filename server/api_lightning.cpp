@@ -10,12 +10,6 @@ namespace {
 using nlohmann::json;
 namespace lt = effects::lightning;
 
-ApiError fieldError(int status, const std::string& pointer, const std::string& message) {
-  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-field",
-                  status == 413 ? "Request exceeds a configured limit" : "Invalid field", pointer + ": " + message,
-                  {{pointer, message}}, {}};
-}
-
 std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
   std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
   bool any = false;

@@ -35,8 +35,7 @@ glm::dvec4 rgba(const json& j) { return {j[0].get<double>(), j[1].get<double>(),
 rd::Image image(const json& base64, const std::string& pointer, const Config& config) {
   auto bytes = base64Decode(base64.get<std::string>());
   if (!bytes)
-    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": is not valid base64",
-                   {{pointer, "is not valid base64 (standard alphabet, padded)"}}, {}};
+    throw fieldError(400, pointer, "is not valid base64 (standard alphabet, padded)");
   auto decoded = rd::decodeImage(*bytes, config.limits.maxRenderPixels);
   if (!decoded.ok()) {
     effects::Error e = decoded.error();
@@ -67,8 +66,7 @@ std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOption
 
 void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
   if (v.x == 0 && v.y == 0 && v.z == 0)
-    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": must not be the zero vector",
-                   {{pointer, "must not be the zero vector"}}, {}};
+    throw fieldError(400, pointer, "must not be the zero vector");
 }
 
 }  // namespace
@@ -79,11 +77,9 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
   s.width = body.value("width", 512);
   s.height = body.value("height", 512);
   if (size_t(s.width) * size_t(s.height) > config.limits.maxRenderPixels)
-    throw ApiError{413, "limit-exceeded", "Request exceeds a configured limit",
-                   "/width: " + std::to_string(s.width) + "x" + std::to_string(s.height) + " exceeds the limit of " +
-                       std::to_string(config.limits.maxRenderPixels) + " pixels (--max-render-pixels)",
-                   {{"/width", "width*height exceeds the limit of " + std::to_string(config.limits.maxRenderPixels) + " pixels"}},
-                   {}};
+    throw fieldError(413, "/width",
+                     std::to_string(s.width) + "x" + std::to_string(s.height) + " exceeds the limit of " +
+                         std::to_string(config.limits.maxRenderPixels) + " pixels (--max-render-pixels)");
   s.bitDepth = body.value("bitDepth", 8);
   s.time = body.value("time", 0.0);
 
@@ -96,14 +92,11 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
   s.camera.farPlane = cam.value("far", s.camera.farPlane);
   const glm::dvec3 forward = s.camera.target - s.camera.position;
   if (glm::length(forward) < 1e-12)
-    throw ApiError{400, "invalid-field", "Invalid field", "/camera/target: must differ from the camera position",
-                   {{"/camera/target", "must differ from the camera position"}}, {}};
+    throw fieldError(400, "/camera/target", "must differ from the camera position");
   if (!(glm::length(glm::cross(forward, s.camera.up)) > 1e-12 * glm::length(forward) * glm::length(s.camera.up)))
-    throw ApiError{400, "invalid-field", "Invalid field", "/camera/up: must not be parallel to the view direction",
-                   {{"/camera/up", "must not be parallel to the view direction (or zero)"}}, {}};
+    throw fieldError(400, "/camera/up", "must not be parallel to the view direction (or zero)");
   if (!(s.camera.farPlane > s.camera.nearPlane))
-    throw ApiError{400, "invalid-field", "Invalid field", "/camera/far: must be greater than near",
-                   {{"/camera/far", "must be greater than near"}}, {}};
+    throw fieldError(400, "/camera/far", "must be greater than near");
 
   if (body.contains("background")) {
     const json& b = body["background"];
@@ -151,8 +144,7 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
       fog.global = parseFog(f["fog"], "/fog");
       if (f.contains("regions")) {
         if (f["regions"].size() > rd::kMaxFogRegions)
-          throw ApiError{422, "invalid-field", "Invalid field", "/regions: a rendered scene takes at most 16 fog regions",
-                         {{"/regions", "a rendered scene takes at most 16 fog regions"}}, {}};
+          throw fieldError(422, "/regions", "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
         for (size_t i = 0; i < f["regions"].size(); ++i)
           fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
       }

@@ -23,8 +23,7 @@ tg::Options options(const Config& config, tg::Mode mode) {
 template <class V, int N>
 std::vector<V> unflatten(const json& a, const std::string& pointer) {
   if (a.size() % N != 0)
-    throw ApiError{400, "invalid-field", "Invalid field", pointer + ": length must be a multiple of " + std::to_string(N),
-                   {{pointer, "length must be a multiple of " + std::to_string(N)}}, {}};
+    throw fieldError(400, pointer, "length must be a multiple of " + std::to_string(N));
   std::vector<V> out(a.size() / N);
   for (size_t i = 0; i < out.size(); ++i)
     for (int c = 0; c < N; ++c) out[i][c] = a[i * N + size_t(c)].get<float>();

@@ -45,6 +45,9 @@ effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, con
 
 // --- helpers shared by the api_*.cpp files ---
 glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers
+// A problem about one field: 400 invalid-field, 413 limit-exceeded, 422 (well-formed but
+// impossible); detail "<pointer>: <message>", errors [{pointer, message}].
+ApiError fieldError(int status, const std::string& pointer, const std::string& message);
 // The body's "include" list as a set test; `defaults` applies when "include" is absent.
 class Includes {
  public:
