@@ -333,12 +333,8 @@ void setBackground(Program& p, const Background& b, const Texture* image) {
 void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
   std::vector<size_t> order(f.regions.size());
   std::iota(order.begin(), order.end(), 0);
-  auto volume = [&](size_t i) {
-    const fog::Region& r = f.regions[i];
-    glm::dvec3 e = r.max - r.min;
-    return r.shape == fog::Region::Shape::kBox ? e.x * e.y * e.z : 4.0 / 3.0 * kPi * r.radius * r.radius * r.radius;
-  };
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return volume(a) < volume(b); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
   std::vector<int> types;
   std::vector<float> params, colors, lo, hi;
   auto add = [&](const fog::Fog& g) {

@@ -178,25 +178,30 @@ std::optional<Error> validate(const Region& r) {
   return std::nullopt;
 }
 
+double volume(const Region& r) {
+  if (r.shape == Region::Shape::kBox) {
+    glm::dvec3 e = r.max - r.min;
+    return e.x * e.y * e.z;
+  }
+  return 4.0 / 3.0 * 3.14159265358979323846 * r.radius * r.radius * r.radius;
+}
+
 int regionAt(const std::vector<Region>& regions, const glm::dvec3& p) {
   int best = -1;
   double bestVolume = kInf;
   for (size_t i = 0; i < regions.size(); ++i) {
     const Region& r = regions[i];
-    double volume;
     bool inside;
     if (r.shape == Region::Shape::kBox) {
       inside = p.x >= r.min.x && p.x <= r.max.x && p.y >= r.min.y && p.y <= r.max.y && p.z >= r.min.z && p.z <= r.max.z;
-      glm::dvec3 e = r.max - r.min;
-      volume = e.x * e.y * e.z;
     } else {
       glm::dvec3 d = p - r.center;
       inside = glm::dot(d, d) <= r.radius * r.radius;
-      volume = 4.0 / 3.0 * 3.14159265358979323846 * r.radius * r.radius * r.radius;
     }
-    if (inside && (best < 0 || volume < bestVolume)) {
+    const double v = volume(r);
+    if (inside && (best < 0 || v < bestVolume)) {
       best = static_cast<int>(i);
-      bestVolume = volume;
+      bestVolume = v;
     }
   }
   return best;

@@ -94,6 +94,7 @@ struct Region {
   Fog fog;
 };
 std::optional<Error> validate(const Region& region);
+double volume(const Region& region);  // what "innermost" compares
 // Index of the region that applies at `point`, or -1 for the global fog.
 int regionAt(const std::vector<Region>& regions, const glm::dvec3& point);
 
