@@ -229,6 +229,8 @@ struct Renderer::Impl {
   std::map<std::string, Program> programs;
   int compiled = 0;
   Texture normalA, normalB, waveAlpha, defaultFlow;
+  std::vector<float> waveVertices;  // the surface-wave quad with its MikkTSpace frames
+  std::vector<uint32_t> waveIndices;
 
   ~Impl() {
     if (egl.context) {
@@ -281,13 +283,32 @@ struct Renderer::Impl {
     return defaultFlow;
   }
 
-  void ensureWaveTextures() {
-    if (normalA.id) return;
+  // Generated once per context: the two normal maps, the alpha texture, and the quad with
+  // its MikkTSpace frames (seed 004's TBN for the ripple lighting).
+  std::optional<Error> ensureWave() {
+    if (normalA.id) return std::nullopt;
+    tangents::Mesh quad{{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
+                        {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}},
+                        {{0, 0}, {1, 0}, {1, 1}, {0, 1}},
+                        {0, 1, 2, 0, 2, 3}};
+    auto frames = tangents::generate(quad, tangents::Options{});
+    if (!frames.ok()) return frames.error();
+    const auto& out = frames.value();
+    for (size_t i = 0; i < out.remap.size(); ++i) {
+      uint32_t src = out.remap[i];
+      const glm::vec3& p = quad.positions[src];
+      const glm::vec2& uv = quad.uvs[src];
+      const glm::vec3& n = out.normals[i];
+      const glm::vec4& t = out.tangents[i];
+      waveVertices.insert(waveVertices.end(), {p.x, p.y, uv.x, uv.y, n.x, n.y, n.z, t.x, t.y, t.z, t.w});
+    }
+    waveIndices = out.indices;
     auto a = normalMap(256, 3), b = normalMap(256, 7);
     normalA = texture2D(256, 256, GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, a.data());
     normalB = texture2D(256, 256, GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, b.data());
     auto alpha = softPattern(128, 1, 5, 0.2, 1.0);
     waveAlpha = texture2D(128, 128, GL_R8, GL_RED, GL_UNSIGNED_BYTE, alpha.data());
+    return std::nullopt;
   }
 
   Result<Frame> render(const Scene& scene);
@@ -450,26 +471,10 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   // Seed 000 section 2.2: the surface-wave quad, lit through its MikkTSpace frames.
   if (scene.wave) {
     const SurfaceWave& w = *scene.wave;
-    ensureWaveTextures();
-    tangents::Mesh quad{{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
-                        {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}},
-                        {{0, 0}, {1, 0}, {1, 1}, {0, 1}},
-                        {0, 1, 2, 0, 2, 3}};
-    auto frames = tangents::generate(quad, tangents::Options{});
-    if (!frames.ok()) return frames.error();
-    const auto& out = frames.value();
-    std::vector<float> data;
-    for (size_t i = 0; i < out.remap.size(); ++i) {
-      uint32_t src = out.remap[i];
-      const glm::vec3& p = quad.positions[src];
-      const glm::vec2& uv = quad.uvs[src];
-      const glm::vec3& n = out.normals[i];
-      const glm::vec4& t = out.tangents[i];
-      data.insert(data.end(), {p.x, p.y, uv.x, uv.y, n.x, n.y, n.z, t.x, t.y, t.z, t.w});
-    }
+    if (auto e = ensureWave()) return *e;
     TRY(p, program("wave", waveVertex(), waveFragment()));
     glUseProgram(p.id);
-    Vertices mesh(data, {2, 2, 3, 4}, &out.indices);
+    Vertices mesh(waveVertices, {2, 2, 3, 4}, &waveIndices);
     // Scroll offsets reduced modulo 1 in double: hours of play keep full float precision.
     const double s = w.speed * scene.time;
     auto wrap = [](double x) { return float(x - std::floor(x)); };
@@ -481,7 +486,7 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
     p.set("uLightColor", glm::vec3(w.lightColor)), p.set("uLight", glm::vec3(w.lightDirection));
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    glDrawElements(GL_TRIANGLES, GLsizei(out.indices.size()), GL_UNSIGNED_INT, nullptr);
+    glDrawElements(GL_TRIANGLES, GLsizei(waveIndices.size()), GL_UNSIGNED_INT, nullptr);
     glDisable(GL_BLEND);
     glBindVertexArray(emptyVao);
     frame.passes.push_back("surfaceWave");
