@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
       }
       auto png = rd::encodePng(f.value().image, 8);
       if (i == 0) {  // the first frame compiles the variants: not counted
-        for (const auto& p : f.value().passes) passes += (passes.empty() ? "" : ",") + p;
+        passes = f.value().passList();
         continue;
       }
       frame.push_back(f.value().ms);

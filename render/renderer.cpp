@@ -700,6 +700,12 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   return frame;
 }
 
+std::string Frame::passList() const {
+  std::string out;
+  for (const auto& p : passes) out += (out.empty() ? "" : ",") + p;
+  return out;
+}
+
 Renderer::Renderer() : impl_(std::make_unique<Impl>()) {}
 Renderer::~Renderer() = default;
 

@@ -261,17 +261,13 @@ void addRenderEndpoints(Service& service) {
     effects::Stopwatch encode;
     auto png = rd::encodePng(f.image, bitDepth);
     if (!png.ok()) throwError(png.error());
-    std::string passes;
-    for (const auto& p : f.passes) {
-      passes += (passes.empty() ? "" : ",") + p;
-      metrics->count("render_passes", p);
-    }
+    for (const auto& p : f.passes) metrics->count("render_passes", p);
     metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
     reply.computeMs += f.ms + encode.ms();
     reply.binary = std::move(png.value());
     reply.contentType = "image/png";
     reply.headers = {{"X-Renderer", pool->description()},
-                     {"X-Render-Passes", passes},
+                     {"X-Render-Passes", f.passList()},
                      {"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
                      {"X-Render-Ms", std::to_string(f.ms)}};
     return reply;

@@ -75,8 +75,7 @@ int renderCommand(std::vector<std::string> args) {
       std::fprintf(stderr, "effectd render: cannot write %s\n", outPath.c_str());
       return 1;
     }
-    std::string passes;
-    for (const auto& p : frame.value().passes) passes += (passes.empty() ? "" : ",") + p;
+    const std::string passes = frame.value().passList();
     std::fprintf(stderr, "{\"renderer\":\"%s\",\"passes\":\"%s\",\"renderMs\":%.2f,\"bytes\":%zu}\n",
                  renderer.value()->description().c_str(), passes.c_str(), frame.value().ms, png.value().size());
     return 0;

@@ -137,6 +137,7 @@ struct Frame {
   int variantsCompiled = 0;         // shader programs compiled for this frame (0 when all cached)
   int variantsCached = 0;           // programs in this context's cache afterwards
   double ms = 0;                    // GPU work including read-back
+  std::string passList() const;     // "background,quads,...": the passes, comma-separated
 };
 
 // Which EGL platform to use: "auto" (device, then surfaceless), "device" or "surfaceless".
