@@ -24,15 +24,18 @@ int connectLoopback(int port) {
   return fd;
 }
 
+void sendAll(int fd, const std::string& bytes) {
+  for (size_t sent = 0; sent < bytes.size();) {
+    ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) return;
+    sent += size_t(n);
+  }
+}
+
 std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
   int fd = connectLoopback(port);
   if (fd < 0) return "";
-  size_t sent = 0;
-  while (sent < bytes.size()) {
-    ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
-    if (n <= 0) break;
-    sent += size_t(n);
-  }
+  sendAll(fd, bytes);
   std::string out;
   char buf[4096];
   pollfd p{fd, POLLIN, 0};

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <map>
 #include <fstream>
-#include <sstream>
 
 #include <malloc.h>
 #include <unistd.h>
@@ -18,13 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<fs::path> filesIn(const fs::path& dir) {
   std::vector<fs::path> out;

@@ -16,14 +16,6 @@ namespace {
 
 using nlohmann::json;
 
-void sendAll(int fd, const std::string& s) {
-  for (size_t sent = 0; sent < s.size();) {
-    ssize_t n = ::send(fd, s.data() + sent, s.size() - sent, MSG_NOSIGNAL);
-    if (n <= 0) return;
-    sent += size_t(n);
-  }
-}
-
 void expectHealthy(const TestServer& s) {
   auto r = s.client().Get("/healthz");
   ASSERT_TRUE(r);

@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
-#include <iterator>
 
 #include <glm/geometric.hpp>
 #include <render/render.h>
@@ -23,11 +22,6 @@ namespace {
 using nlohmann::json;
 namespace rd = effects::render;
 namespace fs = std::filesystem;
-
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 rd::Image decode(const std::string& png) {
   auto img = rd::decodeImage(png, size_t(1) << 28);
@@ -50,7 +44,7 @@ TEST(Render, ExampleScenesMatchTheirGoldenImages) {
     if (entry.path().extension() != ".json") continue;
     ++scenes;
     SCOPED_TRACE(entry.path().filename().string());
-    auto r = s.postJson("/v1/render", readFile(entry.path()));
+    auto r = s.postJson("/v1/render", slurp(entry.path()));
     ASSERT_TRUE(r);
     ASSERT_EQ(r->status, 200) << r->body;
     EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
@@ -61,7 +55,7 @@ TEST(Render, ExampleScenesMatchTheirGoldenImages) {
       continue;
     }
     ASSERT_TRUE(fs::exists(golden)) << golden << " is missing: run with EFFECTD_UPDATE_GOLDEN=1";
-    rd::Image got = decode(r->body), want = decode(readFile(golden));
+    rd::Image got = decode(r->body), want = decode(slurp(golden));
     ASSERT_EQ(got.width, want.width);
     ASSERT_EQ(got.height, want.height);
     // Tolerance: llvmpipe builds and GPUs may differ by rounding at edges, not in content.

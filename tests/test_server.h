@@ -3,6 +3,9 @@
 
 #include <httplib.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <thread>
@@ -60,6 +63,14 @@ class TestServer {
 std::string rawExchange(int port, const std::string& bytes, int timeoutMs = 3000);
 // A TCP connection to 127.0.0.1:port, or -1.
 int connectLoopback(int port);
+// Writes all of `bytes` to a socket (stops quietly when the peer has gone).
+void sendAll(int fd, const std::string& bytes);
+
+// A whole file as bytes.
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 // Parses a problem+json response and checks the RFC 9457 members.
 inline nlohmann::json expectProblem(const httplib::Result& r, int status) {
