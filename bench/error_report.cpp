@@ -25,7 +25,7 @@
 #include <effects/lightning.h>
 #include <effects/tangents.h>
 
-#include "meshes.h"
+#include "fixtures.h"
 
 namespace {
 
@@ -82,15 +82,6 @@ struct LightningSetting {
   lt::Params params;
 };
 
-lt::Params layout(int n) {
-  lt::Params p;
-  p.width = p.height = n;
-  p.start = {n / 2, 0};
-  p.targets = {{n / 2, n - 1}};
-  p.eta = 2;
-  return p;
-}
-
 double dimensionOf(const lt::Bolt& b, int n) {
   std::vector<lt::Cell> cells;
   for (const auto& node : b.nodes) cells.push_back(node.cell);
@@ -108,11 +99,11 @@ void lightning(bool quick, Section& tv, Section& fd) {
   for (int n : sizes) {
     std::vector<LightningSetting> settings;
     for (int life : {2, 4, 8, 0}) {
-      lt::Params p = layout(n);
+      lt::Params p = bench::lightningLayout(n);
       p.lifetime = life;
       settings.push_back({"fast", "lifetime " + (life ? std::to_string(life) : std::string("inf")), p});
     }
-    lt::Params c = layout(n);
+    lt::Params c = bench::lightningLayout(n);
     c.method = lt::Method::kCharges;
     settings.push_back({"charges", "charges", c});
     std::vector<double> tolerances;
@@ -123,7 +114,7 @@ void lightning(bool quick, Section& tv, Section& fd) {
     for (lt::Solver solver : {lt::Solver::kMgpcg, lt::Solver::kCg}) {
       if (solver == lt::Solver::kCg && (quick || n > 128)) continue;
       for (double tol : tolerances) {
-        lt::Params p = layout(n);
+        lt::Params p = bench::lightningLayout(n);
         p.method = lt::Method::kDbm;
         p.solver = solver;
         p.tolerance = tol;
@@ -146,7 +137,7 @@ void lightning(bool quick, Section& tv, Section& fd) {
     // Reference dimension: DBM at tolerance 1e-8 (MGPCG).
     std::vector<double> refD;
     {
-      lt::Params p = layout(n);
+      lt::Params p = bench::lightningLayout(n);
       p.method = lt::Method::kDbm;
       p.tolerance = 1e-8;
       const int seeds = quick ? 3 : n == 64 ? 10 : n == 128 ? 5 : 1;

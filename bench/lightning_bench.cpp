@@ -13,19 +13,13 @@
 
 #include <effects/lightning.h>
 
+#include "fixtures.h"
+
 namespace {
 
 using namespace effects::lightning;
 
-Params layout(int n, Method m, uint64_t seed = 1) {
-  Params p;
-  p.width = p.height = n;
-  p.start = {n / 2, 0};
-  p.targets = {{n / 2, n - 1}};
-  p.method = m;
-  p.seed = seed;
-  return p;
-}
+using bench::lightningLayout;
 
 void run(benchmark::State& state, Params p) {
   uint64_t seed = 1;
@@ -42,16 +36,16 @@ void run(benchmark::State& state, Params p) {
   state.counters["cells"] = cells / double(state.iterations());
 }
 
-void BM_Fast(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kFast)); }
-void BM_Charges(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kCharges)); }
-void BM_DbmMgpcg(benchmark::State& s) { run(s, layout(int(s.range(0)), Method::kDbm)); }
+void BM_Fast(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kFast)); }
+void BM_Charges(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kCharges)); }
+void BM_DbmMgpcg(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kDbm)); }
 void BM_DbmCg(benchmark::State& s) {
-  Params p = layout(int(s.range(0)), Method::kDbm);
+  Params p = lightningLayout(int(s.range(0)), Method::kDbm);
   p.solver = Solver::kCg;
   run(s, p);
 }
 void BM_Fast1024Obstacles(benchmark::State& s) {
-  Params p = layout(1024, Method::kFast);
+  Params p = lightningLayout(1024, Method::kFast);
   p.obstacles.assign(size_t(1024) * 1024, 0);
   effects::Rng rng(12);
   for (size_t i = 0; i < p.obstacles.size(); ++i) {
@@ -88,7 +82,7 @@ void fractal() {
     for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
       double sum = 0, sum2 = 0;
       for (uint64_t seed = 1; seed <= 20; ++seed) {
-        Params p = layout(128, m, seed);
+        Params p = lightningLayout(128, m, seed);
         p.eta = eta;
         auto b = grow(p);
         std::vector<Cell> cells;

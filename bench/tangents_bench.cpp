@@ -8,7 +8,7 @@
 
 #include <effects/tangents.h>
 
-#include "meshes.h"
+#include "fixtures.h"
 
 namespace {
 

@@ -1,13 +1,26 @@
-// Test meshes for the tangent benchmarks and the error report.
+// Shared inputs of the benchmarks and the error report: meshes and the lightning layout.
 #pragma once
 
 #include <cmath>
 
+#include <effects/lightning.h>
 #include <effects/tangents.h>
 
 namespace bench {
 
 namespace tg = effects::tangents;
+
+// Issue 3's layout: start top-centre, target bottom-centre, no obstacles, eta 2 (the default).
+inline effects::lightning::Params lightningLayout(int n, effects::lightning::Method m = effects::lightning::Method::kFast,
+                                                  uint64_t seed = 1) {
+  effects::lightning::Params p;
+  p.width = p.height = n;
+  p.start = {n / 2, 0};
+  p.targets = {{n / 2, n - 1}};
+  p.method = m;
+  p.seed = seed;
+  return p;
+}
 
 // UV sphere: seam and poles included (pole rows without zero-area triangles), normals given.
 inline tg::Mesh uvSphere(int rings, int segments) {
