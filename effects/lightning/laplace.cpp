@@ -1,153 +1,274 @@
 #include "laplace.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace effects::lightning::detail {
 
+namespace {
+
+constexpr int kPreSmooth = 1;  // red-black / lexicographic Gauss-Seidel sweeps per level side
+constexpr int kCoarsestSweeps = 12;
+
+int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// Bilinear weight of the coarse cell sitting on fine cell c for fine cell f, per axis.
+double axisWeight(int d) { return d == 0 ? 1.0 : 0.5; }
+
+}  // namespace
+
 Laplace::Laplace(int width, int height) : w_(width), h_(height), stride_(width + 2) {
   size_t n = size_t(width + 2) * size_t(height + 2);
   phi_.assign(n, 0.0);
+  bvec_.assign(n, 0.0);
   unknown_.assign(n, 0);
+  mask_.assign(n, 0.0);
   for (int y = 0; y < h_; ++y)
-    for (int x = 0; x < w_; ++x) unknown_[at(x, y)] = 1;
-  r_.assign(n, 0.0);
-  z_.assign(n, 0.0);
-  p_.assign(n, 0.0);
-  ap_.assign(n, 0.0);
+    for (int x = 0; x < w_; ++x) unknown_[at(x, y)] = 1, mask_[at(x, y)] = 1.0;
+  for (auto* v : {&r_, &z_, &p_, &ap_, &e0_}) v->assign(n, 0.0);
+  levels_.resize(1);
+  for (int w = w_ / 2, h = h_ / 2; w >= 2 && h >= 2; w /= 2, h /= 2) {
+    Level l;
+    l.w = w;
+    l.h = h;
+    l.stride = w + 2;
+    size_t m = size_t(w + 2) * size_t(h + 2);
+    l.a.assign(m, {});
+    l.invDiag.assign(m, 0.0);
+    l.mask.assign(m, 0.0);
+    l.e.assign(m, 0.0);
+    l.r.assign(m, 0.0);
+    levels_.push_back(std::move(l));
+  }
+  dirty_ = {0, 0, w_ - 1, h_ - 1};
 }
 
 void Laplace::fix(int x, int y, double value) {
-  unknown_[at(x, y)] = 0;
-  phi_[at(x, y)] = value;
-  levelsDirty_ = true;
+  const size_t i = at(x, y);
+  const bool wasUnknown = unknown_[i];
+  const double delta = wasUnknown ? value : value - phi_[i];
+  if (wasUnknown) {
+    bb_ -= bvec_[i] * bvec_[i];
+    bvec_[i] = 0;
+    unknown_[i] = 0;
+    mask_[i] = 0.0;
+    dirty_ = dirty_.empty() ? Box{x, y, x, y}
+                            : Box{std::min(dirty_.x0, x), std::min(dirty_.y0, y), std::max(dirty_.x1, x), std::max(dirty_.y1, y)};
+  }
+  phi_[i] = value;
+  if (delta != 0.0)
+    for (size_t j : {i - 1, i + 1, i - size_t(stride_), i + size_t(stride_)})
+      if (unknown_[j]) {
+        bb_ += (bvec_[j] + delta) * (bvec_[j] + delta) - bvec_[j] * bvec_[j];
+        bvec_[j] += delta;
+      }
 }
 
-void Laplace::buildLevels() {
-  // Level 0 mirrors the fine grid; a coarse block is unknown when any of its children is.
-  // With block-constant prolongation P and R = P^T, the Galerkin operator R A P of
-  // scale * L is 2 * scale * L on the coarse grid, hence scale doubles per level.
-  if (levels_.empty()) {
-    int w = w_, h = h_;
-    double scale = 1.0;
-    while (true) {
-      Level l{w, h, w + 2, scale, {}, {}, {}};
-      size_t n = size_t(w + 2) * size_t(h + 2);
-      l.unknown.assign(n, 0);
-      l.e.assign(n, 0.0);
-      l.r.assign(n, 0.0);
-      levels_.push_back(std::move(l));
-      if (w <= 4 || h <= 4) break;
-      w = (w + 1) / 2;
-      h = (h + 1) / 2;
-      scale *= 2.0;
+// One row of A_c = P^T A P at level k (k >= 1) from the operator of level k - 1.
+void Laplace::galerkinRow(size_t k, int cx, int cy) {
+  Level& c = levels_[k];
+  const Level* f = k > 1 ? &levels_[k - 1] : nullptr;
+  const int fw = f ? f->w : w_, fh = f ? f->h : h_, fs = f ? f->stride : stride_;
+  std::array<double, 9> row{};
+  for (int fy = 2 * cy; fy <= 2 * cy + 2 && fy < fh; ++fy)
+    for (int fx = 2 * cx; fx <= 2 * cx + 2 && fx < fw; ++fx) {
+      const size_t fi = size_t(fy + 1) * size_t(fs) + size_t(fx + 1);
+      const double wf = axisWeight(fx - 2 * cx - 1) * axisWeight(fy - 2 * cy - 1);
+      for (int o = 0; o < 9; ++o) {
+        const int ox = o % 3 - 1, oy = o / 3 - 1;
+        double a;
+        if (f) {
+          a = f->a[fi][size_t(o)];
+        } else {  // the fine 5-point operator on unknowns
+          if (!unknown_[fi] || (ox != 0 && oy != 0)) continue;
+          a = o == 4 ? 4.0 : (unknown_[fi + size_t(ox) + size_t(oy) * size_t(fs)] ? -1.0 : 0.0);
+        }
+        if (a == 0.0) continue;
+        const int gx = fx + ox, gy = fy + oy;
+        // Coarse parents of g per axis: odd g sits on one (weight 1), even g between two (1/2).
+        int px[2], py[2], npx = 0, npy = 0;
+        double wx[2], wy[2];
+        auto parents = [](int g, int n, int* p, double* wt, int& np) {
+          if (g & 1) {
+            if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, wt[np++] = 1.0;
+          } else {
+            if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, wt[np++] = 0.5;
+            if (g / 2 < n) p[np] = g / 2, wt[np++] = 0.5;
+          }
+        };
+        if (gx < 0 || gy < 0) continue;
+        parents(gx, c.w, px, wx, npx);
+        parents(gy, c.h, py, wy, npy);
+        for (int a1 = 0; a1 < npy; ++a1)
+          for (int a0 = 0; a0 < npx; ++a0)
+            row[size_t((px[a0] - cx + 1) + 3 * (py[a1] - cy + 1))] += wf * a * wx[a0] * wy[a1];
+      }
     }
-  }
-  levels_[0].unknown = unknown_;
-  for (size_t k = 1; k < levels_.size(); ++k) {
-    Level& c = levels_[k];
-    const Level& f = levels_[k - 1];
-    std::fill(c.unknown.begin(), c.unknown.end(), 0);
-    for (int y = 0; y < f.h; ++y)
-      for (int x = 0; x < f.w; ++x)
-        if (f.unknown[size_t(y + 1) * f.stride + size_t(x + 1)]) c.unknown[size_t(y / 2 + 1) * c.stride + size_t(x / 2 + 1)] = 1;
-  }
-  levelsDirty_ = false;
+  const size_t ci = size_t(cy + 1) * size_t(c.stride) + size_t(cx + 1);
+  c.a[ci] = row;
+  c.invDiag[ci] = row[4] > 0 ? 1.0 / row[4] : 0.0;
+  c.mask[ci] = row[4] > 0 ? 1.0 : 0.0;
 }
 
-void Laplace::smooth(Level& l, bool forward) {
-  // Red-black Gauss-Seidel on scale * (4e - sum e_n) = r; reversed colour order on the way
-  // up keeps the V-cycle symmetric, as CG needs of a preconditioner.
+void Laplace::updateCoarse() {
+  Box b = dirty_;
+  for (size_t k = 1; k < levels_.size() && !b.empty(); ++k) {
+    Level& c = levels_[k];
+    // Row J changes when its fine support (2J .. 2J+2) is within one cell of a changed row.
+    Box cb{std::max(0, floorDiv(b.x0 - 2, 2)), std::max(0, floorDiv(b.y0 - 2, 2)), std::min(c.w - 1, floorDiv(b.x1 + 1, 2)),
+           std::min(c.h - 1, floorDiv(b.y1 + 1, 2))};
+    for (int y = cb.y0; y <= cb.y1; ++y)
+      for (int x = cb.x0; x <= cb.x1; ++x) galerkinRow(k, x, y);
+    b = cb;
+  }
+  dirty_ = {0, 0, -1, -1};
+}
+
+void Laplace::smoothFine(bool forward, bool fromZero) {
+  // Red-black Gauss-Seidel on 4e - sum e_n = r over the unknowns (e is 0 on fixed cells).
+  // From zero, the first colour's neighbours are all 0; writing every cell of both colours
+  // (the pad is never written) then replaces clearing the vector.
+  std::vector<double>& e = z_;
+  const size_t s = size_t(stride_);
   for (int pass = 0; pass < 2; ++pass) {
-    int colour = forward ? pass : 1 - pass;
-    const double inv = 1.0 / l.scale;
-    for (int y = 0; y < l.h; ++y) {
-      size_t row = size_t(y + 1) * l.stride;
-      for (int x = (y + colour) & 1; x < l.w; x += 2) {
-        size_t i = row + size_t(x + 1);
-        if (!l.unknown[i]) continue;
-        l.e[i] = 0.25 * (l.r[i] * inv + l.e[i - 1] + l.e[i + 1] + l.e[i - l.stride] + l.e[i + l.stride]);
+    const int colour = forward ? pass : 1 - pass;
+    for (int y = 0; y < h_; ++y) {
+      const size_t row = size_t(y + 1) * s;
+      if (fromZero && pass == 0) {
+        for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x + 1)] = mask_[row + size_t(x + 1)] * 0.25 * r_[row + size_t(x + 1)];
+        continue;
+      }
+      for (int x = (y + colour) & 1; x < w_; x += 2) {
+        const size_t i = row + size_t(x + 1);
+        e[i] = mask_[i] * 0.25 * (r_[i] + e[i - 1] + e[i + 1] + e[i - s] + e[i + s]);
       }
     }
   }
 }
 
-void Laplace::vcycle(size_t k) {
-  Level& l = levels_[k];
-  std::fill(l.e.begin(), l.e.end(), 0.0);
-  if (k + 1 == levels_.size()) {
-    for (int i = 0; i < 16; ++i) smooth(l, i % 2 == 0);  // forward/backward pairs: symmetric
-    return;
+void Laplace::smoothCoarse(Level& l, bool forward) {
+  // Lexicographic Gauss-Seidel with the 9-point Galerkin stencil (backward on the way up, so
+  // that the V-cycle is symmetric, as CG needs of a preconditioner). Only the term of the
+  // previous cell in the sweep depends on the cell just updated; the rest is summed first
+  // so that the loop-carried chain is one multiply-add.
+  const size_t s = size_t(l.stride);
+  double* e = l.e.data();
+  auto update = [&](size_t i, size_t prevOffset) {
+    const auto& a = l.a[i];  // all zero on inactive and pad cells, where invDiag is 0 too
+    const double* u = e + i - s;
+    const double* d = e + i + s;
+    double rest = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
+    // forward: e[i-1] was just updated, e[i+1] is old; backward the other way round.
+    if (prevOffset == 1) rest -= a[5] * e[i + 1], e[i] = (rest - a[3] * e[i - 1]) * l.invDiag[i];
+    else rest -= a[3] * e[i - 1], e[i] = (rest - a[5] * e[i + 1]) * l.invDiag[i];
+  };
+  if (forward) {
+    for (int y = 0; y < l.h; ++y)
+      for (int x = 0; x < l.w; ++x) update(size_t(y + 1) * s + size_t(x + 1), 1);
+  } else {
+    for (int y = l.h; y-- > 0;)
+      for (int x = l.w; x-- > 0;) update(size_t(y + 1) * s + size_t(x + 1), 0);
   }
-  smooth(l, true);
-  smooth(l, true);
-  Level& c = levels_[k + 1];
-  std::fill(c.r.begin(), c.r.end(), 0.0);
-  for (int y = 0; y < l.h; ++y)
-    for (int x = 0; x < l.w; ++x) {
-      size_t i = size_t(y + 1) * l.stride + size_t(x + 1);
-      if (!l.unknown[i]) continue;
-      double res = l.r[i] - l.scale * (4 * l.e[i] - l.e[i - 1] - l.e[i + 1] - l.e[i - l.stride] - l.e[i + l.stride]);
-      c.r[size_t(y / 2 + 1) * c.stride + size_t(x / 2 + 1)] += res;
-    }
-  vcycle(k + 1);
-  for (int y = 0; y < l.h; ++y)
-    for (int x = 0; x < l.w; ++x) {
-      size_t i = size_t(y + 1) * l.stride + size_t(x + 1);
-      if (l.unknown[i]) l.e[i] += c.e[size_t(y / 2 + 1) * c.stride + size_t(x / 2 + 1)];
-    }
-  smooth(l, false);
-  smooth(l, false);
 }
 
-void Laplace::precondition(const std::vector<double>& r, std::vector<double>& z) {
-  if (levelsDirty_) buildLevels();
-  levels_[0].r = r;
+// e_k approximately solves A_k e_k = r_k; k = 0 is the fine level (r_ -> z_).
+void Laplace::vcycle(size_t k) {
+  const bool fine = k == 0;
+  const bool coarsest = k + 1 == levels_.size();
+  if (!fine) {
+    Level& l = levels_[k];
+    std::fill(l.e.begin(), l.e.end(), 0.0);
+    if (coarsest) {
+      for (int i = 0; i < kCoarsestSweeps; ++i) smoothCoarse(l, i % 2 == 0);  // symmetric pairs
+      return;
+    }
+  }
+  for (int i = 0; i < kPreSmooth; ++i) fine ? smoothFine(true, i == 0) : smoothCoarse(levels_[k], true);
+  if (!coarsest) {
+    // Residual of this level, restricted with P^T (full weighting over the 3x3 fine support).
+    const int fw = fine ? w_ : levels_[k].w, fh = fine ? h_ : levels_[k].h;
+    const size_t fs = size_t(fine ? stride_ : levels_[k].stride);
+    std::vector<double>& res = e0_;
+    const size_t first = fs + 1, last = size_t(fh + 1) * fs - 1;  // the pad columns come out 0
+    if (fine) {
+      for (size_t i = first; i < last; ++i)
+        res[i] = mask_[i] * (r_[i] - (4 * z_[i] - z_[i - 1] - z_[i + 1] - z_[i - fs] - z_[i + fs]));
+    } else {
+      const Level& l = levels_[k];
+      const double* e = l.e.data();
+      for (size_t i = first; i < last; ++i) {
+        const auto& a = l.a[i];
+        const double* u = e + i - fs;
+        const double* d = e + i + fs;
+        res[i] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) - (a[3] * e[i - 1] + a[4] * e[i] + a[5] * e[i + 1]) -
+                 (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
+      }
+    }
+    Level& c = levels_[k + 1];
+    const size_t cs = size_t(c.stride);
+    for (int cy = 0; cy < c.h; ++cy)
+      for (int cx = 0; cx < c.w; ++cx) {
+        // fine cell (2cx+1, 2cy+1) is at padded index (2cx+2, 2cy+2)
+        size_t i = size_t(2 * cy + 2) * fs + size_t(2 * cx + 2);
+        double v = res[i] + 0.5 * (res[i - 1] + res[i + 1] + res[i - fs] + res[i + fs]) +
+                   0.25 * (res[i - fs - 1] + res[i - fs + 1] + res[i + fs - 1] + res[i + fs + 1]);
+        c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = v;
+      }
+    vcycle(k + 1);
+    // Prolongation (bilinear), masked to this level's active cells, gathered per fine row:
+    // odd fine rows/columns sit on a coarse one, even ones halfway between two (the pad of
+    // the coarse grid is 0, so the borders need no special case).
+    std::vector<double>& e = fine ? z_ : levels_[k].e;
+    const std::vector<double>& m = fine ? mask_ : levels_[k].mask;
+    rowTmp_.resize(cs);
+    for (int y = 0; y < fh; ++y) {
+      const double* c0 = &c.e[size_t((y + 1) / 2) * cs];  // coarse row (y-1)/2 or y/2-1, padded
+      const double* c1 = &c.e[size_t(y / 2 + 1) * cs];
+      const bool odd = y & 1;
+      for (size_t j = 0; j < cs; ++j) rowTmp_[j] = odd ? c1[j] : 0.5 * (c0[j] + c1[j]);
+      const size_t row = size_t(y + 1) * fs + 1;
+      for (int x = 0; x < fw; ++x) {
+        const double v = (x & 1) ? rowTmp_[size_t(x / 2 + 1)] : 0.5 * (rowTmp_[size_t(x / 2)] + rowTmp_[size_t(x / 2 + 1)]);
+        e[row + size_t(x)] += m[row + size_t(x)] * v;
+      }
+    }
+  }
+  for (int i = 0; i < kPreSmooth; ++i) fine ? smoothFine(false, false) : smoothCoarse(levels_[k], false);
+}
+
+void Laplace::precondition() {
+  if (!dirty_.empty()) updateCoarse();
   vcycle(0);
-  z = levels_[0].e;
 }
 
 int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
   const size_t n = phi_.size();
-  const int s = stride_;
-  // b: the fixed neighbours' values; r = b - A phi = (sum of 4 neighbours) - 4 phi on unknowns.
-  double bb = 0.0, rr = 0.0;
-  for (size_t i = size_t(s); i + size_t(s) < n; ++i) {
-    if (!unknown_[i]) {
-      r_[i] = 0.0;
-      continue;
-    }
-    double b = 0.0;
-    for (size_t j : {i - 1, i + 1, i - size_t(s), i + size_t(s)})
-      if (!unknown_[j]) b += phi_[j];
-    bb += b * b;
-    r_[i] = phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i];
+  const size_t s = size_t(stride_);
+  // r = b - A phi = (sum of 4 neighbours) - 4 phi on unknowns (fixed neighbours carry b).
+  double rr = 0.0;
+  for (size_t i = s; i + s < n; ++i) {
+    r_[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i]);
     rr += r_[i] * r_[i];
   }
-  const double bnorm = std::sqrt(bb) > 0 ? std::sqrt(bb) : 1.0;
+  const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
-  auto apply = [&](const std::vector<double>& r, std::vector<double>& z) {
-    if (solver == Solver::kMgpcg) precondition(r, z);
-    else z = r;
-  };
+  const bool mg = solver == Solver::kMgpcg;
   int it = 0;
   const int maxIt = 20 * (w_ + h_) + 1000;  // CG converges in O(sqrt(cond)) ~ O(n) iterations
   if (std::sqrt(rr) > goal) {
-    apply(r_, z_);
+    if (mg) precondition();
+    else z_ = r_;
     p_ = z_;
     double rz = 0;
     for (size_t i = 0; i < n; ++i) rz += r_[i] * z_[i];
     for (; it < maxIt; ++it) {
       double pap = 0;
-      for (size_t i = size_t(s); i + size_t(s) < n; ++i) {
-        if (!unknown_[i]) {
-          ap_[i] = 0;
-          continue;
-        }
-        ap_[i] = 4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s];  // p is 0 on fixed cells
+      for (size_t i = s; i + s < n; ++i) {
+        ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
         pap += p_[i] * ap_[i];
       }
       if (!(pap > 0)) break;
-      double alpha = rz / pap;
+      const double alpha = rz / pap;
       rr = 0;
       for (size_t i = 0; i < n; ++i) {
         phi_[i] += alpha * p_[i];
@@ -158,12 +279,13 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
         ++it;
         break;
       }
-      apply(r_, z_);
+      if (mg) precondition();
+      else z_ = r_;
       double rzNew = 0;
       for (size_t i = 0; i < n; ++i) rzNew += r_[i] * z_[i];
-      double beta = rzNew / rz;
+      const double beta = rzNew / rz;
       rz = rzNew;
-      for (size_t i = 0; i < n; ++i) p_[i] = unknown_[i] ? z_[i] + beta * p_[i] : 0.0;
+      for (size_t i = 0; i < n; ++i) p_[i] = z_[i] + beta * p_[i];  // z is 0 on fixed cells
     }
   }
   if (relResidual) *relResidual = std::sqrt(rr) / bnorm;

@@ -1,8 +1,16 @@
 // Private to effects/lightning: the Dirichlet Laplace problem of DBM on a grid with fixed
 // cells (bolt, obstacles: 0; target: 1; outside: 0), 5-point stencil, solved by plain CG or
 // multigrid-preconditioned CG, warm-started from the previous solution.
+//
+// The multigrid is algebraic in its coarse operators: vertex-centred coarsening (coarse cell
+// J sits on fine cell 2J+1), bilinear prolongation P masked to the unknown fine cells,
+// restriction P^T and Galerkin coarse operators A_c = P^T A P (9-point stencils). Fixed cells
+// inside the grid — a one-cell-wide bolt — are seen exactly by every coarse level, which a
+// re-discretised coarse grid cannot do. Fixing a cell changes A_c only near it, so the
+// coarse rows are rebuilt in a small box per level instead of from scratch every step.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "effects/lightning.h"
@@ -20,23 +28,31 @@ class Laplace {
 
  private:
   size_t at(int x, int y) const { return size_t(y + 1) * stride_ + size_t(x + 1); }
+  // A coarse level: padded (w+2) x (h+2) arrays; a[i][k] is the stencil weight from cell i to
+  // its neighbour at offset k = (dx+1) + 3 (dy+1). A cell with a zero diagonal is inactive.
   struct Level {
-    int w, h, stride;
-    double scale;                 // operator = scale * (4 u - sum of 4 neighbours)
-    std::vector<uint8_t> unknown;
-    std::vector<double> e, r;
+    int w = 0, h = 0, stride = 0;
+    std::vector<std::array<double, 9>> a;
+    std::vector<double> invDiag, mask, e, r;  // mask: 1 on active cells
   };
-  void buildLevels();
-  void vcycle(size_t level);
-  void smooth(Level& l, bool forward);
-  void precondition(const std::vector<double>& r, std::vector<double>& z);
+  struct Box {
+    int x0, y0, x1, y1;  // inclusive; empty when x0 > x1
+    bool empty() const { return x0 > x1 || y0 > y1; }
+  };
+  void updateCoarse();
+  void galerkinRow(size_t k, int cx, int cy);
+  void vcycle(size_t k);
+  void smoothFine(bool forward, bool fromZero);
+  void smoothCoarse(Level& l, bool forward);
+  void precondition();
 
   int w_, h_, stride_;
-  std::vector<double> phi_;
+  std::vector<double> phi_, bvec_, mask_;  // mask_: 1 on unknowns, 0 on fixed and pad cells
   std::vector<uint8_t> unknown_;  // padded; the pad is fixed at 0
-  std::vector<double> r_, z_, p_, ap_;
-  std::vector<Level> levels_;
-  bool levelsDirty_ = true;
+  double bb_ = 0;                 // ||b||^2, kept up to date by fix()
+  std::vector<double> r_, z_, p_, ap_, e0_, rowTmp_;
+  std::vector<Level> levels_;     // levels_[0] is unused: the fine level lives in the members
+  Box dirty_;                     // fine cells fixed since the coarse operators were built
 };
 
 }  // namespace effects::lightning::detail
