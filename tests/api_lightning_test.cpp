@@ -1,4 +1,8 @@
 // POST /v1/lightning over HTTP.
+#include <sys/resource.h>
+
+#include <cmath>
+
 #include <effects/common.h>
 
 #include "codec.h"
@@ -67,6 +71,49 @@ TEST(LightningApi, LargeGridWithBitmapObstacles) {
   ASSERT_EQ(r->status, 200) << r->body.substr(0, 500);
   json j = json::parse(r->body);
   EXPECT_FALSE(j["guide"].empty());
+}
+
+TEST(LightningApi, GridAtTheConfiguredMaximum) {
+  // 4096^2 (the default --max-grid-cells) with walls across 60 % of the rows, each with one
+  // gap at alternating ends: finite output, memory bounded by the grid; one more row -> 413.
+  TestServer s;
+  const int n = 4096;
+  json req = request(n);
+  json rects = json::array();
+  for (int k = 0; k < 6; ++k) {
+    int y = 400 + k * 600;
+    rects.push_back(k % 2 ? json{64, y, n - 64, 360} : json{0, y, n - 64, 360});  // x, y, w, h
+  }
+  req["obstacles"] = {{"rects", rects}};
+  req["include"] = {"polylines", "stats", "guide"};
+  struct rusage before {};
+  getrusage(RUSAGE_SELF, &before);
+  auto r = s.postJson("/v1/lightning", req);
+  ASSERT_EQ(r->status, 200) << r->body.substr(0, 500);
+  struct rusage after {};
+  getrusage(RUSAGE_SELF, &after);
+  json j = json::parse(r->body);
+  EXPECT_GE(j["guide"].size(), 6u);
+  size_t vertices = 0;
+  for (const json& line : j["polylines"])
+    for (const json& v : line["points"]) {
+      ASSERT_TRUE(v.is_number() && std::isfinite(v.get<double>()));
+      ASSERT_TRUE(v.get<double>() >= 0 && v.get<double>() <= n);
+      ++vertices;
+    }
+  EXPECT_GT(vertices, 2u * n);  // the bolt winds through every gap
+  // Growth state is about 26 bytes per cell (boundary map ~1 byte): well under 64 per cell.
+  EXPECT_LT((after.ru_maxrss - before.ru_maxrss) * 1024.0, 64.0 * n * n);
+
+  json big = request(n);
+  big["grid"]["height"] = n + 1;
+  auto p = expectProblem(s.postJson("/v1/lightning", big), 413);
+  EXPECT_TRUE(hasPointer(p, "/grid")) << p;
+  EXPECT_NE(p.value("detail", "").find("--max-grid-cells"), std::string::npos) << p;
+  json dbm = request(n);
+  dbm["method"] = "dbm";
+  p = expectProblem(s.postJson("/v1/lightning", dbm), 413);
+  EXPECT_NE(p.value("detail", "").find("--max-solver-grid-cells"), std::string::npos) << p;
 }
 
 TEST(LightningApi, WalledTargetIs422NotAHang) {

@@ -9,49 +9,54 @@
 namespace effects::lightning {
 namespace detail {
 
-BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles) {
-  int domain = std::max(width, height) + 2;
-  int size = 1;
-  while (size < domain) size *= 2;
-  Level base{size, std::vector<float>(size_t(size) * size), {}, {}};
-  base.cx.assign(base.count.size(), 0.0f);
-  base.cy.assign(base.count.size(), 0.0f);
-  auto put = [&](int x, int y) {  // grid coordinates; the ring is at -1 and width/height
-    size_t i = size_t(y + offset_) * size + size_t(x + offset_);
-    base.count[i] = 1.0f;
-    base.cx[i] = float(x + offset_) + 0.5f;
-    base.cy[i] = float(y + offset_) + 0.5f;
+BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles)
+    : width_(width), height_(height), dw_(width + 2), dh_(height + 2) {
+  bits_.assign((size_t(dw_) * size_t(dh_) + 63) / 64, 0);
+  auto put = [&](int dx, int dy) {
+    size_t i = size_t(dy) * size_t(dw_) + size_t(dx);
+    bits_[i / 64] |= uint64_t(1) << (i % 64);
   };
-  for (int x = -1; x <= width; ++x) {
-    put(x, -1);
-    put(x, height);
-  }
-  for (int y = 0; y < height; ++y) {
-    put(-1, y);
-    put(width, y);
-  }
-  if (!obstacles.empty())
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x)
-        if (obstacles[size_t(y) * width + x]) put(x, y);
-  levels_.push_back(std::move(base));
-  while (levels_.back().size > 1) {
+  for (int dy = 0; dy < dh_; ++dy)
+    for (int dx = 0; dx < dw_; ++dx)
+      if (dx == 0 || dy == 0 || dx == dw_ - 1 || dy == dh_ - 1 ||
+          (!obstacles.empty() && obstacles[size_t(dy - 1) * size_t(width) + size_t(dx - 1)]))
+        put(dx, dy);
+  // 4x4 blocks straight from the cells, then 2x2 of the level below.
+  Level l{(dw_ + 3) / 4, (dh_ + 3) / 4, {}, {}, {}};
+  const size_t n = size_t(l.w) * size_t(l.h);
+  l.count.assign(n, 0.0f);
+  l.cx.assign(n, 0.0f);
+  l.cy.assign(n, 0.0f);
+  for (int dy = 0; dy < dh_; ++dy)
+    for (int dx = 0; dx < dw_; ++dx)
+      if (charge(dx, dy)) {
+        size_t b = size_t(dy / 4) * size_t(l.w) + size_t(dx / 4);
+        l.count[b] += 1.0f;
+        l.cx[b] += float(dx) + 0.5f;  // sums of at most 16 half-integers < 2^24: exact
+        l.cy[b] += float(dy) + 0.5f;
+      }
+  for (size_t b = 0; b < n; ++b)
+    if (l.count[b] > 0) l.cx[b] /= l.count[b], l.cy[b] /= l.count[b];
+  levels_.push_back(std::move(l));
+  while (levels_.back().w > 1 || levels_.back().h > 1) {
     const Level& f = levels_.back();
-    Level c{f.size / 2, {}, {}, {}};
-    size_t n = size_t(c.size) * c.size;
-    c.count.assign(n, 0.0f);
-    c.cx.assign(n, 0.0f);
-    c.cy.assign(n, 0.0f);
-    for (int y = 0; y < c.size; ++y)
-      for (int x = 0; x < c.size; ++x) {
+    Level c{(f.w + 1) / 2, (f.h + 1) / 2, {}, {}, {}};
+    size_t m = size_t(c.w) * size_t(c.h);
+    c.count.assign(m, 0.0f);
+    c.cx.assign(m, 0.0f);
+    c.cy.assign(m, 0.0f);
+    for (int y = 0; y < c.h; ++y)
+      for (int x = 0; x < c.w; ++x) {
         double cnt = 0, sx = 0, sy = 0;
         for (int k = 0; k < 4; ++k) {
-          size_t fi = size_t(2 * y + k / 2) * f.size + size_t(2 * x + k % 2);
+          int fx = 2 * x + k % 2, fy = 2 * y + k / 2;
+          if (fx >= f.w || fy >= f.h) continue;
+          size_t fi = size_t(fy) * size_t(f.w) + size_t(fx);
           cnt += f.count[fi];
           sx += double(f.count[fi]) * f.cx[fi];
           sy += double(f.count[fi]) * f.cy[fi];
         }
-        size_t ci = size_t(y) * c.size + x;
+        size_t ci = size_t(y) * size_t(c.w) + size_t(x);
         c.count[ci] = float(cnt);
         if (cnt > 0) {
           c.cx[ci] = float(sx / cnt);
@@ -62,12 +67,37 @@ BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obst
   }
 }
 
+bool BoundaryMap::sameGrid(int width, int height, const std::vector<uint8_t>& obstacles) const {
+  if (width != width_ || height != height_) return false;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (charge(x + 1, y + 1) != (!obstacles.empty() && obstacles[size_t(y) * size_t(width) + size_t(x)] != 0)) return false;
+  return true;
+}
+
+size_t BoundaryMap::bytes() const {
+  size_t b = bits_.size() * sizeof(uint64_t);
+  for (const Level& l : levels_) b += l.count.size() * 3 * sizeof(float);
+  return b;
+}
+
 double BoundaryMap::visit(int level, int bx, int by, double px, double py) const {
-  const Level& l = levels_[size_t(level)];
-  size_t i = size_t(by) * l.size + size_t(bx);
-  float count = l.count[i];
+  // Levels 0 and 1 (cells, 2x2 blocks) come from the charge bits; 2 and up are stored.
+  float count = 0, cx = 0, cy = 0;
+  if (level >= 2) {
+    const Level& l = levels_[size_t(level - 2)];
+    if (bx >= l.w || by >= l.h) return 0.0;
+    size_t i = size_t(by) * size_t(l.w) + size_t(bx);
+    count = l.count[i], cx = l.cx[i], cy = l.cy[i];
+  } else {
+    const int side = 1 << level;
+    for (int y = by * side; y < (by + 1) * side && y < dh_; ++y)
+      for (int x = bx * side; x < (bx + 1) * side && x < dw_; ++x)
+        if (charge(x, y)) count += 1.0f, cx += float(x) + 0.5f, cy += float(y) + 0.5f;
+    if (count > 0) cx /= count, cy /= count;
+  }
   if (count == 0.0f) return 0.0;
-  double dx = l.cx[i] - px, dy = l.cy[i] - py;
+  double dx = cx - px, dy = cy - py;
   double r2 = dx * dx + dy * dy;
   double blockSize = double(1 << level);
   // Opening criterion theta = 0.5: use the block as one charge when its size is at most half
@@ -79,35 +109,37 @@ double BoundaryMap::visit(int level, int bx, int by, double px, double py) const
 }
 
 double BoundaryMap::potential(int x, int y) const {
-  double px = x + offset_ + 0.5, py = y + offset_ + 0.5;
-  return visit(int(levels_.size()) - 1, 0, 0, px, py);
+  double px = x + 1.5, py = y + 1.5;  // domain coordinates of the cell centre
+  return visit(int(levels_.size()) + 1, 0, 0, px, py);
 }
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
                                                      bool* hit) {
-  struct Entry {
-    int w, h;
-    std::vector<uint8_t> obstacles;
-    std::shared_ptr<const BoundaryMap> map;
-  };
+  // Least recently used first out, bounded in bytes (the maps hold their own key).
   static std::mutex mu;
-  static std::list<Entry> lru;  // most recent first
-  constexpr size_t kCapacity = 8;
+  static std::list<std::shared_ptr<const BoundaryMap>> lru;  // most recent first
+  constexpr size_t kBudgetBytes = size_t(64) << 20;
   {
     std::lock_guard<std::mutex> lock(mu);
     for (auto it = lru.begin(); it != lru.end(); ++it) {
-      if (it->w == width && it->h == height && it->obstacles == obstacles) {
+      if ((*it)->sameGrid(width, height, obstacles)) {
         lru.splice(lru.begin(), lru, it);
         if (hit) *hit = true;
-        return lru.front().map;
+        return lru.front();
       }
     }
   }
   if (hit) *hit = false;
   auto map = std::make_shared<const BoundaryMap>(width, height, obstacles);  // built outside the lock
   std::lock_guard<std::mutex> lock(mu);
-  lru.push_front({width, height, obstacles, map});
-  if (lru.size() > kCapacity) lru.pop_back();
+  lru.push_front(map);
+  size_t total = 0;
+  for (auto it = lru.begin(); it != lru.end();) {
+    total += (*it)->bytes();
+    if (total > kBudgetBytes && it != lru.begin()) it = lru.erase(it);
+    else ++it;
+  }
+  if (map->bytes() > kBudgetBytes) lru.pop_front();  // used by this request only
   return map;
 }
 
