@@ -119,6 +119,8 @@ case("g-lightning-bitmap-bad-padding", L, 400, "/obstacles/bitmap", body=dict(ba
 case("g-lightning-bitmap-whitespace", L, 400, "/obstacles/bitmap", body=dict(base, obstacles={"bitmap": "AAAA AAAA"}))
 case("g-lightning-bitmap-url-alphabet", L, 400, "/obstacles/bitmap", body=dict(base, obstacles={"bitmap": "____" * 8}))
 case("g-lightning-everything-blocked", L, 422, None, body=dict(base, obstacles={"rects": [[0, 0, 16, 16]]}))
+case("g-lightning-axis-growth-below-one", L, 400, "/axisGrowth", body=dict(base, axisGrowth=0.5))
+case("g-lightning-axis-growth-huge", L, 400, "/axisGrowth", body=dict(base, axisGrowth=1e308))
 case("g-lightning-max-steps-zero", L, 400, "/maxSteps", body=dict(base, maxSteps=0))
 case("g-lightning-shape-falloff-negative", L, 400, "/shape/branchFalloff", body=dict(base, shape={"branchFalloff": -1}))
 case("g-lightning-solver-unknown", L, 400, "/solver", body=dict(base, method="dbm", solver="jacobi"))

@@ -74,6 +74,7 @@ LightningRequest parseLightning(const json& body, const Config& config) {
                                        std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
   p.lifetime = body.value("lifetime", p.lifetime);
+  p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
   p.solver = body.value("solver", "mgpcg") == "cg" ? lt::Solver::kCg : lt::Solver::kMgpcg;
   p.tolerance = body.value("tolerance", p.tolerance);
   const std::string guide = body.value("guide", "auto");

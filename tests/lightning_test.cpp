@@ -174,6 +174,28 @@ TEST(Lightning, ChainLightning) {
   }
 }
 
+TEST(Lightning, AxisGrowthControlsBranching) {
+  // Eqn 8's base: the paper's 2 makes a nearly straight bolt; towards 1 the bolt branches
+  // more (more cells for the same start and target), which is how it approaches DBM's D.
+  double cellsPaper = 0, cellsLow = 0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    Params p = basic(96, Method::kFast, seed);
+    cellsPaper += double(grow(p).value().nodes.size());
+    p.axisGrowth = 1.1;
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok());
+    cellsLow += double(b.value().nodes.size());
+  }
+  EXPECT_GT(cellsLow, 1.3 * cellsPaper);
+  Params p = basic(16);
+  for (double bad : {0.99, 64.5, double(NAN)}) {
+    p.axisGrowth = bad;
+    auto b = grow(p);
+    ASSERT_FALSE(b.ok());
+    EXPECT_EQ(b.error().field, "/axisGrowth");
+  }
+}
+
 TEST(Lightning, SolversAgree) {
   std::vector<Cell> bolt = {{16, 0}, {16, 1}, {15, 2}, {16, 3}};
   int itCg = 0, itMg = 0;

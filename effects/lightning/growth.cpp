@@ -25,6 +25,7 @@ std::optional<Error> validate(const Params& p) {
   if (!p.obstacles.empty() && p.obstacles.size() != size_t(p.width) * size_t(p.height))
     return invalid("/obstacles", "must have width*height cells");
   if (!(p.eta >= 0.0 && p.eta <= 50.0)) return invalid("/eta", "must be in [0, 50]");
+  if (!(p.axisGrowth >= 1.0 && p.axisGrowth <= 64.0)) return invalid("/axisGrowth", "must be in [1, 64]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
@@ -159,9 +160,11 @@ void Grower::logWeights(std::vector<double>& out) {
   out.resize(cands_.size());
   switch (p_.method) {
     case Method::kFast: {
-      // Seed 002 eqn 8: P_i = 2^G / (B * N * P). B (eqn 4) is the border/obstacle charge
+      // Seed 002 eqn 8: P_i = 2^G / (B * N * P), the base 2 being Params::axisGrowth. B (eqn 4)
+      // is the border/obstacle charge
       // potential (large near them: Phi small), N (eqn 6) the adjacent bolt cells, P (eqn 5)
       // the distance to the positive charge, G the candidate's step along anchor -> attractor.
+      const double lnGrowth = std::log(p_.axisGrowth);  // the paper: ln 2
       double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
       double len = std::hypot(ax, ay);
       if (len > 0) {
@@ -172,7 +175,7 @@ void Grower::logWeights(std::vector<double>& out) {
         const Candidate& c = cands_[i];
         double G = std::floor((c.cell.x - anchor_.x) * ax + (c.cell.y - anchor_.y) * ay);
         double P = std::hypot(double(c.cell.x - attractor_.x), double(c.cell.y - attractor_.y));
-        out[i] = G * M_LN2 - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
+        out[i] = G * lnGrowth - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
       }
       break;
     }

@@ -55,6 +55,8 @@ struct Params {
   Method method = Method::kFast;
   double eta = 2.0;               // [0, 50]; seed 002: 2..3 looks like lightning
   int lifetime = 4;               // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
+  double axisGrowth = 2.0;        // kFast: base of eqn 8's 2^G, in [1, 64]; the paper's 2 gives
+                                  // thinner bolts than DBM, ~1.1 matches DBM's D at eta 2
   Guide guide = Guide::kAuto;
   Solver solver = Solver::kMgpcg; // kDbm
   double tolerance = 1e-6;        // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
