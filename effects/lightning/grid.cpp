@@ -10,11 +10,10 @@ namespace effects::lightning {
 namespace detail {
 
 BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles)
-    : width_(width), height_(height), dw_(width + 2), dh_(height + 2) {
-  bits_.assign((size_t(dw_) * size_t(dh_) + 63) / 64, 0);
+    : width_(width), height_(height), dw_(width + 2), dh_(height + 2), qw_((dw_ + 1) / 2), qh_((dh_ + 1) / 2) {
+  quads_.assign(size_t(qw_) * size_t(qh_), 0);
   auto put = [&](int dx, int dy) {
-    size_t i = size_t(dy) * size_t(dw_) + size_t(dx);
-    bits_[i / 64] |= uint64_t(1) << (i % 64);
+    quads_[size_t(dy / 2) * size_t(qw_) + size_t(dx / 2)] |= uint8_t(1u << ((dx & 1) + 2 * (dy & 1)));
   };
   for (int dy = 0; dy < dh_; ++dy)
     for (int dx = 0; dx < dw_; ++dx)
@@ -76,25 +75,30 @@ bool BoundaryMap::sameGrid(int width, int height, const std::vector<uint8_t>& ob
 }
 
 size_t BoundaryMap::bytes() const {
-  size_t b = bits_.size() * sizeof(uint64_t);
+  size_t b = quads_.size();
   for (const Level& l : levels_) b += l.count.size() * 3 * sizeof(float);
   return b;
 }
 
 double BoundaryMap::visit(int level, int bx, int by, double px, double py) const {
-  // Levels 0 and 1 (cells, 2x2 blocks) come from the charge bits; 2 and up are stored.
+  // Levels 0 and 1 (cells, 2x2 blocks) come from the charge masks; 2 and up are stored.
+  static constexpr float kCount[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+  static constexpr float kSumX[16] = {0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 2, 2, 1, 1, 2, 2};
+  static constexpr float kSumY[16] = {0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2, 2};
   float count = 0, cx = 0, cy = 0;
   if (level >= 2) {
     const Level& l = levels_[size_t(level - 2)];
     if (bx >= l.w || by >= l.h) return 0.0;
     size_t i = size_t(by) * size_t(l.w) + size_t(bx);
     count = l.count[i], cx = l.cx[i], cy = l.cy[i];
+  } else if (level == 1) {
+    if (bx >= qw_ || by >= qh_) return 0.0;
+    const uint8_t m = quad(bx, by);
+    count = kCount[m];
+    if (count > 0) cx = float(2 * bx) + 0.5f + kSumX[m] / count, cy = float(2 * by) + 0.5f + kSumY[m] / count;
   } else {
-    const int side = 1 << level;
-    for (int y = by * side; y < (by + 1) * side && y < dh_; ++y)
-      for (int x = bx * side; x < (bx + 1) * side && x < dw_; ++x)
-        if (charge(x, y)) count += 1.0f, cx += float(x) + 0.5f, cy += float(y) + 0.5f;
-    if (count > 0) cx /= count, cy /= count;
+    if (bx >= dw_ || by >= dh_ || !charge(bx, by)) return 0.0;
+    count = 1, cx = float(bx) + 0.5f, cy = float(by) + 0.5f;
   }
   if (count == 0.0f) return 0.0;
   double dx = cx - px, dy = cy - py;
