@@ -2,9 +2,11 @@
 // top-centre, target bottom-centre, eta = 2, no obstacles unless said.
 //   fast 128^2 (target <= 1 ms); fast vs plain-CG dbm at tolerance 1e-6 (targets >= 300x at
 //   64^2, >= 2000x at 128^2); dbm with MGPCG at 128^2 (target <= 100 ms); fast at 1024^2 with
-//   ~20 % obstacles (target <= 50 ms, less with the boundary map cached).
+//   ~20 % obstacles (target <= 50 ms, less with the boundary map cached); fast at 4096^2, the
+//   default grid limit, with the process's peak RSS.
 // Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds.
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <cstdio>
@@ -34,6 +36,9 @@ void run(benchmark::State& state, Params p) {
     cells += double(b.value().nodes.size());
   }
   state.counters["cells"] = cells / double(state.iterations());
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  state.counters["peakRssMB"] = double(usage.ru_maxrss) / 1024.0;  // of the process so far
 }
 
 void BM_Fast(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kFast)); }
@@ -71,6 +76,7 @@ void BM_Fast1024Obstacles(benchmark::State& s) {
 }
 
 BENCHMARK(BM_Fast)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Fast)->Arg(4096)->Iterations(3)->Unit(benchmark::kMillisecond);  // the default grid limit
 BENCHMARK(BM_Charges)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmMgpcg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmCg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(2);
