@@ -66,14 +66,6 @@ BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obst
   }
 }
 
-bool BoundaryMap::sameGrid(int width, int height, const std::vector<uint8_t>& obstacles) const {
-  if (width != width_ || height != height_) return false;
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x)
-      if (charge(x + 1, y + 1) != (!obstacles.empty() && obstacles[size_t(y) * size_t(width) + size_t(x)] != 0)) return false;
-  return true;
-}
-
 size_t BoundaryMap::bytes() const {
   size_t b = quads_.size();
   for (const Level& l : levels_) b += l.count.size() * 3 * sizeof(float);
@@ -119,31 +111,38 @@ double BoundaryMap::potential(int x, int y) const {
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
                                                      bool* hit) {
-  // Least recently used first out, bounded in bytes (the maps hold their own key).
+  // Least recently used first out, bounded in bytes (maps and their keys).
+  struct Entry {
+    int w, h;
+    std::vector<uint8_t> obstacles;  // compared with memcmp: a millisecond at 4096^2
+    std::shared_ptr<const BoundaryMap> map;
+    size_t bytes() const { return obstacles.size() + map->bytes(); }
+  };
   static std::mutex mu;
-  static std::list<std::shared_ptr<const BoundaryMap>> lru;  // most recent first
+  static std::list<Entry> lru;  // most recent first
   constexpr size_t kBudgetBytes = size_t(64) << 20;
   {
     std::lock_guard<std::mutex> lock(mu);
     for (auto it = lru.begin(); it != lru.end(); ++it) {
-      if ((*it)->sameGrid(width, height, obstacles)) {
+      if (it->w == width && it->h == height && it->obstacles == obstacles) {
         lru.splice(lru.begin(), lru, it);
         if (hit) *hit = true;
-        return lru.front();
+        return lru.front().map;
       }
     }
   }
   if (hit) *hit = false;
   auto map = std::make_shared<const BoundaryMap>(width, height, obstacles);  // built outside the lock
+  Entry entry{width, height, obstacles, map};
+  if (entry.bytes() > kBudgetBytes) return map;  // used by this request only
   std::lock_guard<std::mutex> lock(mu);
-  lru.push_front(map);
+  lru.push_front(std::move(entry));
   size_t total = 0;
   for (auto it = lru.begin(); it != lru.end();) {
-    total += (*it)->bytes();
-    if (total > kBudgetBytes && it != lru.begin()) it = lru.erase(it);
+    total += it->bytes();
+    if (total > kBudgetBytes) it = lru.erase(it);
     else ++it;
   }
-  if (map->bytes() > kBudgetBytes) lru.pop_front();  // used by this request only
   return map;
 }
 

@@ -25,14 +25,13 @@ constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 // outside the grid) and on obstacle cells, sum of 1/r. A pyramid of charge counts and
 // centroids answers a query in O(log n) blocks (Barnes-Hut), so 1024^2 grids with 20 %
 // obstacles cost milliseconds; the pyramid depends only on the grid and obstacles and is
-// cached per (size, obstacle set). Memory: a 4-bit charge mask per 2x2 cells (which is also
-// the cache key; cells and 2x2 blocks are derived from it on the fly), stored floats from 4x4
-// blocks up: about 1.0 byte per cell (17 MB at 4096^2).
+// cached per (size, obstacle set) within 64 MB. Memory: a 4-bit charge mask per 2x2 cells
+// (cells and 2x2 blocks are derived from it on the fly) and stored floats from 4x4 blocks up,
+// about 1 byte per cell (17 MB at 4096^2); the cache keeps the obstacle grid as its key.
 class BoundaryMap {
  public:
   BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles);
   double potential(int x, int y) const;
-  bool sameGrid(int width, int height, const std::vector<uint8_t>& obstacles) const;
   size_t bytes() const;
 
  private:
