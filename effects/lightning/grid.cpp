@@ -10,7 +10,7 @@ namespace effects::lightning {
 namespace detail {
 
 BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles)
-    : width_(width), height_(height), dw_(width + 2), dh_(height + 2), qw_((dw_ + 1) / 2), qh_((dh_ + 1) / 2) {
+    : dw_(width + 2), dh_(height + 2), qw_((dw_ + 1) / 2), qh_((dh_ + 1) / 2) {
   quads_.assign(size_t(qw_) * size_t(qh_), 0);
   auto put = [&](int dx, int dy) {
     quads_[size_t(dy / 2) * size_t(qw_) + size_t(dx / 2)] |= uint8_t(1u << ((dx & 1) + 2 * (dy & 1)));

@@ -44,7 +44,7 @@ class BoundaryMap {
   uint8_t quad(int qx, int qy) const { return quads_[size_t(qy) * size_t(qw_) + size_t(qx)]; }
   bool charge(int dx, int dy) const { return (quad(dx / 2, dy / 2) >> ((dx & 1) + 2 * (dy & 1))) & 1u; }
   double visit(int level, int bx, int by, double px, double py) const;
-  int width_, height_, dw_, dh_;  // grid and domain (grid + ring) sizes
+  int dw_, dh_;                   // domain (grid + ring) size
   int qw_, qh_;                   // 2x2 blocks per side
   std::vector<uint8_t> quads_;
   std::vector<Level> levels_;     // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2

@@ -15,6 +15,19 @@ int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 // Bilinear weight of the coarse cell sitting on fine cell c for fine cell f, per axis.
 double axisWeight(int d) { return d == 0 ? 1.0 : 0.5; }
 
+// Coarse parents (index, weight) of fine cell g along one axis of n coarse cells: an odd g
+// sits on one (weight 1), an even g lies between two (1/2 each). Returns how many.
+int coarseParents(int g, int n, int* p, double* w) {
+  int np = 0;
+  if (g & 1) {
+    if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, w[np++] = 1.0;
+  } else {
+    if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, w[np++] = 0.5;
+    if (g / 2 < n) p[np] = g / 2, w[np++] = 0.5;
+  }
+  return np;
+}
+
 }  // namespace
 
 Laplace::Laplace(int width, int height) : w_(width), h_(height), stride_(width + 2) {
@@ -85,20 +98,10 @@ void Laplace::galerkinRow(size_t k, int cx, int cy) {
         }
         if (a == 0.0) continue;
         const int gx = fx + ox, gy = fy + oy;
-        // Coarse parents of g per axis: odd g sits on one (weight 1), even g between two (1/2).
-        int px[2], py[2], npx = 0, npy = 0;
-        double wx[2], wy[2];
-        auto parents = [](int g, int n, int* p, double* wt, int& np) {
-          if (g & 1) {
-            if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, wt[np++] = 1.0;
-          } else {
-            if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, wt[np++] = 0.5;
-            if (g / 2 < n) p[np] = g / 2, wt[np++] = 0.5;
-          }
-        };
         if (gx < 0 || gy < 0) continue;
-        parents(gx, c.w, px, wx, npx);
-        parents(gy, c.h, py, wy, npy);
+        int px[2], py[2];
+        double wx[2], wy[2];
+        const int npx = coarseParents(gx, c.w, px, wx), npy = coarseParents(gy, c.h, py, wy);
         for (int a1 = 0; a1 < npy; ++a1)
           for (int a0 = 0; a0 < npx; ++a0)
             row[size_t((px[a0] - cx + 1) + 3 * (py[a1] - cy + 1))] += wf * a * wx[a0] * wy[a1];
