@@ -4,6 +4,7 @@
 #include <effects/bubble.h>
 
 #include "codec.h"
+#include "costs.h"
 #include "endpoints.h"
 
 namespace effectd {
@@ -193,6 +194,6 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   return reply;
 }
 
-void addBubbleEndpoints(Service& service) { service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble); }
+void addBubbleEndpoints(Service& service) { service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble, bubbleCost); }
 
 }  // namespace effectd

@@ -4,6 +4,7 @@
 #include <effects/fog.h>
 
 #include "codec.h"
+#include "costs.h"
 #include "endpoints.h"
 
 namespace effectd {
@@ -183,6 +184,6 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
   return reply;
 }
 
-void addFogEndpoints(Service& service) { service.addJsonEndpoint("/v1/fog", "fog.json", handleFog); }
+void addFogEndpoints(Service& service) { service.addJsonEndpoint("/v1/fog", "fog.json", handleFog, fogCost); }
 
 }  // namespace effectd

@@ -2,6 +2,7 @@
 #include <effects/lightning.h>
 
 #include "codec.h"
+#include "costs.h"
 #include "endpoints.h"
 
 namespace effectd {
@@ -170,7 +171,7 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
 }
 
 void addLightningEndpoints(Service& service) {
-  service.addJsonEndpoint("/v1/lightning", "lightning.json", handleLightning);
+  service.addJsonEndpoint("/v1/lightning", "lightning.json", handleLightning, lightningCost);
 }
 
 }  // namespace effectd

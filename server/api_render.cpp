@@ -8,6 +8,7 @@
 #include <effects/bubble.h>
 
 #include "codec.h"
+#include "costs.h"
 #include "endpoints.h"
 #include "scene.h"
 
@@ -243,7 +244,7 @@ void addRenderEndpoints(Service& service) {
   auto pool = std::make_shared<rd::RenderPool>(rd::PoolOptions{config.renderThreads, config.renderQueue, config.eglPlatform});
   service.addReadinessCheck("renderer", [pool] { return pool->start(); });
   service.addReadinessInfo("renderer", [pool] { return pool->description(); });
-  service.addJsonEndpoint("/v1/scene", "scene.json", handleScene);
+  service.addJsonEndpoint("/v1/scene", "scene.json", handleScene, sceneCost);
   Metrics* metrics = &service.metrics();
   service.addJsonEndpoint("/v1/render", "scene.json", [pool, metrics](const json& body, const RequestContext& ctx) {
     JsonReply reply;
@@ -266,12 +267,11 @@ void addRenderEndpoints(Service& service) {
     reply.computeMs += f.ms + encode.ms();
     reply.binary = std::move(png.value());
     reply.contentType = "image/png";
-    reply.headers = {{"X-Renderer", pool->description()},
-                     {"X-Render-Passes", f.passList()},
-                     {"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
-                     {"X-Render-Ms", std::to_string(f.ms)}};
+    reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
+    reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
+                        {"X-Render-Ms", std::to_string(f.ms)}};
     return reply;
-  });
+  }, renderCost);
   // The same scene renders alike on the same renderer: it is part of the render's ETag.
   service.setEtagSalt("/v1/render", [pool] { return pool->start().empty() ? pool->description() : std::string(); });
 }

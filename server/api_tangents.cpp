@@ -3,6 +3,7 @@
 
 #include <effects/tangents.h>
 
+#include "costs.h"
 #include "endpoints.h"
 #include "glb.h"
 
@@ -221,8 +222,8 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
 }
 
 void addTangentsEndpoints(Service& service) {
-  service.addJsonEndpoint("/v1/tangents", "tangents.json", handleTangents);
-  service.addBinaryAlternative("/v1/tangents", "model/gltf-binary", handleGlb);
+  service.addJsonEndpoint("/v1/tangents", "tangents.json", handleTangents, tangentsCost);
+  service.addBinaryAlternative("/v1/tangents", "model/gltf-binary", handleGlb, glbCost);
 }
 
 }  // namespace effectd

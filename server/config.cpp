@@ -1,5 +1,6 @@
 #include "config.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <functional>
 #include <limits>
@@ -91,6 +92,48 @@ const std::vector<Option>& options() {
          c.eglPlatform = s;
          return s == "auto" || s == "device" || s == "surfaceless";
        }},
+      {"memory-budget-mb", "EFFECTD_MEMORY_BUDGET_MB",
+       "memory all requests together may reserve at their estimated peaks; beyond it they wait, then 503 "
+       "(default 0 = 60 % of the cgroup memory limit, or of physical memory without one)",
+       [](const std::string& s, Config& c) {
+         long long v;
+         if (!parseInt(s, 0, 1LL << 22, v)) return false;
+         c.memoryBudgetMb = size_t(v);
+         return true;
+       }},
+      {"heavy-threads", "EFFECTD_HEAVY_THREADS",
+       "heavy computations (Laplace solvers, huge grids and meshes) at once, so cheap requests keep a core "
+       "(default 0 = cores - 1, at least 1)",
+       intField(&Config::heavyThreads, 0, 1024)},
+      {"admission-queue", "EFFECTD_ADMISSION_QUEUE", "requests waiting for memory or a heavy slot before 503 (default 64)",
+       intField(&Config::admissionQueue, 0, 100000)},
+      {"admission-timeout-ms", "EFFECTD_ADMISSION_TIMEOUT_MS", "longest wait for memory or a heavy slot before 503 (default 10000)",
+       intField(&Config::admissionTimeoutMs, 0, 3600000)},
+      {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB", "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
+       [](const std::string& s, Config& c) {
+         long long v;
+         if (!parseInt(s, 0, 1LL << 20, v)) return false;
+         c.responseCacheMb = size_t(v);
+         return true;
+       }},
+      {"cors-origins", "EFFECTD_CORS_ORIGINS",
+       "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default none)",
+       [](const std::string& s, Config& c) {
+         c.corsOrigins.clear();
+         size_t pos = 0;
+         while (pos <= s.size()) {
+           size_t end = std::min(s.find(',', pos), s.size());
+           std::string o = s.substr(pos, end - pos);
+           while (!o.empty() && o.front() == ' ') o.erase(0, 1);
+           while (!o.empty() && (o.back() == ' ' || o.back() == '/')) o.pop_back();
+           if (!o.empty()) {
+             if (o != "*" && o.find("://") == std::string::npos) return false;
+             c.corsOrigins.push_back(o);
+           }
+           pos = end + 1;
+         }
+         return true;
+       }},
   };
   return opts;
 }
@@ -99,7 +142,9 @@ const std::vector<Option>& options() {
 
 std::string usage() {
   std::ostringstream os;
-  os << "usage: effectd [serve] [--flag=value ...]\n"
+  os << "usage: effectd [serve] [--flag=value ...]          serve HTTP until SIGTERM/SIGINT\n"
+        "       effectd render SCENE.json -o OUT.png [--egl-platform=...] [--max-*=N]\n"
+        "                                                   render a /v1/render scene to a PNG, no server\n"
         "       effectd --help\n\n"
         "Flags (environment variable in brackets; flags win over the environment):\n";
   for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";

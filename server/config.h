@@ -33,6 +33,12 @@ struct Config {
   int renderThreads = 2;      // render pool: threads, one EGL context each
   int renderQueue = 8;        // renders waiting beyond the running ones; more -> 503
   std::string eglPlatform;    // auto | device | surfaceless; "" = EFFECTD_EGL_PLATFORM or auto
+  size_t memoryBudgetMb = 0;  // 0 = kDefaultBudgetFraction of the cgroup limit or physical memory
+  int heavyThreads = 0;       // heavy computations at once; 0 = cores - 1 (at least 1)
+  int admissionQueue = 64;    // requests waiting for memory or a heavy slot; more -> 503
+  int admissionTimeoutMs = 10000;  // longest wait for admission before 503
+  size_t responseCacheMb = 64;     // encoded answers kept for repeats; 0 = off
+  std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   Limits limits;
 };
 

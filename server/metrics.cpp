@@ -54,6 +54,7 @@ std::string Metrics::render() const {
     }
     os << "effectd_" << name << "_total{kind=\"" << label << "\"} " << v << "\n";
   }
+  for (const auto& source : sources_) os << source();
   return os.str();
 }
 

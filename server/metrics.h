@@ -4,6 +4,8 @@
 
 #include <array>
 #include <atomic>
+#include <functional>
+#include <vector>
 #include <map>
 #include <mutex>
 #include <string>
@@ -20,6 +22,8 @@ class Metrics {
   // A named counter (e.g. render passes by kind), exported as effectd_<name>_total{label}.
   void count(const std::string& name, const std::string& label, double by = 1.0);
   std::string render() const;
+  // Extra exposition text appended by render() (gauges owned by other components).
+  void addSource(std::function<std::string()> source) { sources_.push_back(std::move(source)); }
 
  private:
   struct Histogram {
@@ -32,6 +36,7 @@ class Metrics {
   std::map<std::string, Histogram> latency_;
   std::map<std::pair<std::string, std::string>, double> counters_;
   std::atomic<int64_t> inFlight_{0};
+  std::vector<std::function<std::string()>> sources_;  // set up before serving
 };
 
 }  // namespace effectd

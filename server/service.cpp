@@ -3,6 +3,8 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <charconv>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -11,9 +13,12 @@
 #include <random>
 #include <thread>
 
+#include <malloc.h>
+
 #include <effects/common.h>
 
 #include "codec.h"
+#include "encoding.h"
 #include "resources.h"
 
 namespace effectd {
@@ -23,6 +28,17 @@ using nlohmann::json;
 namespace {
 
 constexpr size_t kMaxJsonDepth = 64;
+// A JSON body costs its text, the parsed document (16-byte values in vectors that may be
+// half empty: ~4x the text for arrays of short numbers), and the canonical text for the ETag.
+constexpr size_t kJsonBodyFactor = 6;
+constexpr size_t kBinaryBodyFactor = 2;  // the bytes and the buffers decoded from them
+// After a request that reserved this much, free heap pages go back to the system at once.
+constexpr size_t kTrimAfterBytes = 32u << 20;
+// Headers a browser on another origin may read (CORS), and may send.
+constexpr const char* kExposedHeaders =
+    "ETag, Server-Timing, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, X-Render-Passes, "
+    "X-Render-Ms, X-Shader-Variants-Compiled, Retry-After";
+constexpr const char* kAllowedRequestHeaders = "Content-Type, If-None-Match, X-Request-ID";
 
 // Per-request state. A request is served start to finish on one worker thread, from the
 // pre-routing handler to the logger, so thread-local storage is the request's scratch pad.
@@ -31,6 +47,11 @@ struct RequestState {
   std::chrono::steady_clock::time_point start;
   std::string route = "unmatched";
   std::string requestId;
+  std::string acceptEncoding;  // taken off the request so cpp-httplib does not encode itself
+  std::string corsOrigin;      // the value of Access-Control-Allow-Origin, "" = no CORS headers
+  bool encoded = false;        // the answer's coding is chosen (and part of its ETag) already
+  // Held until the answer has been written (the logger runs after that).
+  Admission::Ticket bodyTicket, workTicket;
 };
 thread_local RequestState tl;
 
@@ -106,7 +127,12 @@ struct Service::Route {
   std::vector<std::string> methods;  // GET routes also answer HEAD
   std::string schema;                // for JSON POST routes
   JsonHandler json;
-  std::map<std::string, BinaryHandler> binary;  // by media type
+  CostEstimator cost;
+  struct Binary {
+    BinaryHandler handler;
+    BinaryEstimator cost;
+  };
+  std::map<std::string, Binary> binary;  // by media type
   std::function<std::string()> etagSalt;
 };
 
@@ -147,12 +173,30 @@ void writeProblem(httplib::Response& res, const ApiError& p, const std::string& 
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/problem+json");
 }
 
-Service::Service(Config config) : config_(std::move(config)), http_(std::make_unique<httplib::Server>()) {
+namespace {
+Admission::Options admissionOptions(const Config& c) {
+  Admission::Options o;
+  o.budgetBytes = c.memoryBudgetMb ? c.memoryBudgetMb << 20
+                                   : size_t(double(detectMemoryLimit().bytes) * kDefaultBudgetFraction);
+  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  o.heavySlots = c.heavyThreads > 0 ? c.heavyThreads : std::max(1, cores - 1);
+  o.maxWaiting = c.admissionQueue;
+  o.maxWait = std::chrono::milliseconds(c.admissionTimeoutMs);
+  return o;
+}
+}  // namespace
+
+Service::Service(Config config)
+    : config_(std::move(config)),
+      admission_(std::make_unique<Admission>(admissionOptions(config_))),
+      cache_(config_.responseCacheMb << 20),
+      http_(std::make_unique<httplib::Server>()) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())
     if (name.rfind("schemas/", 0) == 0) docs[name.substr(8)] = std::string(data);
   schemas_ = std::make_unique<SchemaRegistry>(docs);
   installCore();
+  installHttpPolicy();
 }
 
 Service::~Service() = default;
@@ -280,11 +324,17 @@ void Service::installCore() {
   });
 
   s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    tl = RequestState{true, std::chrono::steady_clock::now(), "unmatched", ""};
+    tl = RequestState{};
+    tl.active = true;
+    tl.start = std::chrono::steady_clock::now();
     metrics_.requestStarted();
     std::string given = req.get_header_value("X-Request-ID");
     tl.requestId = saneRequestId(given) ? given : newRequestId();
     res.set_header("X-Request-ID", tl.requestId);
+    // effectd negotiates the coding itself (encoding.h): cpp-httplib must not see the header.
+    tl.acceptEncoding = req.get_header_value("Accept-Encoding");
+    const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
+    tl.corsOrigin = allowedOrigin(req.get_header_value("Origin"));
 
     const Route* route = findRoute(req.path);
     if (!route && req.path.rfind("/v1/schemas/", 0) == 0) route = findRoute("/v1/schemas/");
@@ -299,6 +349,16 @@ void Service::installCore() {
     for (const auto& m : route->methods) {
       allowed = allowed || m == req.method;
       allow += (allow.empty() ? "" : ", ") + m;
+    }
+    if (req.method == "OPTIONS") {  // RFC 9110 9.3.7, and the CORS preflight
+      res.status = 204;
+      res.set_header("Allow", allow + ", OPTIONS");
+      if (!tl.corsOrigin.empty()) {
+        res.set_header("Access-Control-Allow-Methods", allow);
+        res.set_header("Access-Control-Allow-Headers", kAllowedRequestHeaders);
+        res.set_header("Access-Control-Max-Age", "600");
+      }
+      return httplib::Server::HandlerResponse::Handled;
     }
     if (!allowed) {
       return fail({405, "method-not-allowed", "Method Not Allowed",
@@ -336,6 +396,14 @@ void Service::installCore() {
       return fail({415, "unsupported-media-type", "Unsupported Media Type",
                    "Content-Type '" + type + "' is not accepted here; use " + accepted, {}, {{"Accept-Post", accepted}}});
     }
+    // The body is read after this handler returns: its memory is reserved before it arrives.
+    try {
+      tl.bodyTicket = admission_->admit(length * (type == "application/json" ? kJsonBodyFactor : kBinaryBodyFactor), false);
+    } catch (const ApiError& e) {
+      ApiError p = e;
+      p.headers["Connection"] = "close";  // the unread body must not be taken for the next request
+      return fail(p);
+    }
     return httplib::Server::HandlerResponse::Unhandled;
   });
 
@@ -365,8 +433,25 @@ void Service::installCore() {
                  tl.requestId);
   });
 
-  s.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
+  s.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
     if (!res.has_header("X-Request-ID")) res.set_header("X-Request-ID", tl.requestId);
+    if (!tl.corsOrigin.empty()) {
+      res.set_header("Access-Control-Allow-Origin", tl.corsOrigin);
+      res.set_header("Access-Control-Expose-Headers", kExposedHeaders);
+    }
+    const std::string type = res.get_header_value("Content-Type");
+    std::string vary = tl.encoded || compressible(type) ? "Accept-Encoding" : "";
+    if (!config_.corsOrigins.empty() && config_.corsOrigins != std::vector<std::string>{"*"})
+      vary += vary.empty() ? "Origin" : ", Origin";
+    if (!vary.empty()) res.set_header("Vary", vary);
+    // Answers without an ETag (contract documents, metrics, problems) are encoded here.
+    if (!tl.encoded && res.body.size() >= kMinCompressBytes && compressible(type) && !res.has_header("Content-Range")) {
+      Coding coding = negotiate(tl.acceptEncoding);
+      if (coding != Coding::kIdentity) {
+        res.body = encode(coding, res.body);
+        res.set_header("Content-Encoding", codingName(coding));
+      }
+    }
   });
 
   s.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
@@ -389,25 +474,75 @@ void Service::installCore() {
                    ts, jsonEscape(req.method).c_str(), jsonEscape(req.path).c_str(), res.status, res.body.size(),
                    seconds * 1e3, jsonEscape(tl.requestId).c_str(), jsonEscape(req.remote_addr).c_str());
     }
-    tl = RequestState{};
+    const bool large = tl.bodyTicket.bytes() + tl.workTicket.bytes() >= kTrimAfterBytes;
+    tl = RequestState{};  // releases the reservations: the answer has been written
+    // glibc keeps freed heap pages in its per-thread arenas; after a large request, hand
+    // them back now rather than holding the burst's peak for good.
+    if (large) malloc_trim(0);
   });
 }
 
-void Service::addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler) {
+std::string Service::allowedOrigin(const std::string& origin) const {
+  if (origin.empty()) return "";
+  for (const auto& o : config_.corsOrigins) {
+    if (o == "*") return "*";
+    if (o.size() == origin.size() && std::equal(o.begin(), o.end(), origin.begin(), [](char a, char b) {
+          return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+        }))
+      return origin;
+  }
+  return "";
+}
+
+void Service::installHttpPolicy() {
+  addReadinessCheck("admission", [this] {
+    return admission_->queueFull() ? std::string("admission queue full (--admission-queue)") : std::string();
+  });
+  metrics_.addSource([this] {
+    const Admission::Counts a = admission_->counts();
+    const ResponseCache::Counts c = cache_.counts();
+    std::string out;
+    auto metric = [&](const char* name, const char* type, const char* help, double value) {
+      out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type + "\neffectd_" +
+             name + " " + std::to_string(value) + "\n";
+    };
+    metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.", double(a.budgetBytes));
+    metric("memory_reserved_bytes", "gauge", "Bytes reserved by requests being served.", double(a.reservedBytes));
+    metric("memory_reserved_peak_bytes", "gauge", "Most bytes reserved at once since start.", double(a.peakReservedBytes));
+    metric("heavy_running", "gauge", "Heavy computations running.", a.heavyRunning);
+    metric("admission_waiting", "gauge", "Requests waiting for memory or a heavy slot.", a.waiting);
+    metric("admission_waits_total", "counter", "Requests that had to wait before admission.", double(a.waited));
+    metric("admission_refused_busy_total", "counter", "Requests refused with 503 after waiting or with the queue full.",
+           double(a.refusedBusy));
+    metric("admission_refused_too_large_total", "counter", "Requests refused with 413: larger than the whole budget.",
+           double(a.refusedTooLarge));
+    metric("response_cache_hits_total", "counter", "Answers served from the response cache.", double(c.hits));
+    metric("response_cache_misses_total", "counter", "Cacheable answers that had to be computed.", double(c.misses));
+    metric("response_cache_evictions_total", "counter", "Cache entries evicted to stay within --response-cache-mb.",
+           double(c.evictions));
+    metric("response_cache_bytes", "gauge", "Bytes held by the response cache.", double(c.bytes));
+    return out;
+  });
+}
+
+void Service::addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler,
+                              CostEstimator cost) {
   schemas_->document(schema);  // fail at startup, not at the first request
   auto r = std::make_unique<Route>();
   r->path = path;
   r->methods = {"POST"};
   r->schema = schema;
   r->json = std::move(handler);
+  r->cost = std::move(cost);
   const Route* raw = r.get();
   routes_.push_back(std::move(r));
-  http_->Post(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handleJson(*raw, req, res); });
+  http_->Post(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handlePost(*raw, req, res); });
 }
 
-void Service::addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler) {
+void Service::addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler,
+                                   BinaryEstimator cost) {
   for (auto& r : routes_)
-    if (r->path == path) r->binary[contentType] = std::move(handler);
+    if (r->path == path) r->binary[contentType] = {std::move(handler), std::move(cost)};
 }
 
 void Service::addReadinessCheck(const std::string& name, std::function<std::string()> probe) {
@@ -461,47 +596,126 @@ bool matches(const std::string& ifNoneMatch, const std::string& etag) {
 
 }  // namespace
 
-void Service::handleJson(const Route& route, const httplib::Request& req, httplib::Response& res) {
+// Rounds every number that is exactly a float32 to the shortest decimal that reads back to
+// the same float32 (0.7f goes out as 0.7, not 0.699999988079071): geometry, tables and colours
+// are float on the wire. A double that is not exactly a float keeps all its digits.
+void shortenFloats(json& j) {
+  if (j.is_number_float()) {
+    double& d = j.get_ref<json::number_float_t&>();
+    const float f = static_cast<float>(d);
+    if (static_cast<double>(f) != d || !std::isfinite(f)) return;
+    char buf[32];
+    auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
+    std::from_chars(buf, end, d);
+  } else if (j.is_array() || j.is_object()) {
+    for (auto& v : j) shortenFloats(v);
+  }
+}
+
+void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_};
-  // Deterministic answers: a strong validator from what determines them, checked before any work.
-  auto etag = [&](const std::string& canonical) {
-    std::string salt = route.etagSalt ? route.etagSalt() : "";
-    return "\"" + sha256Hex(std::string(EFFECTD_VERSION) + "\n" + route.path + "\n" + salt + "\n" + canonical).substr(0, 32) + "\"";
-  };
-  auto notModified = [&](const std::string& tag) {
-    res.set_header("ETag", tag);
-    if (!matches(req.get_header_value("If-None-Match"), tag)) return false;
-    res.status = 304;
-    return true;
-  };
-  try {
-    std::string type = mediaType(req.get_header_value("Content-Type"));
-    if (auto it = route.binary.find(type); it != route.binary.end()) {
-      if (notModified(etag(type + "\n" + req.body))) return;
-      BinaryReply reply = it->second(req.body, ctx);
-      res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
-      if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
-      res.set_content(std::move(reply.body), reply.contentType);
+  const std::string type = mediaType(req.get_header_value("Content-Type"));
+  const Coding coding = negotiate(tl.acceptEncoding);
+  const std::string inm = req.get_header_value("If-None-Match");
+  tl.encoded = true;
+  // The exact request bytes find a cached answer before any parsing.
+  const std::string requestKey = req.body.size() <= ResponseCache::kMaxAliasKeyBytes
+                                     ? route.path + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
+                                     : std::string();
+  auto send = [&](const CachedAnswer& a) {
+    res.set_header("ETag", a.etag);
+    if (matches(inm, a.etag)) {
+      res.status = 304;
       return;
     }
-    json body = parseBody(req.body);
-    auto violations = schemas_->validate(route.schema, body);
-    if (!violations.empty()) {
-      std::string detail = violations.front().pointer + ": " + violations.front().message;
-      if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
-      throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
+    for (const auto& [name, value] : a.headers) res.set_header(name, value);
+    if (!a.contentEncoding.empty()) res.set_header("Content-Encoding", a.contentEncoding);
+    res.set_content(a.body, a.contentType);
+  };
+  try {
+    if (auto hit = cache_.byRequest(requestKey)) {
+      res.set_header("Server-Timing", "cache;desc=\"hit\"");
+      return send(*hit);
     }
-    if (!asksForTimings(body) && notModified(etag(body.dump()))) return;
-    JsonReply reply = route.json(body, ctx);
-    res.set_header("Server-Timing", "compute;dur=" + std::to_string(reply.computeMs));
-    if (!reply.method.empty()) res.set_header("X-Effect-Method", reply.method);
-    for (const auto& [name, value] : reply.headers) res.set_header(name, value);
-    if (!reply.contentType.empty())
-      res.set_content(std::move(reply.binary), reply.contentType);
-    else
-      res.set_content(reply.body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+    const auto binary = route.binary.find(type);
+    json body;
+    std::string canonical;  // what determines the answer; "" = not cacheable
+    if (binary != route.binary.end()) {
+      canonical = type + "\n" + req.body;
+    } else {
+      body = parseBody(req.body);
+      auto violations = schemas_->validate(route.schema, body);
+      if (!violations.empty()) {
+        std::string detail = violations.front().pointer + ": " + violations.front().message;
+        if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
+        throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
+      }
+      if (!asksForTimings(body)) canonical = "application/json\n" + body.dump();
+    }
+    // Deterministic answers: a strong validator per representation (request and coding).
+    std::string tag;
+    if (!canonical.empty()) {
+      std::string salt = route.etagSalt ? route.etagSalt() : "";
+      tag = "\"" + sha256Hex(std::string(EFFECTD_VERSION) + "\n" + route.path + "\n" + salt + "\n" + canonical).substr(0, 32);
+      tag += coding == Coding::kIdentity ? "\"" : std::string("-") + codingName(coding) + "\"";
+      if (matches(inm, tag)) {
+        res.set_header("ETag", tag);
+        res.status = 304;
+        return;
+      }
+      if (auto hit = cache_.byTag(tag)) {
+        cache_.alias(requestKey, tag);
+        res.set_header("Server-Timing", "cache;desc=\"hit\"");
+        return send(*hit);
+      }
+    }
+    // Admission: the estimated peak is reserved until the answer has been written.
+    const Cost cost = binary != route.binary.end() ? binary->second.cost(req.body, config_) : route.cost(body, config_);
+    tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
+    res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
+
+    auto answer = std::make_shared<CachedAnswer>();
+    answer->etag = tag;
+    double computeMs = 0;
+    if (binary != route.binary.end()) {
+      BinaryReply reply = binary->second.handler(req.body, ctx);
+      computeMs = reply.computeMs;
+      if (!reply.method.empty()) answer->headers["X-Effect-Method"] = reply.method;
+      answer->body = std::move(reply.body);
+      answer->contentType = reply.contentType;
+    } else {
+      JsonReply reply = route.json(body, ctx);
+      body = json();  // the request document is no longer needed
+      computeMs = reply.computeMs;
+      if (!reply.method.empty()) answer->headers["X-Effect-Method"] = reply.method;
+      answer->headers.insert(reply.headers.begin(), reply.headers.end());
+      for (const auto& [name, value] : reply.runHeaders) res.set_header(name, value);
+      if (!reply.contentType.empty()) {
+        answer->body = std::move(reply.binary);
+        answer->contentType = reply.contentType;
+      } else {
+        shortenFloats(reply.body);
+        answer->body = reply.body.dump(-1, ' ', false, json::error_handler_t::replace);
+        answer->contentType = "application/json";
+      }
+    }
+    if (coding != Coding::kIdentity && compressible(answer->contentType) && answer->body.size() >= kMinCompressBytes) {
+      answer->body = encode(coding, answer->body);
+      answer->contentEncoding = codingName(coding);
+    }
+    res.set_header("Server-Timing", "compute;dur=" + std::to_string(computeMs));
+    if (tag.empty()) {
+      for (const auto& [name, value] : answer->headers) res.set_header(name, value);
+      if (!answer->contentEncoding.empty()) res.set_header("Content-Encoding", answer->contentEncoding);
+      res.set_content(std::move(answer->body), answer->contentType);
+      return;
+    }
+    send(*answer);
+    cache_.put(std::move(answer), requestKey);
   } catch (const ApiError& e) {
     res.headers.erase("ETag");  // problems are not cacheable representations
+    res.headers.erase("Server-Timing");
+    tl.encoded = false;
     writeProblem(res, e, ctx.requestId);
   }
 }

@@ -12,8 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "admission.h"
 #include "config.h"
 #include "metrics.h"
+#include "response_cache.h"
 #include "schema.h"
 
 namespace effects { struct Error; struct Stats; }
@@ -43,8 +45,23 @@ struct JsonReply {
   std::string method;  // the method that ran, echoed in the X-Effect-Method header
   // A JSON request may answer with bytes of another media type instead (e.g. image/png).
   std::string binary, contentType;
-  std::map<std::string, std::string> headers;
+  std::map<std::string, std::string> headers;     // part of the answer (cached with it)
+  std::map<std::string, std::string> runHeaders;  // facts of this run (timings): not cached
 };
+
+// What a request will cost, estimated from its body before any work starts: the bytes it
+// holds at its peak (inputs, working set, the answer as JSON and as sent) and whether it is
+// heavy (seconds of CPU). Admission control reserves these (see admission.h).
+struct Cost {
+  size_t bytes = 0;
+  bool heavy = false;
+  Cost& operator+=(const Cost& o) {
+    bytes += o.bytes;
+    heavy = heavy || o.heavy;
+    return *this;
+  }
+};
+using CostEstimator = std::function<Cost(const nlohmann::json& body, const Config& config)>;
 
 struct RequestContext {
   std::string requestId;
@@ -60,6 +77,7 @@ struct BinaryReply {
   std::string method;
 };
 using BinaryHandler = std::function<BinaryReply(const std::string& body, const RequestContext& ctx)>;
+using BinaryEstimator = std::function<Cost(const std::string& body, const Config& config)>;
 
 class Service {
  public:
@@ -68,10 +86,12 @@ class Service {
   Service(const Service&) = delete;
   Service& operator=(const Service&) = delete;
 
-  // POST `path` with an application/json body validated against proto/schemas/<schema>.
-  void addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler);
+  // POST `path` with an application/json body validated against proto/schemas/<schema>;
+  // `cost` estimates each valid request's peak memory before the handler runs.
+  void addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler, CostEstimator cost);
   // Lets `path` also accept a body of `contentType` (its own handler, no JSON Schema).
-  void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler);
+  void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler,
+                            BinaryEstimator cost);
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
   // Responses carry a strong ETag: SHA-256 of the version, the route, the canonical request
@@ -88,15 +108,21 @@ class Service {
   const Config& config() const { return config_; }
   Metrics& metrics() { return metrics_; }
   const SchemaRegistry& schemas() const { return *schemas_; }
+  Admission& admission() { return *admission_; }
+  ResponseCache& responseCache() { return cache_; }
 
  private:
   struct Route;
   void installCore();
-  void handleJson(const Route& route, const httplib::Request& req, httplib::Response& res);
+  void installHttpPolicy();
+  void handlePost(const Route& route, const httplib::Request& req, httplib::Response& res);
   const Route* findRoute(const std::string& path) const;
+  std::string allowedOrigin(const std::string& origin) const;  // "" when not allowed
 
   Config config_;
   Metrics metrics_;
+  std::unique_ptr<Admission> admission_;
+  ResponseCache cache_;
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
   std::vector<std::unique_ptr<Route>> routes_;

@@ -246,7 +246,7 @@ TEST(Api, ExceptionsBecome500WithoutInternals) {
   Service svc(c);
   svc.addJsonEndpoint("/v1/fog", "fog.json", [](const json&, const RequestContext&) -> JsonReply {
     throw std::runtime_error("secret internal detail /etc/passwd");
-  });
+  }, [](const json&, const Config&) { return Cost{}; });
   int port = svc.bind();
   std::thread t([&] { svc.run(); });
   svc.waitUntilRunning(std::chrono::seconds(5));

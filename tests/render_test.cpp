@@ -211,7 +211,9 @@ TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
   EXPECT_EQ(withFog.find("uRegionLo"), std::string::npos) << "region code only with regions";
   EXPECT_EQ(rd::detail::compositeFragment(false).find("uGlow"), std::string::npos);
 
-  TestServer s;
+  Config uncached = TestServer::quietConfig();
+  uncached.responseCacheMb = 0;  // every request renders: the compile counts are what is tested
+  TestServer s(uncached);
   json scene = {{"width", 64}, {"height", 64}, {"quads", {{{"center", {0, 0.5, 0}}, {"size", {1, 1}}}}}};
   auto r = render(s, scene);
   ASSERT_TRUE(r);
@@ -308,6 +310,7 @@ TEST(Render, SaturatedPoolAnswers503WithRetryAfterAndRecovers) {
   c.threads = 16;
   c.renderThreads = 1;
   c.renderQueue = 0;
+  c.responseCacheMb = 0;  // repeats would be answered from the cache, never reaching the pool
   TestServer s(c);
   json scene = {{"width", 512}, {"height", 512},
                 {"lightning", {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}}},
