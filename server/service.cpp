@@ -3,8 +3,6 @@
 #include <httplib.h>
 
 #include <atomic>
-#include <charconv>
-#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -19,6 +17,7 @@
 
 #include "codec.h"
 #include "encoding.h"
+#include "json_writer.h"
 #include "resources.h"
 
 namespace effectd {
@@ -503,8 +502,10 @@ void Service::installHttpPolicy() {
     const ResponseCache::Counts c = cache_.counts();
     std::string out;
     auto metric = [&](const char* name, const char* type, const char* help, double value) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%.17g", value);
       out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type + "\neffectd_" +
-             name + " " + std::to_string(value) + "\n";
+             name + " " + number + "\n";
     };
     metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.", double(a.budgetBytes));
     metric("memory_reserved_bytes", "gauge", "Bytes reserved by requests being served.", double(a.reservedBytes));
@@ -596,22 +597,6 @@ bool matches(const std::string& ifNoneMatch, const std::string& etag) {
 
 }  // namespace
 
-// Rounds every number that is exactly a float32 to the shortest decimal that reads back to
-// the same float32 (0.7f goes out as 0.7, not 0.699999988079071): geometry, tables and colours
-// are float on the wire. A double that is not exactly a float keeps all its digits.
-void shortenFloats(json& j) {
-  if (j.is_number_float()) {
-    double& d = j.get_ref<json::number_float_t&>();
-    const float f = static_cast<float>(d);
-    if (static_cast<double>(f) != d || !std::isfinite(f)) return;
-    char buf[32];
-    auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
-    std::from_chars(buf, end, d);
-  } else if (j.is_array() || j.is_object()) {
-    for (auto& v : j) shortenFloats(v);
-  }
-}
-
 void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_};
   const std::string type = mediaType(req.get_header_value("Content-Type"));
@@ -694,8 +679,7 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
         answer->body = std::move(reply.binary);
         answer->contentType = reply.contentType;
       } else {
-        shortenFloats(reply.body);
-        answer->body = reply.body.dump(-1, ' ', false, json::error_handler_t::replace);
+        answer->body = writeJson(reply.body);
         answer->contentType = "application/json";
       }
     }
