@@ -11,7 +11,7 @@ namespace {
 
 // A number in an answer: the JSON value in its array (16 B, vectors up to 2x their size),
 // its text, and the encoded copy.
-constexpr size_t kAnswerNumber = 64;
+constexpr size_t kAnswerNumber = 56;
 constexpr size_t kBase = 256u << 10;  // any request: handler scratch, headers, strings
 // Work above these sizes takes long enough to hold a core: it is heavy.
 constexpr size_t kHeavyGridCells = 1024u * 1024u;
@@ -34,7 +34,7 @@ Cost fogCost(const json& body, const Config& config) {
   entries = std::min(entries, config.limits.maxTableSize);
   const size_t colors = body.contains("objectColors") ? body["objectColors"].size() : 0;
   const size_t samples = body.contains("samples") ? body["samples"].value("points", json::array()).size() : 0;
-  return {kBase + entries * (16 + kAnswerNumber * (4 + 3 * colors)) + samples * 8 * kAnswerNumber, false};
+  return {kBase + entries * (64 + kAnswerNumber * (4 + 3 * colors)) + samples * 8 * kAnswerNumber, false};
 }
 
 Cost lightningCost(const json& body, const Config& config) {
@@ -45,10 +45,10 @@ Cost lightningCost(const json& body, const Config& config) {
                                 solver ? config.limits.maxSolverGridCells : config.limits.maxGridCells);
   // Working set per cell: fast keeps the obstacle grid, candidate and potential state and
   // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils).
-  const size_t perCell = solver ? 320 : 24;
+  const size_t perCell = solver ? 160 : 24;
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
-  const size_t boltCells = std::min({cells, steps, 64 * size_t(std::sqrt(double(cells))) + 4096});
+  const size_t boltCells = std::min({cells, steps, 16 * size_t(std::sqrt(double(cells))) + 4096});
   size_t numbersPerCell = 0;
   if (includes(body, "polylines", true)) numbersPerCell += 5;
   if (includes(body, "cells", false)) numbersPerCell += 2;
@@ -60,10 +60,15 @@ Cost tangentsCost(const json& body, const Config& config) {
   const json& m = body["mesh"];
   const size_t vertices = std::min(m["positions"].size() / 3, config.limits.maxMeshVertices);
   const size_t triangles = std::min(m["indices"].size() / 3, config.limits.maxMeshTriangles);
-  // Welding, adjacency and the MikkTSpace groups per corner, frames per vertex; the answer
-  // (tangents, remap, indices, optional normals and per-triangle frames) as JSON numbers.
-  const size_t answer = vertices * 2 * (4 + 1 + 3) + triangles * (3 + 13);
-  return {kBase + triangles * 3 * 96 + vertices * 2 * 64 + answer * kAnswerNumber, triangles >= kHeavyTriangles};
+  // Welding, adjacency and the MikkTSpace groups per corner, frames per vertex (the output
+  // may have up to twice the vertices after splits); the answer as JSON numbers.
+  size_t numbers = 0;
+  if (includes(body, "tangents", true)) numbers += 2 * vertices * 4;
+  if (includes(body, "remap", true)) numbers += 2 * vertices;
+  if (includes(body, "indices", true)) numbers += 3 * triangles;
+  if (includes(body, "normals", false)) numbers += 2 * vertices * 3;
+  if (includes(body, "triangleFrames", false)) numbers += 11 * triangles;
+  return {kBase + triangles * 3 * 64 + vertices * 2 * 64 + numbers * kAnswerNumber, triangles >= kHeavyTriangles};
 }
 
 Cost glbCost(const std::string& body, const Config&) {
@@ -77,14 +82,15 @@ Cost bubbleCost(const json& body, const Config& config) {
   if (includes(body, "mesh", false)) {
     const int level = std::min(body.value("mesh", json::object()).value("level", 3), 7);
     const size_t vertices = 10 * (size_t(1) << (2 * level)) + 2, triangles = 20 * (size_t(1) << (2 * level));
-    c.bytes += vertices * (256 + 16 * kAnswerNumber) + triangles * (64 + 3 * kAnswerNumber);
+    const size_t perVertex = body.contains("camera") ? 16 : 12;  // + final vectors and rim
+    c.bytes += vertices * (64 + perVertex * kAnswerNumber) + triangles * (16 + 3 * kAnswerNumber);
     c.heavy = level >= kHeavyLevel;
   }
   if (includes(body, "thinFilm", false)) {
     const json tf = body.value("thinFilm", json::object());
     const size_t texels =
         std::min(size_t(tf.value("width", 256)) * size_t(tf.value("height", 256)), config.limits.maxThinFilmTexels);
-    c.bytes += texels * (24 + 3 * kAnswerNumber);
+    c.bytes += texels * (24 + 3 * kAnswerNumber + 8);  // float RGB, its numbers, or RGBA16F base64
   }
   return c;
 }
@@ -101,8 +107,9 @@ Cost renderCost(const json& body, const Config& config) {
   Cost c = sceneCost(body, config);
   const size_t pixels =
       std::min(size_t(body.value("width", 512)) * size_t(body.value("height", 512)), config.limits.maxRenderPixels);
-  // Read-back RGBA float, the converted 8/16-bit image, the PNG; a decoded background image.
-  c.bytes += pixels * 40;
+  // Render targets and read-back (RGBA float), the converted 8/16-bit image, the PNG; a
+  // decoded background image.
+  c.bytes += pixels * 96;
   if (body.contains("background") && body["background"].contains("image")) c.bytes += config.limits.maxRenderPixels * 16;
   c.heavy = c.heavy || pixels >= (2048u * 2048u);
   return c;
