@@ -449,6 +449,8 @@ void Service::installCore() {
       if (coding != Coding::kIdentity) {
         res.body = encode(coding, res.body);
         res.set_header("Content-Encoding", codingName(coding));
+        res.headers.erase("Content-Length");  // cpp-httplib set it before this handler runs
+        res.set_header("Content-Length", std::to_string(res.body.size()));
       }
     }
   });
