@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Load and soak over loopback with wrk: a mixed load of valid requests against one effectd
-# (CONNECTIONS connections, SECONDS seconds), then /v1/fog against nginx serving the same
-# response bytes as a static file, in the same run. Prints throughput, p50/p99 per endpoint
-# (from effectd's own latency histograms), errors, and RSS before/after.
+# (CONNECTIONS connections, SECONDS seconds), then each route alone as wrk sees it (client-side
+# latency distribution), then /v1/fog against nginx serving the same response bytes as a
+# static file (wrk -t2 -c16), in the same run. Prints throughput, client-side p50/p90/p99 per
+# route beside the server's own histograms, errors, and RSS before/after. Keep-alive latency
+# on one connection and cheap-under-heavy figures: bench/serving_bench.py.
 #   scripts/load.sh [SECONDS=60] [CONNECTIONS=64]     (build first: scripts/build.sh)
 # Exit 1 when a request failed or RSS grew by 10 % or more.
 set -euo pipefail
@@ -60,6 +62,22 @@ awk '
       printf "\n"
     }
   }' "$work/metrics.txt" | sort
+echo "(server histograms above; what clients see, each route alone, $connections connections:)"
+short=$(( seconds < 15 ? seconds : 15 ))
+printf "%-28s %10s %10s %10s %10s\n" "route (client side, wrk)" "req/s" "p50 ms" "p90 ms" "p99 ms"
+client_side() {  # name, wrk args...
+  local name=$1; shift
+  wrk -t2 -c"$connections" -d"${short}s" --latency "$@" >"$work/route.txt"
+  awk -v n="$name" '
+    function ms(v) { if (v ~ /us$/) return v / 1000; if (v ~ /ms$/) return v + 0; if (v ~ /s$/) return v * 1000; return v }
+    /Requests\/sec/ { r = $2 } / 50%/ { a = ms($2) } / 90%/ { b = ms($2) } / 99%/ { c = ms($2) }
+    END { printf "%-28s %10.0f %10.2f %10.2f %10.2f\n", n, r, a, b, c }' "$work/route.txt"
+}
+client_side "GET /healthz" "$url/healthz"
+BODY='{"fog":{"fogType":"GL_EXP2","density":0.05},"table":{"size":256}}' client_side "POST /v1/fog (repeat)" -s tests/load/post.lua "$url/v1/fog"
+BODY='{"grid":{"width":128,"height":128},"start":[64,0],"targets":[[64,127]]}' \
+  client_side "POST /v1/lightning (repeat)" -s tests/load/post.lua "$url/v1/lightning"
+client_side "mixed (tests/load/mixed.lua)" -s tests/load/mixed.lua "$url"
 growth=$(awk -v a="$before" -v b="$after" 'BEGIN { printf "%.1f", (b - a) * 100 / a }')
 echo
 echo "RSS: ${before} kB before, ${after} kB after (${growth} %)"
@@ -88,10 +106,9 @@ nginx -p "$work" -c "$work/nginx.conf" -g "daemon off; $user" >/dev/null 2>"$wor
 pids+=($!)
 for _ in $(seq 100); do curl -sf "http://127.0.0.1:$nport/fog.json" >/dev/null && break; sleep 0.05; done
 cmp -s "$work/fog.json" <(curl -s "http://127.0.0.1:$nport/fog.json") || { echo "nginx serves other bytes"; exit 1; }
-short=$(( seconds < 15 ? seconds : 15 ))
-ours=$(BODY="$body" wrk -t2 -c"$connections" -d"${short}s" -s tests/load/post.lua "$url/v1/fog" | awk '/Requests\/sec/ {print $2}')
-theirs=$(wrk -t2 -c"$connections" -d"${short}s" "http://127.0.0.1:$nport/fog.json" | awk '/Requests\/sec/ {print $2}')
-echo "/v1/fog $ours req/s vs nginx static file $theirs req/s: ratio $(awk -v a="$ours" -v b="$theirs" 'BEGIN { printf "%.2f", a / b }') (target >= 0.5)"
+ours=$(BODY="$body" wrk -t2 -c16 -d"${short}s" -s tests/load/post.lua "$url/v1/fog" | awk '/Requests\/sec/ {print $2}')
+theirs=$(wrk -t2 -c16 -d"${short}s" "http://127.0.0.1:$nport/fog.json" | awk '/Requests\/sec/ {print $2}')
+echo "/v1/fog (wrk -t2 -c16) $ours req/s vs nginx static file $theirs req/s: ratio $(awk -v a="$ours" -v b="$theirs" 'BEGIN { printf "%.2f", a / b }') (target >= 0.5)"
 
 [ "$non2xx" -eq 0 ] && [ "$sockerr" -eq 0 ] || { echo "FAIL: errors under load"; exit 1; }
 awk -v g="$growth" 'BEGIN { exit !(g < 10) }' || { echo "FAIL: RSS grew by $growth %"; exit 1; }

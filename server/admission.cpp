@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "service.h"
@@ -42,22 +43,19 @@ Admission::Ticket Admission::admit(size_t bytes, bool heavy) {
     ++c_.refusedBusy;
     return ApiError{503, "busy", "Server busy", why + "; retry shortly", {}, {{"Retry-After", "1"}}};
   };
-  if (queue_.empty() && fits(bytes, heavy)) {
+  std::deque<uint64_t>& queue = queue_[heavy ? 1 : 0];
+  if (queue.empty() && fits(bytes, heavy)) {
     // Admitted at once.
   } else {
-    if (int(queue_.size()) >= o_.maxWaiting)
+    if (int(queue_[0].size() + queue_[1].size()) >= o_.maxWaiting)
       throw busy("the admission queue is full (" + std::to_string(o_.maxWaiting) + " requests wait for memory or a heavy slot)");
     const uint64_t id = nextId_++;
-    queue_.push_back(id);
+    queue.push_back(id);
     ++c_.waited;
-    c_.waiting = int(queue_.size());
-    bool ok = cv_.wait_for(lock, o_.maxWait, [&] { return queue_.front() == id && fits(bytes, heavy); });
-    for (auto it = queue_.begin(); it != queue_.end(); ++it)
-      if (*it == id) {
-        queue_.erase(it);
-        break;
-      }
-    c_.waiting = int(queue_.size());
+    c_.waiting = int(queue_[0].size() + queue_[1].size());
+    bool ok = cv_.wait_for(lock, o_.maxWait, [&] { return queue.front() == id && fits(bytes, heavy); });
+    queue.erase(std::find(queue.begin(), queue.end(), id));
+    c_.waiting = int(queue_[0].size() + queue_[1].size());
     cv_.notify_all();  // the next in line may fit now
     if (!ok)
       throw busy("waited " + std::to_string(o_.maxWait.count()) + " ms for " + mb(bytes) +
@@ -93,7 +91,7 @@ Admission::Counts Admission::counts() const {
 
 bool Admission::queueFull() const {
   std::lock_guard<std::mutex> lock(mu_);
-  return int(queue_.size()) >= o_.maxWaiting;
+  return int(queue_[0].size() + queue_[1].size()) >= o_.maxWaiting;
 }
 
 namespace {

@@ -4,7 +4,8 @@
 // whether it is heavy (seconds of CPU: the Laplace solvers, huge grids, meshes and renders).
 // It is admitted when its bytes fit in what the budget has left and, if heavy, when a heavy
 // slot is free; otherwise it waits in a bounded queue for a bounded time, first come first
-// served, and is then refused with 503 + Retry-After. A request larger than the whole budget
+// served within its class, and is then refused with 503 + Retry-After. Light and heavy
+// requests queue apart: a small request never waits behind bolts waiting for a heavy slot. A request larger than the whole budget
 // can never run: 413 naming --memory-budget-mb. The ticket releases its bytes and slot when
 // destroyed — after the answer has been written, since the answer's bytes count too.
 #pragma once
@@ -63,7 +64,7 @@ class Admission {
   const Options o_;
   mutable std::mutex mu_;
   std::condition_variable cv_;
-  std::deque<uint64_t> queue_;  // waiting requests in arrival order
+  std::deque<uint64_t> queue_[2];  // waiting requests in arrival order: [0] light, [1] heavy
   uint64_t nextId_ = 0;
   Counts c_;
 };
