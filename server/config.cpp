@@ -95,12 +95,7 @@ const std::vector<Option>& options() {
       {"memory-budget-mb", "EFFECTD_MEMORY_BUDGET_MB",
        "memory all requests together may reserve at their estimated peaks; beyond it they wait, then 503 "
        "(default 0 = 60 % of the cgroup memory limit, or of physical memory without one)",
-       [](const std::string& s, Config& c) {
-         long long v;
-         if (!parseInt(s, 0, 1LL << 22, v)) return false;
-         c.memoryBudgetMb = size_t(v);
-         return true;
-       }},
+       intField(&Config::memoryBudgetMb, 0, 1LL << 22)},
       {"heavy-threads", "EFFECTD_HEAVY_THREADS",
        "heavy computations (Laplace solvers, huge grids and meshes) at once, so cheap requests keep a core "
        "(default 0 = cores - 1, at least 1)",
@@ -110,12 +105,7 @@ const std::vector<Option>& options() {
       {"admission-timeout-ms", "EFFECTD_ADMISSION_TIMEOUT_MS", "longest wait for memory or a heavy slot before 503 (default 10000)",
        intField(&Config::admissionTimeoutMs, 0, 3600000)},
       {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB", "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
-       [](const std::string& s, Config& c) {
-         long long v;
-         if (!parseInt(s, 0, 1LL << 20, v)) return false;
-         c.responseCacheMb = size_t(v);
-         return true;
-       }},
+       intField(&Config::responseCacheMb, 0, 1LL << 20)},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default none)",
        [](const std::string& s, Config& c) {
