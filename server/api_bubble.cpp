@@ -84,7 +84,7 @@ json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std:
 }  // namespace
 
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
-  Includes include(body, {"uniforms", "shader"});
+  Includes include(body, kBubbleIncludes);
   const bb::Params params = parseBubbleParams(body.value("params", json::object()));
   const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
   const double t = body.value("time", 0.0);

@@ -124,7 +124,7 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
 }  // namespace
 
 JsonReply handleFog(const json& body, const RequestContext& ctx) {
-  Includes include(body, {"table"});
+  Includes include(body, kFogIncludes);
   fog::Fog global = parseFog(body["fog"], "/fog");
   std::vector<fog::Region> regions;
   if (body.contains("regions"))

@@ -103,7 +103,7 @@ lt::Bolt growBolt(const lt::Params& p) {
 }
 
 JsonReply handleLightning(const json& body, const RequestContext& ctx) {
-  Includes include(body, {"polylines"});
+  Includes include(body, kLightningIncludes);
   LightningRequest request = parseLightning(body, ctx.config);
   const lt::Params& p = request.params;
   request.params.measureError = include.has("error");

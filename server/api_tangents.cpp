@@ -45,7 +45,7 @@ void flipW(tg::Output& out) {
 }  // namespace
 
 JsonReply handleTangents(const json& body, const RequestContext& ctx) {
-  Includes include(body, {"tangents", "remap", "indices"});
+  Includes include(body, kTangentsIncludes);
   const json& m = body["mesh"];
   tg::Mesh mesh;
   mesh.positions = unflatten<glm::vec3, 3>(m["positions"], "/mesh/positions");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "endpoints.h"
+
 namespace effectd {
 
 using nlohmann::json;
@@ -17,12 +19,6 @@ constexpr size_t kBase = 256u << 10;  // any request: handler scratch, headers, 
 constexpr size_t kHeavyGridCells = 1024u * 1024u;
 constexpr size_t kHeavyTriangles = 200'000;
 constexpr int kHeavyLevel = 6;
-
-size_t includes(const json& body, const char* what, bool byDefault) {
-  auto it = body.find("include");
-  if (it == body.end()) return byDefault;
-  return std::find(it->begin(), it->end(), what) != it->end();
-}
 
 }  // namespace
 
@@ -49,10 +45,11 @@ Cost lightningCost(const json& body, const Config& config) {
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
   const size_t boltCells = std::min({cells, steps, 16 * size_t(std::sqrt(double(cells))) + 4096});
+  const Includes include(body, kLightningIncludes);
   size_t numbersPerCell = 0;
-  if (includes(body, "polylines", true)) numbersPerCell += 5;
-  if (includes(body, "cells", false)) numbersPerCell += 2;
-  if (includes(body, "tree", false)) numbersPerCell += 3;
+  if (include.has("polylines")) numbersPerCell += 5;
+  if (include.has("cells")) numbersPerCell += 2;
+  if (include.has("tree")) numbersPerCell += 3;
   return {kBase + cells * perCell + boltCells * (96 + numbersPerCell * kAnswerNumber), solver || cells >= kHeavyGridCells};
 }
 
@@ -62,12 +59,13 @@ Cost tangentsCost(const json& body, const Config& config) {
   const size_t triangles = std::min(m["indices"].size() / 3, config.limits.maxMeshTriangles);
   // Welding, adjacency and the MikkTSpace groups per corner, frames per vertex (the output
   // may have up to twice the vertices after splits); the answer as JSON numbers.
+  const Includes include(body, kTangentsIncludes);
   size_t numbers = 0;
-  if (includes(body, "tangents", true)) numbers += 2 * vertices * 4;
-  if (includes(body, "remap", true)) numbers += 2 * vertices;
-  if (includes(body, "indices", true)) numbers += 3 * triangles;
-  if (includes(body, "normals", false)) numbers += 2 * vertices * 3;
-  if (includes(body, "triangleFrames", false)) numbers += 11 * triangles;
+  if (include.has("tangents")) numbers += 2 * vertices * 4;
+  if (include.has("remap")) numbers += 2 * vertices;
+  if (include.has("indices")) numbers += 3 * triangles;
+  if (include.has("normals")) numbers += 2 * vertices * 3;
+  if (include.has("triangleFrames")) numbers += 11 * triangles;
   return {kBase + triangles * 3 * 64 + vertices * 2 * 64 + numbers * kAnswerNumber, triangles >= kHeavyTriangles};
 }
 
@@ -78,15 +76,16 @@ Cost glbCost(const std::string& body, const Config&) {
 }
 
 Cost bubbleCost(const json& body, const Config& config) {
+  const Includes include(body, kBubbleIncludes);
   Cost c{kBase, false};
-  if (includes(body, "mesh", false)) {
+  if (include.has("mesh")) {
     const int level = std::min(body.value("mesh", json::object()).value("level", 3), 7);
     const size_t vertices = 10 * (size_t(1) << (2 * level)) + 2, triangles = 20 * (size_t(1) << (2 * level));
     const size_t perVertex = body.contains("camera") ? 16 : 12;  // + final vectors and rim
     c.bytes += vertices * (64 + perVertex * kAnswerNumber) + triangles * (16 + 3 * kAnswerNumber);
     c.heavy = level >= kHeavyLevel;
   }
-  if (includes(body, "thinFilm", false)) {
+  if (include.has("thinFilm")) {
     const json tf = body.value("thinFilm", json::object());
     const size_t texels =
         std::min(size_t(tf.value("width", 256)) * size_t(tf.value("height", 256)), config.limits.maxThinFilmTexels);

@@ -3,6 +3,7 @@
 #include <brotli/encode.h>
 #include <zlib.h>
 
+#include <cctype>
 #include <cstdlib>
 
 namespace effectd {

@@ -48,6 +48,11 @@ glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers
 // A problem about one field: 400 invalid-field, 413 limit-exceeded, 422 (well-formed but
 // impossible); detail "<pointer>: <message>", errors [{pointer, message}].
 ApiError fieldError(int status, const std::string& pointer, const std::string& message);
+// What each endpoint answers when the body has no "include" list (handlers and costs.cpp).
+inline const std::vector<std::string> kFogIncludes = {"table"};
+inline const std::vector<std::string> kLightningIncludes = {"polylines"};
+inline const std::vector<std::string> kTangentsIncludes = {"tangents", "remap", "indices"};
+inline const std::vector<std::string> kBubbleIncludes = {"uniforms", "shader"};
 // The body's "include" list as a set test; `defaults` applies when "include" is absent.
 class Includes {
  public:

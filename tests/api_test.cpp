@@ -32,29 +32,33 @@ void sendAll(int fd, const std::string& bytes) {
   }
 }
 
-std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
-  int fd = connectLoopback(port);
-  if (fd < 0) return "";
-  sendAll(fd, bytes);
+KeepAlive::KeepAlive(int port) : fd_(connectLoopback(port)) {}
+
+KeepAlive::~KeepAlive() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::string KeepAlive::exchange(const std::string& bytes, int timeoutMs) {
+  sendAll(fd_, bytes);
   std::string out;
-  char buf[4096];
-  pollfd p{fd, POLLIN, 0};
+  char buf[65536];
+  pollfd p{fd_, POLLIN, 0};
   while (::poll(&p, 1, timeoutMs) > 0) {
-    ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
     if (n <= 0) break;
     out.append(buf, size_t(n));
-    if (out.find("\r\n\r\n") != std::string::npos) {
-      // Stop once the announced body is complete (keep-alive connections stay open).
-      auto head = out.substr(0, out.find("\r\n\r\n"));
-      auto cl = head.find("Content-Length: ");
-      if (cl != std::string::npos) {
-        size_t len = std::stoul(head.substr(cl + 16));
-        if (out.size() >= head.size() + 4 + len) break;
-      }
-    }
+    // Stop once the announced body is complete (keep-alive connections stay open).
+    auto end = out.find("\r\n\r\n");
+    if (end == std::string::npos) continue;
+    auto cl = out.find("Content-Length: ");
+    if (cl != std::string::npos && cl < end && out.size() >= end + 4 + std::stoul(out.substr(cl + 16))) break;
   }
-  ::close(fd);
   return out;
+}
+
+std::string rawExchange(int port, const std::string& bytes, int timeoutMs) {
+  KeepAlive c(port);
+  return c.ok() ? c.exchange(bytes, timeoutMs) : std::string();
 }
 
 namespace {

@@ -1,9 +1,5 @@
 // HTTP as clients meet it, measured from the client's side of a real socket: keep-alive
 // latency, content negotiation, CORS, the response cache, the memory budget.
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <zlib.h>
 
 #include <algorithm>
@@ -19,36 +15,6 @@ namespace effectd::testing {
 namespace {
 
 using nlohmann::json;
-
-// One client connection kept alive across requests, each sent in a single write.
-class KeepAlive {
- public:
-  explicit KeepAlive(int port) : fd_(connectLoopback(port)) {}
-  ~KeepAlive() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  bool ok() const { return fd_ >= 0; }
-  // Sends `request` and reads one whole response (head + Content-Length bytes).
-  std::string exchange(const std::string& request) {
-    sendAll(fd_, request);
-    std::string out;
-    char buf[65536];
-    pollfd p{fd_, POLLIN, 0};
-    while (::poll(&p, 1, 5000) > 0) {
-      ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
-      if (n <= 0) break;
-      out.append(buf, size_t(n));
-      auto end = out.find("\r\n\r\n");
-      if (end == std::string::npos) continue;
-      auto cl = out.find("Content-Length: ");
-      if (cl != std::string::npos && cl < end && out.size() >= end + 4 + std::stoul(out.substr(cl + 16))) break;
-    }
-    return out;
-  }
-
- private:
-  int fd_;
-};
 
 double medianMs(std::vector<double> v) {
   std::sort(v.begin(), v.end());

@@ -58,8 +58,23 @@ class TestServer {
   std::thread thread_;
 };
 
-// Sends raw bytes over a fresh TCP connection and returns everything the server answered
-// until it closed the connection or `timeoutMs` passed.
+// One client connection kept alive across requests, each request sent in a single write.
+class KeepAlive {
+ public:
+  explicit KeepAlive(int port);
+  ~KeepAlive();
+  KeepAlive(const KeepAlive&) = delete;
+  KeepAlive& operator=(const KeepAlive&) = delete;
+  bool ok() const { return fd_ >= 0; }
+  // Sends `bytes` and returns what came back: one whole response (head + Content-Length
+  // bytes), or everything until the server closed the connection or `timeoutMs` passed.
+  std::string exchange(const std::string& bytes, int timeoutMs = 5000);
+
+ private:
+  int fd_;
+};
+// Sends raw bytes over a fresh TCP connection and returns what the server answered (as
+// KeepAlive::exchange).
 std::string rawExchange(int port, const std::string& bytes, int timeoutMs = 3000);
 // A TCP connection to 127.0.0.1:port, or -1.
 int connectLoopback(int port);
