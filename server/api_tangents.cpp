@@ -116,6 +116,13 @@ void check(const std::optional<glb::Problem>& p, int status = 422) {
   if (p) throw gltfProblem(status, *p);
 }
 
+// An accessor index from the glTF document (`pointer` names where it was read).
+int accessorIndex(const json& value, const std::string& pointer) {
+  uint64_t index = 0;
+  check(glb::unsignedValue(value, pointer, INT32_MAX, index));
+  return int(index);
+}
+
 // Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
 // Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
 bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const Config& config, double& ms) {
@@ -123,10 +130,10 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
   if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
   tg::Mesh mesh;
   std::vector<float> pos, nrm, uv;
-  check(glb::readFloats(asset, attrs["POSITION"].get<int>(), 3, pos));
-  check(glb::readFloats(asset, attrs["TEXCOORD_0"].get<int>(), 2, uv));
+  check(glb::readFloats(asset, accessorIndex(attrs["POSITION"], at + "/attributes/POSITION"), 3, pos));
+  check(glb::readFloats(asset, accessorIndex(attrs["TEXCOORD_0"], at + "/attributes/TEXCOORD_0"), 2, uv));
   const bool hadNormals = attrs.contains("NORMAL");
-  if (hadNormals) check(glb::readFloats(asset, attrs["NORMAL"].get<int>(), 3, nrm));
+  if (hadNormals) check(glb::readFloats(asset, accessorIndex(attrs["NORMAL"], at + "/attributes/NORMAL"), 3, nrm));
   const size_t n = pos.size() / 3;
   if (uv.size() / 2 != n || (hadNormals && nrm.size() / 3 != n))
     throw gltfProblem(422, {at + "/attributes", "attribute accessors must have the same count"});
@@ -144,7 +151,7 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     for (size_t i = 0; i < n; ++i) mesh.normals[i] = {nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]};
   }
   if (prim.contains("indices")) {
-    check(glb::readIndices(asset, prim["indices"].get<int>(), mesh.indices));
+    check(glb::readIndices(asset, accessorIndex(prim["indices"], at + "/indices"), mesh.indices));
   } else {
     mesh.indices.resize(n - n % 3);
     for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
@@ -171,14 +178,15 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     for (auto& [name, index] : attrs.items()) {
       if (name == "TANGENT" || (name == "NORMAL" && !hadNormals)) continue;
       int copy = 0;
-      check(glb::addRemappedAccessor(asset, index.get<int>(), out.remap, copy));
+      check(glb::addRemappedAccessor(asset, accessorIndex(index, at + "/attributes/" + name), out.remap, copy));
       index = copy;
     }
     if (prim.contains("targets") && prim["targets"].is_array())
-      for (auto& target : prim["targets"])
-        for (auto& [name, index] : target.items()) {
+      for (size_t ti = 0; ti < prim["targets"].size(); ++ti)
+        for (auto& [name, index] : prim["targets"][ti].items()) {
           int copy = 0;
-          check(glb::addRemappedAccessor(asset, index.get<int>(), out.remap, copy));
+          const std::string pointer = at + "/targets/" + std::to_string(ti) + "/" + name;
+          check(glb::addRemappedAccessor(asset, accessorIndex(index, pointer), out.remap, copy));
           index = copy;
         }
     prim["indices"] = glb::addIndexAccessor(asset, out.indices);
@@ -206,8 +214,10 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
         json& prims = asset.gltf["meshes"][mi]["primitives"];
         if (!prims.is_array()) continue;
         for (size_t pi = 0; pi < prims.size(); ++pi) {
-          if (prims[pi].value("mode", 4) != 4) continue;  // TRIANGLES only
           std::string at = "/meshes/" + std::to_string(mi) + "/primitives/" + std::to_string(pi);
+          uint64_t mode = 4;
+          check(glb::unsignedMember(prims[pi], "mode", at + "/mode", 4, 6, mode));
+          if (mode != 4) continue;  // TRIANGLES only
           done += processPrimitive(asset, prims[pi], at, ctx.config, reply.computeMs);
         }
       }

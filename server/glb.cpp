@@ -1,5 +1,6 @@
 #include "glb.h"
 
+#include <cstdint>
 #include <cstring>
 
 namespace effectd::glb {
@@ -55,30 +56,38 @@ std::optional<Problem> view(const Asset& a, int index, View& v) {
   const json& acc = accessors[size_t(index)];
   v.accessor = &acc;
   if (acc.contains("sparse")) return Problem{at + "/sparse", "sparse accessors are not supported"};
-  v.componentType = acc.value("componentType", 0);
-  v.components = componentCount(acc.value("type", ""));
+  uint64_t componentType = 0, count = 0, bvIndex = 0, buffer = 0, stride = 0, bvOffset = 0, bvLength = 0, accOffset = 0;
+  constexpr uint64_t kAny = SIZE_MAX / 4;  // sums of two stay representable
+  if (auto p = unsignedMember(acc, "componentType", at + "/componentType", 0, 0xFFFF, componentType)) return p;
+  v.componentType = int(componentType);
+  v.components = componentCount(acc.contains("type") && acc["type"].is_string() ? acc["type"].get<std::string>() : "");
   int cs = componentSize(v.componentType);
   if (!cs || !v.components) return Problem{at, "has an unknown componentType or type"};
-  v.count = acc.value("count", size_t(0));
+  if (auto p = unsignedMember(acc, "count", at + "/count", 0, kAny, count)) return p;
+  v.count = size_t(count);
   v.elementSize = size_t(cs) * size_t(v.components);
   if (!acc.contains("bufferView")) {
     v.zeros = true;
     return std::nullopt;
   }
-  size_t bvIndex = acc["bufferView"].get<size_t>();
+  if (auto p = unsignedValue(acc["bufferView"], at + "/bufferView", kAny, bvIndex)) return p;
   const json& views = member(a.gltf, "bufferViews");
   if (bvIndex >= views.size()) return Problem{at + "/bufferView", "does not exist"};
-  const json& bv = views[bvIndex];
-  if (bv.value("buffer", 0) != 0)
-    return Problem{"/bufferViews/" + std::to_string(bvIndex) + "/buffer", "only the GLB binary chunk (buffer 0) is supported"};
+  const json& bv = views[size_t(bvIndex)];
+  const std::string bvAt = "/bufferViews/" + std::to_string(bvIndex);
+  if (auto p = unsignedMember(bv, "buffer", bvAt + "/buffer", 0, kAny, buffer)) return p;
+  if (buffer != 0) return Problem{bvAt + "/buffer", "only the GLB binary chunk (buffer 0) is supported"};
   const json& buffers = member(a.gltf, "buffers");
   if (buffers.empty() || buffers[0].contains("uri"))
     return Problem{"/buffers/0", "must be the GLB binary chunk (no uri)"};
-  v.stride = bv.value("byteStride", size_t(0));
-  if (v.stride == 0) v.stride = v.elementSize;
-  v.offset = bv.value("byteOffset", size_t(0)) + acc.value("byteOffset", size_t(0));
-  size_t bvEnd = bv.value("byteOffset", size_t(0)) + bv.value("byteLength", size_t(0));
-  if (v.stride < v.elementSize) return Problem{"/bufferViews/" + std::to_string(bvIndex) + "/byteStride", "is smaller than an element"};
+  if (auto p = unsignedMember(bv, "byteStride", bvAt + "/byteStride", 0, 252, stride)) return p;
+  if (auto p = unsignedMember(bv, "byteOffset", bvAt + "/byteOffset", 0, kAny, bvOffset)) return p;
+  if (auto p = unsignedMember(bv, "byteLength", bvAt + "/byteLength", 0, kAny, bvLength)) return p;
+  if (auto p = unsignedMember(acc, "byteOffset", at + "/byteOffset", 0, kAny, accOffset)) return p;
+  v.stride = stride == 0 ? v.elementSize : size_t(stride);
+  v.offset = size_t(bvOffset + accOffset);
+  size_t bvEnd = size_t(bvOffset + bvLength);
+  if (v.stride < v.elementSize) return Problem{bvAt + "/byteStride", "is smaller than an element"};
   if (v.count > 0 && (v.count - 1 > (SIZE_MAX - v.elementSize - v.offset) / v.stride ||
                       v.offset + (v.count - 1) * v.stride + v.elementSize > std::min(bvEnd, a.bin.size())))
     return Problem{at, "reaches past the end of its bufferView or of the binary chunk"};
@@ -118,6 +127,23 @@ int pushAccessor(Asset& a, json accessor) {
 }
 
 }  // namespace
+
+std::optional<Problem> unsignedValue(const json& value, const std::string& pointer, uint64_t max, uint64_t& out) {
+  if (!value.is_number_unsigned() || value.get<uint64_t>() > max)
+    return Problem{pointer, "must be an integer from 0 to " + std::to_string(max)};
+  out = value.get<uint64_t>();
+  return std::nullopt;
+}
+
+std::optional<Problem> unsignedMember(const json& object, const char* key, const std::string& pointer,
+                                      uint64_t fallback, uint64_t max, uint64_t& out) {
+  auto it = object.find(key);
+  if (it == object.end()) {
+    out = fallback;
+    return std::nullopt;
+  }
+  return unsignedValue(*it, pointer, max, out);
+}
 
 std::optional<Problem> parse(const std::string& b, Asset& out) {
   if (b.size() < 20 || u32(b, 0) != kMagic) return Problem{"", "is not a binary glTF (magic 'glTF' missing)"};

@@ -24,6 +24,13 @@ struct Problem {
 };
 
 std::optional<Problem> parse(const std::string& bytes, Asset& out);
+
+// A glTF index, count or offset: a JSON integer in [0, max]. Anything else (a float such as
+// 5e26, a negative number, a string) is a Problem at `pointer` — never a silent conversion.
+std::optional<Problem> unsignedValue(const nlohmann::json& value, const std::string& pointer, uint64_t max, uint64_t& out);
+// The same for `object[key]`, `fallback` when the key is absent.
+std::optional<Problem> unsignedMember(const nlohmann::json& object, const char* key, const std::string& pointer,
+                                      uint64_t fallback, uint64_t max, uint64_t& out);
 std::string serialize(const Asset& asset);
 
 // Accessor `index` as floats, `components` per element (normalized integers scaled to [0, 1]

@@ -185,7 +185,21 @@ TEST(TangentsApi, BrokenGlbIsRefused) {
   // Wrong JSON types inside the glTF.
   ASSERT_FALSE(glb::parse(g, a).has_value());
   a.gltf["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = "zero";
-  expectProblem(s.client().Post("/v1/tangents", glb::serialize(a), "model/gltf-binary"), 422);
+  p = expectProblem(s.client().Post("/v1/tangents", glb::serialize(a), "model/gltf-binary"), 422);
+  EXPECT_TRUE(hasPointer(p, "/meshes/0/primitives/0/attributes/POSITION")) << p.dump();
+  // Numbers that are not glTF integers are named, never converted (5e26 to int is undefined).
+  ASSERT_FALSE(glb::parse(g, a).has_value());
+  a.gltf["accessors"][0]["componentType"] = 5e26;
+  p = expectProblem(s.client().Post("/v1/tangents", glb::serialize(a), "model/gltf-binary"), 422);
+  EXPECT_TRUE(hasPointer(p, "/accessors/0/componentType")) << p.dump();
+  ASSERT_FALSE(glb::parse(g, a).has_value());
+  a.gltf["accessors"][0]["count"] = -4;
+  p = expectProblem(s.client().Post("/v1/tangents", glb::serialize(a), "model/gltf-binary"), 422);
+  EXPECT_TRUE(hasPointer(p, "/accessors/0/count")) << p.dump();
+  ASSERT_FALSE(glb::parse(g, a).has_value());
+  a.gltf["meshes"][0]["primitives"][0]["mode"] = 4.5;
+  p = expectProblem(s.client().Post("/v1/tangents", glb::serialize(a), "model/gltf-binary"), 422);
+  EXPECT_TRUE(hasPointer(p, "/meshes/0/primitives/0/mode")) << p.dump();
 }
 
 }  // namespace
