@@ -13,6 +13,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
+  chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node
 # (e.g. from NodeSource) keep it; otherwise Debian's.
