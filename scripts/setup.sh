@@ -11,6 +11,7 @@ PACKAGES=(
   glslang-tools
   gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
+  iproute2           # ss: tests/binary_test.sh reads the listen backlog
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)

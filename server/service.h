@@ -125,6 +125,7 @@ class Service {
   ResponseCache cache_;
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
+  int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
 };

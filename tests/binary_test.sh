@@ -21,6 +21,14 @@ grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; ex
 
 curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'
 
+# A second effectd on a port in use is an error (cpp-httplib's default SO_REUSEPORT would let
+# it bind and silently take half the connections).
+if "$bin" --host 127.0.0.1 --port "$port" 2>/dev/null; then echo "a second server bound port $port"; exit 1; fi
+# The accept queue is deeper than cpp-httplib's 5 (bursts of new connections overflowed it and
+# waited a second for SYN retransmission): ss shows a listener's backlog as Send-Q.
+backlog=$(ss -Hltn "sport = :$port" | awk '{print $3}' | head -1)
+[ "${backlog:-0}" -ge 128 ] || { echo "listen backlog ${backlog:-?} (want >= 128)"; ss -ltn; exit 1; }
+
 # SIGTERM under load: eight slow requests in flight (DBM bolts with plain CG, and renders);
 # once the server has them all, SIGTERM: every one completes with 200 and the process exits 0.
 body='{"grid":{"width":96,"height":96},"start":[48,0],"targets":[[48,95]],"method":"dbm","solver":"cg"}'
