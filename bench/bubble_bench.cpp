@@ -3,6 +3,9 @@
 // with its Delta E against the 1 nm reference (counters meanDeltaE, maxDeltaE).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <thread>
+
 #include <effects/bubble.h>
 
 namespace {
@@ -14,6 +17,8 @@ void BM_Icosphere(benchmark::State& state) {
   o.level = int(state.range(0));
   o.t = 12.5;
   o.camera = glm::dvec3(0, 0, 4);
+  static effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);  // as effectd runs it
+  o.parallel = &pool;
   size_t vertices = 0;
   for (auto _ : state) {
     auto r = icosphere(Params{}, o);

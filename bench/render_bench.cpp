@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     std::string passes;
     for (int i = 0; i <= iterations; ++i) {
       effects::Stopwatch watch;
-      rd::Scene s = effectd::buildScene(body, config);
+      rd::Scene s = effectd::buildScene(body, effectd::RequestContext{"bench", config});
       auto f = renderer.value()->render(s);
       if (!f.ok()) {
         std::fprintf(stderr, "%s: %s\n", c.name, f.error().message.c_str());

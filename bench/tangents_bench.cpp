@@ -4,7 +4,9 @@
 // (meanAngleDeg, maxAngleDeg) for the error-against-run-time report.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include <effects/tangents.h>
 
@@ -19,10 +21,17 @@ const Mesh& mesh100k() {
   return m;
 }
 
+// As effectd runs it: the steps split over a pool of cores - 1 workers beside the caller.
+effects::ThreadPool& pool() {
+  static effects::ThreadPool p(std::max(1u, std::thread::hardware_concurrency()) - 1);
+  return p;
+}
+
 void run(benchmark::State& state, Mode mode, bool measure) {
   Options o;
   o.mode = mode;
   o.measureError = measure;
+  o.parallel = &pool();
   effects::Stats last;
   for (auto _ : state) {
     auto r = generate(mesh100k(), o);
@@ -35,6 +44,7 @@ void run(benchmark::State& state, Mode mode, bool measure) {
   }
   double tris = double(mesh100k().indices.size() / 3);
   state.counters["triangles"] = tris;
+  state.counters["threads"] = double(pool().threads() + 1);
   state.counters["tris_per_s"] = benchmark::Counter(tris * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["outVertices"] = last.counters["outputVertices"];
   if (last.error) {

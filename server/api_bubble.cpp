@@ -120,6 +120,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     o.radius = m.value("radius", 1.0);
     o.t = t;
     o.wobble = features.wobble;
+    o.parallel = ctx.parallel;
     if (body.contains("camera")) o.camera = toVec3(body["camera"]);
     auto r = bb::icosphere(params, o);
     if (!r.ok()) {

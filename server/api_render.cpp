@@ -72,7 +72,8 @@ void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
 
 }  // namespace
 
-rd::Scene buildScene(const json& body, const Config& config, double* computeMs) {
+rd::Scene buildScene(const json& body, const RequestContext& ctx, double* computeMs) {
+  const Config& config = ctx.config;
   effects::Stopwatch watch;
   rd::Scene s;
   s.width = body.value("width", 512);
@@ -187,6 +188,7 @@ rd::Scene buildScene(const json& body, const Config& config, double* computeMs) 
       o.maxLevel = 7;
       o.radius = m.value("radius", 1.0);
       o.wobble = false;  // the vertex shader wobbles (eqn 11)
+      o.parallel = ctx.parallel;
       auto mesh = bb::icosphere(b.params, o);
       if (!mesh.ok()) {
         effects::Error e = mesh.error();
@@ -249,7 +251,7 @@ void addRenderEndpoints(Service& service) {
   service.addJsonEndpoint("/v1/render", "scene.json", [pool, metrics](const json& body, const RequestContext& ctx) {
     JsonReply reply;
     reply.method = "render";
-    rd::Scene scene = buildScene(body, ctx.config, &reply.computeMs);
+    rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
     const int bitDepth = scene.bitDepth;
     auto job = pool->submit(std::move(scene));
     if (!job)

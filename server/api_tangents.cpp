@@ -13,9 +13,11 @@ namespace {
 using nlohmann::json;
 namespace tg = effects::tangents;
 
-tg::Options options(const Config& config, tg::Mode mode) {
+tg::Options options(const RequestContext& ctx, tg::Mode mode) {
+  const Config& config = ctx.config;
   tg::Options o;
   o.mode = mode;
+  o.parallel = ctx.parallel;
   o.maxVertices = config.limits.maxMeshVertices;
   o.maxTriangles = config.limits.maxMeshTriangles;
   return o;
@@ -53,7 +55,7 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   mesh.uvs = unflatten<glm::vec2, 2>(m["uvs"], "/mesh/uvs");
   mesh.indices = m["indices"].get<std::vector<uint32_t>>();
   const std::string modeName = body.value("mode", "mikktspace");
-  tg::Options opt = options(ctx.config, modeName == "perTriangle" ? tg::Mode::kPerTriangle
+  tg::Options opt = options(ctx, modeName == "perTriangle" ? tg::Mode::kPerTriangle
                                          : modeName == "perVertex" ? tg::Mode::kPerVertex
                                                                    : tg::Mode::kMikkTSpace);
   opt.measureError = include.has("error") && opt.mode != tg::Mode::kMikkTSpace;
@@ -125,7 +127,8 @@ int accessorIndex(const json& value, const std::string& pointer) {
 
 // Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
 // Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
-bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const Config& config, double& ms) {
+bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const RequestContext& ctx, double& ms) {
+  const Config& config = ctx.config;
   json& attrs = prim["attributes"];
   if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
   tg::Mesh mesh;
@@ -156,7 +159,7 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     mesh.indices.resize(n - n % 3);
     for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
   }
-  tg::Options opt = options(config, tg::Mode::kMikkTSpace);
+  tg::Options opt = options(ctx, tg::Mode::kMikkTSpace);
   opt.missingNormals = tg::NormalRule::kFlat;
   auto r = tg::generate(mesh, opt);
   if (!r.ok()) {
@@ -218,7 +221,7 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
           uint64_t mode = 4;
           check(glb::unsignedMember(prims[pi], "mode", at + "/mode", 4, 6, mode));
           if (mode != 4) continue;  // TRIANGLES only
-          done += processPrimitive(asset, prims[pi], at, ctx.config, reply.computeMs);
+          done += processPrimitive(asset, prims[pi], at, ctx, reply.computeMs);
         }
       }
   } catch (const json::exception& e) {

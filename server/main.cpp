@@ -63,7 +63,7 @@ int renderCommand(std::vector<std::string> args) {
     return 2;
   }
   try {
-    effects::render::Scene scene = effectd::buildScene(body, config);
+    effects::render::Scene scene = effectd::buildScene(body, effectd::RequestContext{"render", config});
     auto renderer = effects::render::Renderer::create(config.eglPlatform);
     if (!renderer.ok()) throw effectd::toApiError(renderer.error());
     auto frame = renderer.value()->render(scene);

@@ -6,11 +6,12 @@
 #include <render/render.h>
 
 #include "config.h"
+#include "service.h"
 
 namespace effectd {
 
 // Computes every effect the scene contains (bolt, bubble mesh, thin-film table) and decodes
 // images. Throws ApiError naming the field, with pointers from the scene's root.
-effects::render::Scene buildScene(const nlohmann::json& body, const Config& config, double* computeMs = nullptr);
+effects::render::Scene buildScene(const nlohmann::json& body, const RequestContext& ctx, double* computeMs = nullptr);
 
 }  // namespace effectd

@@ -190,7 +190,8 @@ Service::Service(Config config)
     : config_(std::move(config)),
       admission_(std::make_unique<Admission>(admissionOptions(config_))),
       cache_(config_.responseCacheMb << 20),
-      http_(std::make_unique<httplib::Server>()) {
+      http_(std::make_unique<httplib::Server>()),
+      compute_(std::make_unique<effects::ThreadPool>(std::max(1u, std::thread::hardware_concurrency()) - 1)) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())
     if (name.rfind("schemas/", 0) == 0) docs[name.substr(8)] = std::string(data);
@@ -609,7 +610,7 @@ bool matches(const std::string& ifNoneMatch, const std::string& etag) {
 }  // namespace
 
 void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
-  RequestContext ctx{tl.requestId, config_};
+  RequestContext ctx{tl.requestId, config_, compute_.get()};
   const std::string type = mediaType(req.get_header_value("Content-Type"));
   const Coding coding = negotiate(tl.acceptEncoding);
   const std::string inm = req.get_header_value("If-None-Match");

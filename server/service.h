@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <effects/parallel.h>
+
 #include "admission.h"
 #include "config.h"
 #include "metrics.h"
@@ -66,6 +68,7 @@ using CostEstimator = std::function<Cost(const nlohmann::json& body, const Confi
 struct RequestContext {
   std::string requestId;
   const Config& config;
+  effects::Parallel* parallel = nullptr;  // the process's compute threads, for work that splits
 };
 
 using JsonHandler = std::function<JsonReply(const nlohmann::json& body, const RequestContext& ctx)>;
@@ -125,6 +128,7 @@ class Service {
   ResponseCache cache_;
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
+  std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
   int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;

@@ -170,6 +170,7 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
     for (int c = 0; c < 3; ++c) m.indices.push_back(vertex(tri[t + c], u[c], w[c]));
   }
   tangents::Options to;  // normals after the wobble: angle-weighted, smooth across the seam
+  to.parallel = o.parallel;
   auto frames = tangents::generate(m, to);
   if (!frames.ok()) return frames.error();
   const tangents::Output& f = frames.value();

@@ -32,7 +32,7 @@ struct Endpoint {
 };
 
 JsonReply buildOnly(const json& body, const RequestContext& ctx) {  // no GL in a fuzzer
-  (void)effectd::buildScene(body, ctx.config);
+  (void)effectd::buildScene(body, ctx);
   return {};
 }
 

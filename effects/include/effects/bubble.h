@@ -26,6 +26,7 @@
 #include <glm/vec4.hpp>
 
 #include "effects/common.h"
+#include "effects/parallel.h"
 
 namespace effects::bubble {
 
@@ -74,6 +75,7 @@ struct MeshOptions {
   double t = 0.0;         // time for the wobble
   bool wobble = true;
   std::optional<glm::dvec3> camera;  // when set: per-vertex final vectors and rim
+  Parallel* parallel = nullptr;      // for the tangent frames; null = this thread only
 };
 struct Mesh {
   std::vector<glm::vec3> positions, normals;

@@ -48,6 +48,7 @@
 #include <glm/vec4.hpp>
 
 #include "effects/common.h"
+#include "effects/parallel.h"
 
 namespace effects::tangents {
 
@@ -69,6 +70,7 @@ struct Options {
   bool measureError = false;  // kPerTriangle/kPerVertex: angle error against MikkTSpace (runs both)
   bool triangleFrames = false;  // also return the per-triangle TBN with the face normal
   size_t maxVertices = 2'000'000, maxTriangles = 4'000'000;
+  Parallel* parallel = nullptr;  // where the steps may split their work; null = this thread only
 };
 
 struct Frame {

@@ -1,0 +1,49 @@
+// The steps of tangents::generate (internal to effects/tangents/), one file each:
+//   normals.cpp       unit normal per vertex (given, or angle-weighted), flat expansion
+//   mikktspace.cpp    MikkTSpace corner tangents (the reference algorithm, ported)
+//   per_triangle.cpp  seed 004's per-triangle frame, and corner tangents from it
+//   per_vertex.cpp    per-triangle frames angle-averaged per vertex
+//   split.cpp         vertices split where their corners' tangents differ
+//   tangents.cpp      validation, the order of the steps, stats and the error metric
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "effects/parallel.h"
+#include "effects/tangents.h"
+#include "geometry.h"
+
+namespace effects::tangents {
+
+// A tangent per triangle corner (3 per triangle), and whether it is a fallback.
+struct CornerTangents {
+  std::vector<glm::vec4> tangent;
+  std::vector<uint8_t> fellBack;
+};
+
+// Welding gives corners at the same position (normal, UV) one vertex; see weld.h.
+std::vector<dvec3> vertexNormals(const Mesh& mesh);
+// Every corner its own vertex with the face normal (glTF's rule for meshes without normals);
+// cornerToInput[c] = the input vertex of corner c.
+Mesh flatExpanded(const Mesh& mesh, std::vector<uint32_t>& cornerToInput);
+
+struct MikkStats {
+  size_t degenerateTriangles = 0, zeroUvArea = 0, groups = 0;
+};
+CornerTangents mikktspace(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel, MikkStats& stats);
+
+// The frame of triangle t with normal n (face normal when the corner's is unusable).
+Frame meshTriangleFrame(const Mesh& mesh, size_t t, const dvec3& n);
+// Triangle t's frame with its face normal (the vertex normal of its first corner when the
+// triangle has no area, which marks the frame degenerate).
+Frame faceFrame(const Mesh& mesh, size_t t, const std::vector<dvec3>& normals);
+CornerTangents perTriangle(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel);
+CornerTangents perVertex(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel);
+
+// Output vertices: vertex v < n is input vertex v; a vertex whose corners disagree is split.
+// Fills out.tangents, out.remap, out.indices.
+void splitVertices(const Mesh& mesh, const std::vector<glm::vec4>& corner, const std::vector<dvec3>& normals,
+                   Output& out);
+
+}  // namespace effects::tangents

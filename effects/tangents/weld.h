@@ -1,0 +1,38 @@
+// Welding (internal to effects/tangents/): rep[i] = the first index whose key equals key(i)
+// (N floats, compared as floats, so -0 == +0). Open addressing over the indices themselves,
+// no per-entry allocation.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace effects::tangents {
+
+template <int N, class KeyFn>
+std::vector<uint32_t> weld(size_t count, KeyFn key) {
+  std::vector<std::array<float, N>> keys(count);
+  for (size_t i = 0; i < count; ++i) {
+    key(i, keys[i].data());
+    for (float& f : keys[i]) f = f == 0.0f ? 0.0f : f;
+  }
+  size_t cap = 16;
+  while (cap < 2 * count) cap <<= 1;
+  std::vector<uint32_t> table(cap, UINT32_MAX), rep(count);
+  for (size_t i = 0; i < count; ++i) {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the key's bits
+    for (float f : keys[i]) {
+      uint32_t b;
+      std::memcpy(&b, &f, 4);
+      h = (h ^ b) * 1099511628211ull;
+    }
+    size_t slot = size_t(h ^ (h >> 31)) & (cap - 1);
+    while (table[slot] != UINT32_MAX && keys[table[slot]] != keys[i]) slot = (slot + 1) & (cap - 1);
+    if (table[slot] == UINT32_MAX) table[slot] = uint32_t(i);
+    rep[i] = table[slot];
+  }
+  return rep;
+}
+
+}  // namespace effects::tangents

@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""Checks that a change kept every answer: starts two effectd binaries (before, after) with
+the response cache off and sends both the same requests: every proto/examples request to its
+endpoint, every examples/*.json scene to /v1/render, a large tangents mesh in each mode and a
+level-6 bubble mesh. JSON answers are compared with their run-time fields removed (elapsedMs,
+computeMs and the like differ from run to run); PNG and glTF answers byte for byte.
+
+  scripts/same-answers.py OLD_EFFECTD NEW_EFFECTD     exit 0 when every answer is the same
+"""
+import base64, glob, http.client, json, math, re, subprocess, sys
+
+TIMING = re.compile(r"Ms$|^ms$|^requestId$")  # run times, and the per-request id in problems
+
+
+def start(binary):
+    p = subprocess.Popen([binary, "--host", "127.0.0.1", "--port", "0", "--response-cache-mb", "0",
+                          "--heavy-threads", "2", "--admission-timeout-ms", "120000"],
+                         stderr=subprocess.PIPE, text=True)
+    for line in p.stderr:
+        m = re.search(r'"listening".*"port":(\d+)', line)
+        if m:
+            return p, int(m.group(1))
+    raise SystemExit(f"{binary} did not start")
+
+
+def post(port, path, body, ctype="application/json"):
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=300)
+    c.request("POST", path, body=body, headers={"Content-Type": ctype, "Accept-Encoding": "identity"})
+    r = c.getresponse()
+    data = r.read()
+    return r.status, r.getheader("Content-Type", ""), data
+
+
+def scrub(v):
+    if isinstance(v, dict):
+        return {k: scrub(x) for k, x in v.items() if not TIMING.search(k)}
+    if isinstance(v, list):
+        return [scrub(x) for x in v]
+    return v
+
+
+def requests():
+    for f in sorted(glob.glob("proto/examples/*/*.json")):
+        kind = f.split("/")[2]
+        if kind != "invalid":
+            yield f, f"/v1/{kind}", open(f, "rb").read(), "application/json"
+            continue
+        case = json.load(open(f))  # {endpoint, body | rawBody | rawBodyBase64 [, contentType], expect}
+        if "body" in case:
+            body = json.dumps(case["body"]).encode()
+        elif "rawBody" in case:
+            body = case["rawBody"].encode()
+        elif "rawBodyBase64" in case:
+            body = base64.b64decode(case["rawBodyBase64"])
+        else:
+            continue  # generated cases ("generate"): built by tests/examples_test.cpp
+        yield f, case["endpoint"], body, case.get("contentType", "application/json")
+    for f in sorted(glob.glob("examples/*.json")):
+        yield f, "/v1/render", open(f, "rb").read(), "application/json"
+    n = 300  # a 180k-triangle wavy grid, every mode
+    pos, uv, idx = [], [], []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x, y = i / n, j / n
+            pos += [x, y, 0.1 * math.sin(9 * x) * math.cos(7 * y)]
+            uv += [x + 0.05 * math.sin(13 * y), y]
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            idx += [a, a + 1, a + n + 2, a, a + n + 2, a + n + 1]
+    for mode in ("mikktspace", "perTriangle", "perVertex"):
+        body = {"mesh": {"positions": pos, "uvs": uv, "indices": idx}, "mode": mode,
+                "include": ["tangents", "remap", "indices", "normals"]}
+        yield f"grid {n}x{n} {mode}", "/v1/tangents", json.dumps(body).encode(), "application/json"
+    for f in sorted(glob.glob("/usr/share/assimp/models/glTF2/*/*.glb")):  # assimp-testmodels
+        yield f, "/v1/tangents", open(f, "rb").read(), "model/gltf-binary"
+    yield "bubble level 6", "/v1/bubble", json.dumps(
+        {"mesh": {"level": 6}, "camera": [0, 0, 4], "time": 3, "include": ["mesh", "uniforms"]}).encode(), "application/json"
+
+
+def main():
+    old, new = start(sys.argv[1]), start(sys.argv[2])
+    differ = 0
+    try:
+        for name, path, body, ctype in requests():
+            a, b = post(old[1], path, body, ctype), post(new[1], path, body, ctype)
+            same = a[0] == b[0] and a[1] == b[1]
+            if same and "json" in a[1]:
+                same = scrub(json.loads(a[2])) == scrub(json.loads(b[2]))
+            elif same:
+                same = a[2] == b[2]
+            differ += not same
+            print(f"{'same' if same else 'DIFFERENT'}  {a[0]}  {path:14} {name}  ({len(b[2])} bytes)")
+    finally:
+        for p, _ in (old, new):
+            p.terminate()
+            p.wait()
+    print(f"{differ} answer(s) differ" if differ else "every answer is the same")
+    sys.exit(1 if differ else 0)
+
+
+if __name__ == "__main__":
+    main()
