@@ -1,0 +1,82 @@
+// What the passes share (internal to render/): the per-context GPU state (program cache,
+// textures made once), the frame being drawn, and one function per pass. Each pass draws
+// into the frame's main target (or its own targets), appends its name to Frame::passes, and
+// returns an Error when the GPU refuses; renderer.cpp decides which passes a scene needs.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <effects/tangents.h>
+
+#include "gl.h"
+#include "internal.h"
+
+namespace effects::render::detail {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr int kEnvironmentSize = 256;  // cube map face of the bubble's environment
+inline constexpr int kMaxBlurRadius = 64;     // taps each side in the glow blur
+
+// Generated textures (textures.cpp).
+std::vector<uint8_t> normalMap(int size, uint64_t seed);
+std::vector<uint8_t> softPattern(int size, int channels, uint64_t seed, double lo, double hi);
+std::vector<float> premultiplied(const Image& image);
+inline glm::vec4 premultiplied(const glm::dvec4& c) { return glm::vec4(glm::dvec3(c) * c.a, c.a); }
+
+struct Gpu {
+  EglContext egl;
+  std::string description;
+  int maxTextureSize = 0;
+  bool floatBlend = false;
+  GLuint emptyVao = 0;
+  std::map<std::string, Program> programs;
+  int compiled = 0;  // programs compiled during the current frame
+  Texture normalA, normalB, waveAlpha, defaultFlow;
+  std::vector<float> waveVertices;  // the surface-wave quad with its MikkTSpace frames
+  std::vector<uint32_t> waveIndices;
+
+  ~Gpu();
+  // The program for `key` (compiled and linked on first use: the variant cache).
+  Result<Program*> program(const std::string& key, const std::string& vs, const std::string& fs);
+  // The bubble's flow texture: its own image (uploaded into `owned`) or the default pattern.
+  const Texture& flowTexture(const Bubble& b, Texture& owned);
+  // Generated once per context: the two normal maps, the alpha texture, and the quad with
+  // its MikkTSpace frames (seed 004's TBN for the ripple lighting).
+  std::optional<Error> ensureWave();
+};
+
+struct View {
+  glm::mat4 view, projection, viewProjection;
+  glm::vec2 tanHalfFov;
+  glm::vec3 eye;
+};
+
+// Camera matrices of the scene.
+View viewOf(const Scene& s);
+
+// One frame in progress.
+struct FrameState {
+  const Scene& scene;
+  View view;
+  Target main;                     // premultiplied RGBA float with depth
+  std::optional<FogVariant> fog;   // the fog shader variant when the scene has fog
+  std::string fogKey;              // ":" + its key, part of the program keys that include fog
+  Texture backgroundImage;         // the backdrop image, when it is one
+  Frame frame;
+};
+
+// Backdrop uniforms of a background or environment program (passes/background.cpp).
+void setBackground(Program& p, const Background& b, const Texture* image);
+// Fog uniforms of a program built with fogGlsl (passes/quads.cpp).
+void setFog(Program& p, const Fog& f, const glm::vec3& eye);
+
+std::optional<Error> backgroundPass(Gpu& gpu, FrameState& f);   // passes/background.cpp
+std::optional<Error> surfaceWavePass(Gpu& gpu, FrameState& f);  // passes/surface_wave.cpp
+std::optional<Error> quadsPass(Gpu& gpu, FrameState& f);        // passes/quads.cpp
+std::optional<Error> bubblePass(Gpu& gpu, FrameState& f);       // passes/bubble.cpp
+std::optional<Error> lightningPass(Gpu& gpu, FrameState& f);    // passes/lightning.cpp
+std::optional<Error> cameraBlendPass(Gpu& gpu, FrameState& f);  // passes/camera_blend.cpp
+
+}  // namespace effects::render::detail

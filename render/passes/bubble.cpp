@@ -1,0 +1,103 @@
+// Seed 000's soap bubble: the backdrop rendered into a cube map (what eqn 8's final vector
+// looks up), then the near side of the sphere, blended over the frame.
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "../gpu.h"
+
+namespace effects::render::detail {
+namespace {
+
+// The backdrop as a cube map, so that eqn 8's final vector can look it up.
+std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environment) {
+  const Background& bg = f.scene.background;
+  environment.make(GL_TEXTURE_CUBE_MAP);
+  for (int face = 0; face < 6; ++face)
+    glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, kEnvironmentSize, kEnvironmentSize, 0, GL_RGBA,
+                 GL_HALF_FLOAT, nullptr);
+  auto program = gpu.program("environment:" + std::to_string(int(bg.kind)), screenVertex(), environmentFragment(bg.kind));
+  if (!program.ok()) return program.error();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  setBackground(p, bg, &f.backgroundImage);
+  p.set("uView", glm::mat3(f.view.view));
+  p.set("uTanHalfFov", f.view.tanHalfFov);
+  GLuint fbo = 0;
+  glGenFramebuffers(1, &fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, kEnvironmentSize, kEnvironmentSize);
+  for (int face = 0; face < 6; ++face) {
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, environment.id, 0);
+    p.set("uFace", face);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  glDeleteFramebuffers(1, &fbo);
+  f.main.use();
+  f.frame.passes.push_back("environment");
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
+  const Bubble& b = *f.scene.bubble;
+  const bubble::Features& features = b.features;
+  Texture environment;
+  if (features.reflection || features.refraction)
+    if (auto e = environmentCube(gpu, f, environment)) return e;
+  std::string key = "bubble:";
+  for (bool on : {features.reflection, features.refraction, features.rim, features.textureFlow, features.wobble,
+                  features.iridescence})
+    key += on ? '1' : '0';
+  bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
+                                            f.fog ? "  color.rgb = applyFog(color.rgb, vWorld);\n" : "");
+  auto program = gpu.program(key + f.fogKey, src.vertex, src.fragment);
+  if (!program.ok()) return program.error();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  const bubble::Params& bp = b.params;
+  const bubble::Film film = bubble::film(bp, b.time);
+  p.set("uModel", glm::translate(glm::mat4(1), glm::vec3(b.center)));
+  p.set("uViewProjection", f.view.viewProjection);
+  p.set("uWobblePhase", float(bubble::reducedPhase(bp.deltaSpeed, b.time)));
+  p.set("uWobbleAmplitude", float(bp.wobbleAmplitude));
+  p.set("uBaseColor", glm::vec4(b.baseColor));
+  p.set("uCameraPosition", f.view.eye);
+  p.set("uFilmTop", float(film.top));
+  p.set("uFilmBottom", float(film.bottom));
+  p.set("uEta", float(bp.n1 / bp.n2));
+  p.set("uFlowPhase", float(bubble::reducedPhase(bp.betaSpeed, b.time)));
+  p.set("uRimPower", float(bp.rimPower));
+  p.set("uThickness", float(film.top));
+  if (environment.id) environment.bind(0), p.set("uEnvironment", 0);
+  Texture flowOwned, thinFilm;
+  if (features.textureFlow) gpu.flowTexture(b, flowOwned).bind(1), p.set("uFlowTexture", 1);
+  if (features.iridescence) {
+    thinFilm = texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
+    thinFilm.bind(2), p.set("uThinFilm", 2);
+  }
+  std::vector<float> data;
+  data.reserve(b.mesh.positions.size() * 8);
+  for (size_t i = 0; i < b.mesh.positions.size(); ++i) {
+    const auto &x = b.mesh.positions[i], &n = b.mesh.normals[i];
+    const auto& uv = b.mesh.uvs[i];
+    data.insert(data.end(), {x.x, x.y, x.z, n.x, n.y, n.z, uv.x, uv.y});
+  }
+  Vertices mesh(data, {3, 3, 2}, &b.mesh.indices);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  // The near side only: eqns 4-10 are written for the surface facing the viewer.
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glDrawElements(GL_TRIANGLES, GLsizei(b.mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(gpu.emptyVao);
+  f.frame.passes.push_back(f.scene.fog ? "bubble+fog" : "bubble");
+  return std::nullopt;
+}
+
+}  // namespace effects::render::detail

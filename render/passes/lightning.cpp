@@ -1,0 +1,123 @@
+// Seed 002's bolt on screen: each polyline segment drawn as an anti-aliased quad into a
+// core buffer (MAX blending), an optional separable Gaussian glow at half resolution, and a
+// composite that adds both over the frame.
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "../gpu.h"
+
+namespace effects::render::detail {
+namespace {
+
+// Each polyline segment as a quad in pixels, widened by a one-pixel anti-aliasing margin
+// and by half a width at both ends (joins overlap; the core pass blends with MAX).
+std::vector<float> boltGeometry(const Lightning& l, int width, int height) {
+  std::vector<float> v;
+  const double sx = (l.rect.z - l.rect.x) * width / l.gridWidth, sy = (l.rect.w - l.rect.y) * height / l.gridHeight;
+  auto pixel = [&](const lightning::Vertex& p) {
+    return glm::dvec2(l.rect.x * width + p.x * sx, l.rect.y * height + p.y * sy);
+  };
+  for (const auto& line : l.polylines) {
+    const double half = 0.5 * line.width * l.coreWidth, margin = half + 1.0;
+    for (size_t i = 1; i < line.vertices.size(); ++i) {
+      glm::dvec2 a = pixel(line.vertices[i - 1]), b = pixel(line.vertices[i]);
+      glm::dvec2 d = b - a;
+      double len = glm::length(d);
+      d = len > 1e-9 ? d / len : glm::dvec2(1, 0);
+      glm::dvec2 n(-d.y, d.x);
+      a -= d * half, b += d * half;
+      const float ia = line.vertices[i - 1].intensity, ib = line.vertices[i].intensity;
+      auto put = [&](glm::dvec2 p, float intensity, double side) {
+        glm::dvec2 q = p + n * (side * margin);
+        v.insert(v.end(), {float(q.x), float(q.y), intensity, float(side * margin), float(half)});
+      };
+      put(a, ia, -1), put(b, ib, -1), put(b, ib, 1);
+      put(a, ia, -1), put(b, ib, 1), put(a, ia, 1);
+    }
+  }
+  return v;
+}
+
+// Separable Gaussian of the core at half resolution (sigma in half-resolution pixels) into
+// `glow`, through `blurred`.
+std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l, const Target& core, Target& blurred,
+                              Target& glow) {
+  auto program = gpu.program("blur", screenVertex(), blurFragment());
+  if (!program.ok()) return program.error();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  const double sigma = l.glowSigma / 2;
+  const int radius = std::min(kMaxBlurRadius, int(std::ceil(3 * sigma)));
+  std::vector<float> w(size_t(radius) + 1);
+  double sum = 0;
+  for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * sigma * sigma))));
+  for (float& x : w) x = float(x / sum);
+  glUniform1fv(p.at("uWeights[0]"), GLsizei(w.size()), w.data());
+  p.set("uRadius", radius);
+  p.set("uSource", 0);
+  const int hw = (f.scene.width + 1) / 2, hh = (f.scene.height + 1) / 2;
+  if (!blurred.create(hw, hh, GL_RGBA16F, false) || !glow.create(hw, hh, GL_RGBA16F, false))
+    return unsatisfiable("/renderer", "the glow buffers cannot be created");
+  p.set("uTargetSize", glm::vec2(hw, hh));
+  blurred.use();
+  core.color.bind(0);
+  p.set("uStep", glm::vec2(1.0f / float(hw), 0));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  f.frame.passes.push_back("blurHorizontal");
+  glow.use();
+  blurred.color.bind(0);
+  p.set("uStep", glm::vec2(0, 1.0f / float(hh)));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  f.frame.passes.push_back("blurVertical");
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
+  const Scene& scene = f.scene;
+  const Lightning& l = *scene.lightning;
+  Target core;
+  if (!core.create(scene.width, scene.height, GL_RGBA16F, false))
+    return unsatisfiable("/renderer", "the lightning buffer cannot be created");
+  core.use();
+  glClear(GL_COLOR_BUFFER_BIT);
+  {
+    auto program = gpu.program("bolt", boltVertex(), boltFragment());
+    if (!program.ok()) return program.error();
+    Program& p = *program.value();
+    glUseProgram(p.id);
+    p.set("uSize", glm::vec2(scene.width, scene.height));
+    std::vector<float> data = boltGeometry(l, scene.width, scene.height);
+    Vertices mesh(data, {2, 3});
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_MAX);
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(data.size() / 5));
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_BLEND);
+    glBindVertexArray(gpu.emptyVao);
+    f.frame.passes.push_back("lightning");
+  }
+  const bool glow = l.glowSigma > 0 && l.glowStrength > 0;
+  Target blurred, glowTarget;
+  if (glow)
+    if (auto e = glowBlur(gpu, f, l, core, blurred, glowTarget)) return e;
+  f.main.use();
+  auto program = gpu.program(glow ? "composite:glow" : "composite", screenVertex(), compositeFragment(glow));
+  if (!program.ok()) return program.error();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  core.color.bind(0), p.set("uCore", 0);
+  if (glow) glowTarget.color.bind(1), p.set("uGlow", 1), p.set("uGlowStrength", float(l.glowStrength));
+  p.set("uColor", glm::vec3(l.color));
+  glEnable(GL_BLEND);
+  glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  f.frame.passes.push_back("lightningComposite");
+  return std::nullopt;
+}
+
+}  // namespace effects::render::detail

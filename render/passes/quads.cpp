@@ -1,0 +1,87 @@
+// Opaque quads (walls, floors, props) with the depth test, fogged per fragment when the
+// scene has fog.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <glm/geometric.hpp>
+
+#include "../gpu.h"
+
+namespace effects::render::detail {
+
+// Slot 0 = global fog; slots 1.. = regions by increasing volume (stable: ties keep their
+// order), so that the shader's first containing region is regionAt()'s choice.
+void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
+  std::vector<size_t> order(f.regions.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
+  std::vector<int> types;
+  std::vector<float> params, colors, lo, hi;
+  auto add = [&](const fog::Fog& g) {
+    types.push_back(int(g.type));
+    glm::dvec4 q(0);
+    switch (g.type) {
+      case fog::FogType::kX3dLinear:
+      case fog::FogType::kX3dExponential: q.x = g.visibilityRange; break;
+      case fog::FogType::kGlLinear: q = {g.start, g.end, 0, 0}; break;
+      case fog::FogType::kGlExp:
+      case fog::FogType::kGlExp2: q.x = g.density; break;
+      case fog::FogType::kDistanceExp2: q.x = g.distanceCoefficient; break;
+      case fog::FogType::kDistanceGaussian: q = {g.distanceCoefficient, g.peak, 0, 0}; break;
+      case fog::FogType::kHeight:
+        q = {g.density > 0 ? std::log(g.density) : 0.0, g.heightFalloff, g.baseHeight, g.density > 0 ? 1.0 : 0.0};
+        break;
+    }
+    for (int i = 0; i < 4; ++i) params.push_back(float(q[i]));
+    for (int i = 0; i < 3; ++i) colors.push_back(float(g.color[i]));
+  };
+  add(f.global);
+  for (size_t i : order) {
+    const fog::Region& r = f.regions[i];
+    add(r.fog);
+    glm::dvec4 a = r.shape == fog::Region::Shape::kBox ? glm::dvec4(r.min, 0) : glm::dvec4(r.center, 1);
+    glm::dvec4 b = r.shape == fog::Region::Shape::kBox ? glm::dvec4(r.max, 0) : glm::dvec4(r.radius, 0, 0, 0);
+    for (int k = 0; k < 4; ++k) lo.push_back(float(a[k])), hi.push_back(float(b[k]));
+  }
+  const GLsizei n = GLsizei(types.size());
+  p.set("uFogCamera", eye);
+  glUniform1iv(p.at("uFogType[0]"), n, types.data());
+  glUniform4fv(p.at("uFogParams[0]"), n, params.data());
+  glUniform3fv(p.at("uFogColor[0]"), n, colors.data());
+  if (!lo.empty()) {
+    glUniform4fv(p.at("uRegionLo[0]"), n - 1, lo.data());
+    glUniform4fv(p.at("uRegionHi[0]"), n - 1, hi.data());
+  }
+}
+
+std::optional<Error> quadsPass(Gpu& gpu, FrameState& f) {
+  const Scene& scene = f.scene;
+  std::vector<float> data;
+  for (const Quad& q : scene.quads) {
+    glm::dvec3 n = glm::normalize(q.normal), up = q.up - n * glm::dot(q.up, n);
+    if (glm::length(up) < 1e-9) up = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) - n * n.y : glm::dvec3(1, 0, 0) - n * n.x;
+    up = glm::normalize(up) * (0.5 * q.size.y);
+    glm::dvec3 right = glm::normalize(glm::cross(up, n)) * (0.5 * q.size.x);
+    const glm::dvec3 corners[6] = {q.center - right - up, q.center + right - up, q.center + right + up,
+                                   q.center - right - up, q.center + right + up, q.center - right + up};
+    for (const auto& c : corners)
+      data.insert(data.end(), {float(c.x), float(c.y), float(c.z), float(q.color.r), float(q.color.g), float(q.color.b)});
+  }
+  auto program = gpu.program("quad" + f.fogKey, quadVertex(), quadFragment(f.fog ? &*f.fog : nullptr));
+  if (!program.ok()) return program.error();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  p.set("uViewProjection", f.view.viewProjection);
+  if (scene.fog) setFog(p, *scene.fog, f.view.eye);
+  Vertices mesh(data, {3, 3});
+  glEnable(GL_DEPTH_TEST);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(data.size() / 6));
+  glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(gpu.emptyVao);
+  f.frame.passes.push_back(scene.fog ? "quads+fog" : "quads");
+  return std::nullopt;
+}
+
+}  // namespace effects::render::detail
