@@ -15,6 +15,7 @@
 #include <effects/parallel.h>
 
 #include "admission.h"
+#include "problem.h"
 #include "config.h"
 #include "metrics.h"
 #include "response_cache.h"
@@ -24,21 +25,6 @@ namespace effects { struct Error; struct Stats; }
 namespace httplib { class Server; struct Request; struct Response; }
 
 namespace effectd {
-
-// An RFC 9457 problem. Thrown by endpoint code; turned into application/problem+json.
-struct ApiError {
-  int status = 400;
-  std::string slug;    // problem type, becomes "https://effectd.dev/problems/<slug>"
-  std::string title;
-  std::string detail;
-  std::vector<SchemaViolation> errors;
-  std::map<std::string, std::string> headers;  // e.g. Retry-After
-};
-
-// Maps a library error to a problem: invalid argument -> 400, unsatisfiable -> 422,
-// over a resource limit -> 413 (`prefix` is prepended to the field to make it a body pointer).
-ApiError toApiError(const effects::Error& error, const std::string& prefix = "");
-[[noreturn]] void throwError(const effects::Error& error, const std::string& prefix = "");
 
 // What a JSON endpoint returns: the body, plus the stats whose timing goes to Server-Timing.
 struct JsonReply {
