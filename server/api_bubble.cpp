@@ -5,7 +5,8 @@
 
 #include "codec.h"
 #include "costs.h"
-#include "endpoints.h"
+#include "api_bubble.h"
+#include "api_common.h"
 
 namespace effectd {
 

@@ -5,7 +5,8 @@
 
 #include "codec.h"
 #include "costs.h"
-#include "endpoints.h"
+#include "api_common.h"
+#include "api_fog.h"
 
 namespace effectd {
 

@@ -3,7 +3,8 @@
 
 #include "codec.h"
 #include "costs.h"
-#include "endpoints.h"
+#include "api_common.h"
+#include "api_lightning.h"
 
 namespace effectd {
 namespace {

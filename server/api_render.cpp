@@ -9,7 +9,11 @@
 
 #include "codec.h"
 #include "costs.h"
-#include "endpoints.h"
+#include "api_bubble.h"
+#include "api_common.h"
+#include "api_fog.h"
+#include "api_lightning.h"
+#include "api_render.h"
 #include "scene.h"
 
 namespace effectd {

@@ -4,7 +4,8 @@
 #include <effects/tangents.h>
 
 #include "costs.h"
-#include "endpoints.h"
+#include "api_common.h"
+#include "api_tangents.h"
 #include "glb.h"
 
 namespace effectd {

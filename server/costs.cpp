@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "endpoints.h"
+#include "api_bubble.h"
+#include "api_common.h"
+#include "api_fog.h"
+#include "api_lightning.h"
+#include "api_tangents.h"
 
 namespace effectd {
 

@@ -1,6 +1,10 @@
 #include "endpoints.h"
 
-#include <algorithm>
+#include "api_bubble.h"
+#include "api_fog.h"
+#include "api_lightning.h"
+#include "api_render.h"
+#include "api_tangents.h"
 
 namespace effectd {
 
@@ -10,42 +14,6 @@ void addEffectEndpoints(Service& service) {
   addTangentsEndpoints(service);
   addBubbleEndpoints(service);
   addRenderEndpoints(service);
-}
-
-ApiError fieldError(int status, const std::string& pointer, const std::string& message) {
-  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-field",
-                  status == 413 ? "Request exceeds a configured limit" : "Invalid field", pointer + ": " + message,
-                  {{pointer, message}}, {}};
-}
-
-glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
-
-Includes::Includes(const nlohmann::json& body, std::vector<std::string> defaults) : items_(std::move(defaults)) {
-  if (auto it = body.find("include"); it != body.end()) {
-    items_.clear();
-    for (const auto& v : *it) items_.push_back(v.get<std::string>());
-  }
-}
-
-bool Includes::has(const std::string& what) const {
-  return std::find(items_.begin(), items_.end(), what) != items_.end();
-}
-
-}  // namespace effectd
-
-#include <effects/common.h>
-
-namespace effectd {
-
-nlohmann::json statsJson(const effects::Stats& s) {
-  nlohmann::json j = {{"method", s.method}, {"elapsedMs", s.elapsedMs}};
-  if (!s.counters.empty()) j["counters"] = s.counters;
-  if (s.error) {
-    j["error"] = *s.error;
-    j["errorMetric"] = s.errorMetric;
-    j["reference"] = s.reference;
-  }
-  return j;
 }
 
 }  // namespace effectd

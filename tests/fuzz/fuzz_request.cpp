@@ -4,7 +4,10 @@
 #include <cstdint>
 #include <string>
 
-#include "endpoints.h"
+#include "api_bubble.h"
+#include "api_fog.h"
+#include "api_lightning.h"
+#include "api_tangents.h"
 #include "scene.h"
 #include "service.h"
 

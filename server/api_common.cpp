@@ -1,0 +1,39 @@
+#include "api_common.h"
+
+#include <algorithm>
+
+#include <effects/common.h>
+
+namespace effectd {
+
+ApiError fieldError(int status, const std::string& pointer, const std::string& message) {
+  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-field",
+                  status == 413 ? "Request exceeds a configured limit" : "Invalid field", pointer + ": " + message,
+                  {{pointer, message}}, {}};
+}
+
+glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
+
+Includes::Includes(const nlohmann::json& body, std::vector<std::string> defaults) : items_(std::move(defaults)) {
+  if (auto it = body.find("include"); it != body.end()) {
+    items_.clear();
+    for (const auto& v : *it) items_.push_back(v.get<std::string>());
+  }
+}
+
+bool Includes::has(const std::string& what) const {
+  return std::find(items_.begin(), items_.end(), what) != items_.end();
+}
+
+nlohmann::json statsJson(const effects::Stats& s) {
+  nlohmann::json j = {{"method", s.method}, {"elapsedMs", s.elapsedMs}};
+  if (!s.counters.empty()) j["counters"] = s.counters;
+  if (s.error) {
+    j["error"] = *s.error;
+    j["errorMetric"] = s.errorMetric;
+    j["reference"] = s.reference;
+  }
+  return j;
+}
+
+}  // namespace effectd
