@@ -89,37 +89,54 @@ double dimensionOf(const lt::Bolt& b, int n) {
 }
 
 void lightning(bool quick, Section& tv, Section& fd) {
-  tv = {"lightning-tv", "Lightning: per-step candidate distribution against the converged Laplace solution",
-        "the DBM distribution from a converged solve (MGPCG, relative residual 1e-10) on the same bolt state, every step",
-        "mean total-variation distance per step", "ms per bolt (median)", "setting", "seeds (time / error)", {}, {}};
-  fd = {"lightning-fd", "Lightning: fractal dimension against DBM",
+  tv = {
+      "lightning-tv",
+      "Lightning: per-step candidate distribution against the converged Laplace solution",
+      "the DBM distribution from a converged solve (MGPCG, relative residual 1e-10) on the same bolt state, every step",
+      "mean total-variation distance per step",
+      "ms per bolt (median)",
+      "setting",
+      "seeds (time / error)",
+      {},
+      {}};
+  fd = {"lightning-fd",
+        "Lightning: fractal dimension against DBM",
         "mean box-counting dimension D_ref of DBM (MGPCG, tolerance 1e-8) at the same size and seeds",
-        "abs(mean D − D_ref)", "ms per bolt (median)", "setting", "mean D +- sd", {}, {}};
+        "abs(mean D − D_ref)",
+        "ms per bolt (median)",
+        "setting",
+        "mean D +- sd",
+        {},
+        {}};
   const std::vector<int> sizes = quick ? std::vector<int>{32} : std::vector<int>{64, 128, 256};
   for (int n : sizes) {
     std::vector<LightningSetting> settings;
     for (int life : {2, 4, 8, 0}) {
-      lt::Params p = bench::lightningLayout(n);
+      lt::Params p = fixtures::lightningLayout(n);
       p.lifetime = life;
       settings.push_back({"fast", "lifetime " + (life ? std::to_string(life) : std::string("inf")), p});
     }
     for (double growth : {1.5, 1.25, 1.1, 1.0}) {  // eqn 8's base; 2 is the lifetime-4 row above
-      lt::Params p = bench::lightningLayout(n);
+      lt::Params p = fixtures::lightningLayout(n);
       p.axisGrowth = growth;
       settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3), p});
     }
-    lt::Params c = bench::lightningLayout(n);
+    lt::Params c = fixtures::lightningLayout(n);
     c.method = lt::Method::kCharges;
     settings.push_back({"charges", "charges", c});
     std::vector<double> tolerances;
-    if (quick) tolerances = {1e-2, 1e-4, 1e-6};
-    else if (n == 64) tolerances = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
-    else if (n == 128) tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
-    else tolerances = {1e-2, 1e-4};
+    if (quick)
+      tolerances = {1e-2, 1e-4, 1e-6};
+    else if (n == 64)
+      tolerances = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
+    else if (n == 128)
+      tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
+    else
+      tolerances = {1e-2, 1e-4};
     for (lt::Solver solver : {lt::Solver::kMgpcg, lt::Solver::kCg}) {
       if (solver == lt::Solver::kCg && (quick || n > 128)) continue;
       for (double tol : tolerances) {
-        lt::Params p = bench::lightningLayout(n);
+        lt::Params p = fixtures::lightningLayout(n);
         p.method = lt::Method::kDbm;
         p.solver = solver;
         p.tolerance = tol;
@@ -134,15 +151,17 @@ void lightning(bool quick, Section& tv, Section& fd) {
       return n == 256 ? 5 : 20;
     };
     auto errorSeedsFor = [&](const LightningSetting& s) {
-      if (n == 256) return s.params.method == lt::Method::kFast && s.params.lifetime == 4 && s.params.axisGrowth == 2 ? 1 : 0;
-      if (n == 128 && s.params.method == lt::Method::kDbm && s.params.tolerance > 1e-3 && s.params.solver == lt::Solver::kCg)
+      if (n == 256)
+        return s.params.method == lt::Method::kFast && s.params.lifetime == 4 && s.params.axisGrowth == 2 ? 1 : 0;
+      if (n == 128 && s.params.method == lt::Method::kDbm && s.params.tolerance > 1e-3 &&
+          s.params.solver == lt::Solver::kCg)
         return 0;  // a loose CG solve grows ~10^4 cells: tens of seconds of reference solves
       return quick || n == 128 ? 1 : 2;
     };
     // Reference dimension: DBM at tolerance 1e-8 (MGPCG).
     std::vector<double> refD;
     {
-      lt::Params p = bench::lightningLayout(n);
+      lt::Params p = fixtures::lightningLayout(n);
       p.method = lt::Method::kDbm;
       p.tolerance = 1e-8;
       const int seeds = quick ? 3 : n == 64 ? 10 : n == 128 ? 5 : 1;
@@ -170,7 +189,8 @@ void lightning(bool quick, Section& tv, Section& fd) {
       for (double d : dims) var += (d - mean) * (d - mean) / double(std::max<size_t>(1, dims.size() - 1));
       // One curve per method and grid size; the setting varies along it.
       const std::string series = s.series + " " + std::to_string(n) + "²", label = s.setting;
-      fd.points.push_back({series, label, median(times), std::abs(mean - dRef), fmt(mean, 3) + " ± " + fmt(std::sqrt(var), 2)});
+      fd.points.push_back(
+          {series, label, median(times), std::abs(mean - dRef), fmt(mean, 3) + " ± " + fmt(std::sqrt(var), 2)});
       const int errSeeds = errorSeedsFor(s);
       if (errSeeds == 0) continue;
       double tvSum = 0;
@@ -181,10 +201,12 @@ void lightning(bool quick, Section& tv, Section& fd) {
         auto b = lt::grow(p);
         if (b.ok()) tvSum += b.value().stats.error.value_or(0);
       }
-      tv.points.push_back({series, label, median(times), tvSum / errSeeds, std::to_string(seeds) + " / " + std::to_string(errSeeds)});
+      tv.points.push_back(
+          {series, label, median(times), tvSum / errSeeds, std::to_string(seeds) + " / " + std::to_string(errSeeds)});
     }
-    fd.points.push_back({"dbm reference " + std::to_string(n) + "²", "D_ref", 0, 0,
-                         fmt(dRef, 3) + " (" + std::to_string(refD.size()) + (refD.size() == 1 ? " seed)" : " seeds)")});
+    fd.points.push_back(
+        {"dbm reference " + std::to_string(n) + "²", "D_ref", 0, 0,
+         fmt(dRef, 3) + " (" + std::to_string(refD.size()) + (refD.size() == 1 ? " seed)" : " seeds)")});
   }
 }
 
@@ -201,12 +223,21 @@ fg::Fog fogOf(fg::FogType t) {
 }
 
 void fog(bool quick, Section& tables, Section& march) {
-  tables = {"fog-tables", "Fog: colour tables against the exact function",
-            "the exact closed form, sampled 16x between table entries", "max abs(lerp(table) − f)", "µs per table (median)",
-            "entries", "", {}, {}, 1000};
-  const std::vector<size_t> sizes = quick ? std::vector<size_t>{16, 64, 256} : std::vector<size_t>{16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
-  for (fg::FogType t : {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
-                        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight}) {
+  tables = {"fog-tables",
+            "Fog: colour tables against the exact function",
+            "the exact closed form, sampled 16x between table entries",
+            "max abs(lerp(table) − f)",
+            "µs per table (median)",
+            "entries",
+            "",
+            {},
+            {},
+            1000};
+  const std::vector<size_t> sizes =
+      quick ? std::vector<size_t>{16, 64, 256} : std::vector<size_t>{16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
+  for (fg::FogType t :
+       {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
+        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight}) {
     const fg::Fog f = fogOf(t);
     for (size_t n : sizes) {
       // Height fog tables are 2-D (distance x ray elevation): n x n, up to the 65 536-entry bound.
@@ -219,13 +250,22 @@ void fog(bool quick, Section& tables, Section& march) {
       const double ms = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
       o.measureError = true;
       auto table = fg::buildTable(f, o);
-      tables.points.push_back({fg::toString(t), std::to_string(n) + (t == fg::FogType::kHeight ? " × " + std::to_string(n) : ""), ms,
+      tables.points.push_back({fg::toString(t),
+                               std::to_string(n) + (t == fg::FogType::kHeight ? " × " + std::to_string(n) : ""), ms,
                                table.ok() ? table.value().maxError : NAN, ""});
     }
   }
-  march = {"fog-height-march", "Height fog: closed-form optical depth against ray marching",
-           "the closed form tau = a e^(-b(o_y-h)) t (1-e^(-x))/x (exact; checked against 200 000-step marching in the tests)",
-           "max abs(f_marched − f_exact), 64 rays", "µs for 64 rays (median)", "steps", "", {}, {}, 1000};
+  march = {"fog-height-march",
+           "Height fog: closed-form optical depth against ray marching",
+           "the closed form tau = a e^(-b(o_y-h)) t (1-e^(-x))/x (exact; checked against 200 000-step marching in the "
+           "tests)",
+           "max abs(f_marched − f_exact), 64 rays",
+           "µs for 64 rays (median)",
+           "steps",
+           "",
+           {},
+           {},
+           1000};
   const double a = 0.05, b = 0.3, h = 0, oy = 2, dist = 150;
   std::vector<double> dirs;
   for (int i = 0; i < 64; ++i) dirs.push_back(-0.3 + 0.6 * i / 63.0);
@@ -238,7 +278,8 @@ void fog(bool quick, Section& tables, Section& march) {
   for (int steps : quick ? std::vector<int>{4, 16, 64} : std::vector<int>{4, 8, 16, 32, 64, 128, 256, 512, 1024}) {
     double worst = 0;
     for (double dy : dirs)
-      worst = std::max(worst, std::abs(std::exp(-fg::heightOpticalDepthMarched(a, b, h, oy, dy, dist, steps)) - exact(dy)));
+      worst =
+          std::max(worst, std::abs(std::exp(-fg::heightOpticalDepthMarched(a, b, h, oy, dy, dist, steps)) - exact(dy)));
     const double ms = timeMs(quick ? 5 : 21, [&] {
       for (double dy : dirs) sink = sink + std::exp(-fg::heightOpticalDepthMarched(a, b, h, oy, dy, dist, steps));
     });
@@ -248,16 +289,21 @@ void fog(bool quick, Section& tables, Section& march) {
 
 // ---- tangents ----------------------------------------------------------------------------------
 void tangents(bool quick, Section& out) {
-  out = {"tangents", "Bump mapping: tangent frames against MikkTSpace",
+  out = {"tangents",
+         "Bump mapping: tangent frames against MikkTSpace",
          "MikkTSpace (effectd's implementation, checked against the npm mikktspace WASM build in the tests)",
-         "mean angle between corner tangents, degrees", "ms per 100k triangles (median)", "mesh",
-         "max angle, handedness mismatches", {}, {}};
+         "mean angle between corner tangents, degrees",
+         "ms per 100k triangles (median)",
+         "mesh",
+         "max angle, handedness mismatches",
+         {},
+         {}};
   struct M {
     std::string name;
     tg::Mesh mesh;
   };
-  std::vector<M> meshes = {{"UV sphere", bench::uvSphere(quick ? 40 : 200, quick ? 50 : 250)},
-                           {"mirrored bumpy torus", bench::mirroredTorus(quick ? 40 : 200, quick ? 50 : 250)}};
+  std::vector<M> meshes = {{"UV sphere", fixtures::uvSphere(quick ? 40 : 200, quick ? 50 : 250)},
+                           {"mirrored bumpy torus", fixtures::mirroredTorus(quick ? 40 : 200, quick ? 50 : 250)}};
   for (const M& m : meshes) {
     const double per100k = 100000.0 / double(m.mesh.indices.size() / 3);
     for (tg::Mode mode : {tg::Mode::kMikkTSpace, tg::Mode::kPerVertex, tg::Mode::kPerTriangle}) {
@@ -279,10 +325,17 @@ void tangents(bool quick, Section& out) {
 
 // ---- soap bubble thin film ----------------------------------------------------------------------
 void thinFilm(bool quick, Section& out) {
-  out = {"thin-film", "Soap bubble: thin-film colour table against 1 nm spectral sampling",
-         "400 wavelength samples (1 nm) on a 32 x 32 sub-grid of the table", "mean CIE76 ΔE*ab",
-         quick ? "ms per 64² table (median)" : "ms per 256² table (median)", "wavelength samples", "max ΔE*ab", {}, {}};
-  for (int w : quick ? std::vector<int>{3, 8, 16} : std::vector<int>{3, 4, 5, 6, 8, 11, 16, 23, 32, 45, 64, 81, 128, 200, 400}) {
+  out = {"thin-film",
+         "Soap bubble: thin-film colour table against 1 nm spectral sampling",
+         "400 wavelength samples (1 nm) on a 32 x 32 sub-grid of the table",
+         "mean CIE76 ΔE*ab",
+         quick ? "ms per 64² table (median)" : "ms per 256² table (median)",
+         "wavelength samples",
+         "max ΔE*ab",
+         {},
+         {}};
+  for (int w : quick ? std::vector<int>{3, 8, 16}
+                     : std::vector<int>{3, 4, 5, 6, 8, 11, 16, 23, 32, 45, 64, 81, 128, 200, 400}) {
     bb::ThinFilmOptions o;
     o.width = o.height = quick ? 64 : 256;
     o.wavelengths = w;
@@ -308,7 +361,9 @@ void conclude(std::vector<Section>& sections) {
   for (Section& s : sections) {
     std::ostringstream c;
     const std::string unit = s.timeScale == 1000 ? " µs" : " ms";
-    auto show = [&](const Point& p) { return p.series + " " + p.setting + " (" + fmt(p.ms * s.timeScale) + unit + ", error " + fmt(p.error) + ")"; };
+    auto show = [&](const Point& p) {
+      return p.series + " " + p.setting + " (" + fmt(p.ms * s.timeScale) + unit + ", error " + fmt(p.error) + ")";
+    };
     if (s.id == "lightning-tv") {
       const Point* good = fastestWithin(s, 0.05);
       const Point* fast = fastestWithin(s, 1.0, "fast");
@@ -325,11 +380,14 @@ void conclude(std::vector<Section>& sections) {
       std::map<std::string, std::string> settles;
       for (const auto& p : s.points) {
         if (p.series.rfind("dbm-", 0) != 0) continue;
-        if (p.error > 0.03) settles[p.series] = "";
-        else if (settles[p.series].empty()) settles[p.series] = p.setting;
+        if (p.error > 0.03)
+          settles[p.series] = "";
+        else if (settles[p.series].empty())
+          settles[p.series] = p.setting;
       }
       c << " DBM's dimension stays within 0.03 of D_ref from";
-      for (const auto& [series, setting] : settles) c << " " << series << ": " << (setting.empty() ? "never" : setting) << ";";
+      for (const auto& [series, setting] : settles)
+        c << " " << series << ": " << (setting.empty() ? "never" : setting) << ";";
       c << " looser solves grow visibly different (bushier) bolts.";
     } else if (s.id == "fog-tables") {
       c << "Smallest table meeting 8-bit precision (max error ≤ 1/255) per type:";
@@ -338,15 +396,24 @@ void conclude(std::vector<Section>& sections) {
         if (p.error <= 1.0 / 255 && (!best[p.series] || p.ms < best[p.series]->ms)) best[p.series] = &p;
       for (const auto& p : s.points) best.emplace(p.series, nullptr);
       for (const auto& [series, p] : best) {
-        if (p) c << " " << series << " " << p->setting << " (" << fmt(p->ms * 1000) << " µs);";
-        else c << " " << series << " none up to " << std::prev(std::find_if(s.points.rbegin(), s.points.rend(), [&](const Point& q) { return q.series == series; }).base())->setting << ";";
+        if (p)
+          c << " " << series << " " << p->setting << " (" << fmt(p->ms * 1000) << " µs);";
+        else
+          c << " " << series << " none up to "
+            << std::prev(
+                   std::find_if(s.points.rbegin(), s.points.rend(), [&](const Point& q) { return q.series == series; })
+                       .base())
+                   ->setting
+            << ";";
       }
       c << " tables cost microseconds, so size them by the error bound, not by time.";
     } else if (s.id == "fog-height-march") {
       const Point* exact = &s.points.front();
       const Point* enough = fastestWithin(s, 1.0 / 255, "ray marching");
       c << "The closed form is exact and costs " << fmt(exact->ms * 1000) << " µs for 64 rays";
-      if (enough) c << "; ray marching needs " << enough->setting << " for 8-bit precision at " << fmt(enough->ms * 1000) << " µs";
+      if (enough)
+        c << "; ray marching needs " << enough->setting << " for 8-bit precision at " << fmt(enough->ms * 1000)
+          << " µs";
       c << ": the closed form wins on both axes.";
     } else if (s.id == "tangents") {
       double mikk = 0, vert = 0, vertErr = 0, triErr = 0;
@@ -356,15 +423,16 @@ void conclude(std::vector<Section>& sections) {
         if (p.series == "perVertex") vert = p.ms, vertErr = p.error;
         if (p.series == "perTriangle") triErr = p.error;
       }
-      c << "On the smooth sphere perVertex is " << fmt(mikk / std::max(vert, 1e-9), 2) << "× faster than MikkTSpace at a mean "
-        << fmt(vertErr, 2) << "° (perTriangle " << fmt(triErr, 2)
-        << "°); but normal maps are baked in MikkTSpace, any mismatch shows as seams, and mirrored UVs break the averaged "
+      c << "On the smooth sphere perVertex is " << fmt(mikk / std::max(vert, 1e-9), 2)
+        << "× faster than MikkTSpace at a mean " << fmt(vertErr, 2) << "° (perTriangle " << fmt(triErr, 2)
+        << "°); but normal maps are baked in MikkTSpace, any mismatch shows as seams, and mirrored UVs break the "
+           "averaged "
            "frames (see the torus): MikkTSpace is the default for a reason.";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
       if (jnd)
-        c << "Fewest samples with a mean ΔE below 1 (about one just-noticeable difference): " << jnd->setting << " wavelengths at "
-          << fmt(jnd->ms) << " ms per table; effectd's default is 16.";
+        c << "Fewest samples with a mean ΔE below 1 (about one just-noticeable difference): " << jnd->setting
+          << " wavelengths at " << fmt(jnd->ms) << " ms per table; effectd's default is 16.";
     }
     s.conclusion = c.str();
   }
@@ -394,7 +462,8 @@ void plot(const Section& s, const fs::path& dir) {
     << "plot ";
   int i = 0;
   for (const auto& [name, pts] : series) {
-    g << (i ? ", " : "") << "'" << data.string() << "' index " << i << " with linespoints pt 7 ps 0.8 title '" << name << "'";
+    g << (i ? ", " : "") << "'" << data.string() << "' index " << i << " with linespoints pt 7 ps 0.8 title '" << name
+      << "'";
     ++i;
   }
   g << "\n";
@@ -419,15 +488,23 @@ void write(const std::vector<Section>& sections, const fs::path& out, bool quick
     if (plots && fs::exists(out / "error-vs-time" / (s.id + ".png")))
       md << "![" << s.title << "](error-vs-time/" << s.id << ".png)\n\n";
     md << "| method | " << s.settingName << " | " << s.timeName << " | " << s.errorName << " |"
-       << (s.noteName.empty() ? "" : " " + s.noteName + " |") << "\n|---|---|---|---|" << (s.noteName.empty() ? "" : "---|") << "\n";
+       << (s.noteName.empty() ? "" : " " + s.noteName + " |") << "\n|---|---|---|---|"
+       << (s.noteName.empty() ? "" : "---|") << "\n";
     json pts = json::array();
     for (const Point& p : s.points) {
-      md << "| " << p.series << " | " << p.setting << " | " << (p.ms > 0 ? fmt(p.ms * s.timeScale) : "—") << " | " << fmt(p.error)
-         << " |" << (s.noteName.empty() ? "" : " " + p.note + " |") << "\n";
-      pts.push_back({{"series", p.series}, {"setting", p.setting}, {"ms", p.ms}, {"error", std::isfinite(p.error) ? json(p.error) : json()}});
+      md << "| " << p.series << " | " << p.setting << " | " << (p.ms > 0 ? fmt(p.ms * s.timeScale) : "—") << " | "
+         << fmt(p.error) << " |" << (s.noteName.empty() ? "" : " " + p.note + " |") << "\n";
+      pts.push_back({{"series", p.series},
+                     {"setting", p.setting},
+                     {"ms", p.ms},
+                     {"error", std::isfinite(p.error) ? json(p.error) : json()}});
     }
     md << "\n**Conclusion.** " << s.conclusion << "\n\n";
-    j[s.id] = {{"title", s.title}, {"errorMetric", s.errorName}, {"reference", s.reference}, {"points", pts}, {"conclusion", s.conclusion}};
+    j[s.id] = {{"title", s.title},
+               {"errorMetric", s.errorName},
+               {"reference", s.reference},
+               {"points", pts},
+               {"conclusion", s.conclusion}};
   }
   std::ofstream(out / "error-vs-time.json") << j.dump(1) << "\n";
 }
@@ -439,16 +516,21 @@ int main(int argc, char** argv) {
   fs::path out = "docs";
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    if (a == "--quick") quick = true;
-    else if (a == "--no-plots") plots = false;
-    else if (a == "--out" && i + 1 < argc) out = argv[++i];
+    if (a == "--quick")
+      quick = true;
+    else if (a == "--no-plots")
+      plots = false;
+    else if (a == "--out" && i + 1 < argc)
+      out = argv[++i];
     else {
       std::fprintf(stderr, "usage: error_report [--quick] [--out DIR] [--no-plots]\n");
       return 2;
     }
   }
   if (plots && std::system("gnuplot --version >/dev/null 2>&1") != 0) {
-    std::fprintf(stderr, "error_report: gnuplot not found (Debian: gnuplot-nox; scripts/setup.sh installs it), or pass --no-plots\n");
+    std::fprintf(
+        stderr,
+        "error_report: gnuplot not found (Debian: gnuplot-nox; scripts/setup.sh installs it), or pass --no-plots\n");
     return 2;
   }
   std::vector<Section> sections(6);

@@ -4,24 +4,15 @@
 
 #include <effects/fog.h>
 
+#include "fixtures.h"
+
 namespace {
 
 using namespace effects::fog;
 
-Fog fogOf(int mode) {
-  Fog f;
-  f.type = static_cast<FogType>(mode);
-  f.visibilityRange = 50;
-  f.start = 5;
-  f.end = 40;
-  f.density = 0.05;
-  f.distanceCoefficient = 0.07;
-  f.heightFalloff = 0.2;
-  return f;
-}
 
 void BM_FogTable(benchmark::State& state) {
-  Fog f = fogOf(int(state.range(0)));
+  Fog f = fixtures::fogOf(static_cast<FogType>(state.range(0)));
   TableOptions o;
   // Height fog tables are 2-D: N/2 distances x 2 elevations keeps the entry count at N.
   const bool twoD = f.type == FogType::kHeight;

@@ -21,7 +21,7 @@ namespace {
 
 using namespace effects::lightning;
 
-using bench::lightningLayout;
+using fixtures::lightningLayout;
 
 void run(benchmark::State& state, Params p) {
   uint64_t seed = 1;
@@ -89,8 +89,10 @@ void fractal() {
     Method method;
     double axisGrowth;
   };
-  const Row rows[] = {{"fast", Method::kFast, 2.0}, {"fast, axisGrowth 1.1", Method::kFast, 1.1},
-                      {"charges", Method::kCharges, 2.0}, {"dbm", Method::kDbm, 2.0}};
+  const Row rows[] = {{"fast", Method::kFast, 2.0},
+                      {"fast, axisGrowth 1.1", Method::kFast, 1.1},
+                      {"charges", Method::kCharges, 2.0},
+                      {"dbm", Method::kDbm, 2.0}};
   for (double eta : {1.0, 2.0}) {
     for (const Row& row : rows) {
       double sum = 0, sum2 = 0;

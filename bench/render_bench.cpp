@@ -18,14 +18,19 @@ namespace {
 using nlohmann::json;
 namespace rd = effects::render;
 
-const json kLightning = {{"grid", {{"width", 128}, {"height", 128}}}, {"start", {64, 0}}, {"targets", {{64, 127}}}, {"seed", 7}};
-const json kFog = {{"fog", {{"fogType", "HEIGHT"}, {"color", {0.5, 0.55, 0.6}}, {"density", 0.08}, {"heightFalloff", 0.5}}}};
-const json kBubble = {{"features", {{"iridescence", true}}}, {"mesh", {{"level", 4}}}, {"params", {{"wobbleAmplitude", 0.03}}}};
+const json kLightning = {
+    {"grid", {{"width", 128}, {"height", 128}}}, {"start", {64, 0}}, {"targets", {{64, 127}}}, {"seed", 7}};
+const json kFog = {
+    {"fog", {{"fogType", "HEIGHT"}, {"color", {0.5, 0.55, 0.6}}, {"density", 0.08}, {"heightFalloff", 0.5}}}};
+const json kBubble = {
+    {"features", {{"iridescence", true}}}, {"mesh", {{"level", 4}}}, {"params", {{"wobbleAmplitude", 0.03}}}};
 const json kQuads = {{{"center", {0, -1, -10}}, {"normal", {0, 1, 0}}, {"up", {0, 0, -1}}, {"size", {40, 30}}},
                      {{"center", {-3, 0.5, -6}}, {"size", {1.5, 3}}}};
 
 json scene(bool lightning, bool fog, bool bubble) {
-  json s = {{"width", 512}, {"height", 512}, {"background", {{"gradient", {{"top", {0.1, 0.1, 0.2}}, {"bottom", {0.4, 0.4, 0.5}}}}}}};
+  json s = {{"width", 512},
+            {"height", 512},
+            {"background", {{"gradient", {{"top", {0.1, 0.1, 0.2}}, {"bottom", {0.4, 0.4, 0.5}}}}}}};
   if (lightning) s["lightning"] = kLightning;
   if (fog) s["fog"] = kFog, s["quads"] = kQuads;
   if (bubble) s["bubble"] = kBubble;
@@ -48,7 +53,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("renderer: %s, 512x512, %d iterations each\n\n", renderer.value()->description().c_str(), iterations);
-  std::printf("%-16s %12s %12s %14s %14s  %s\n", "scene", "frame p50", "frame p99", "request p50", "request p99", "passes");
+  std::printf("%-16s %12s %12s %14s %14s  %s\n", "scene", "frame p50", "frame p99", "request p50", "request p99",
+              "passes");
   struct Case {
     const char* name;
     bool lightning, fog, bubble;
@@ -74,8 +80,8 @@ int main(int argc, char** argv) {
       frame.push_back(f.value().ms);
       request.push_back(watch.ms());
     }
-    std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", c.name, percentile(frame, 0.5), percentile(frame, 0.99),
-                percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
+    std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", c.name, percentile(frame, 0.5),
+                percentile(frame, 0.99), percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
   }
   std::printf("\ntarget: all three, request p50 <= 150 ms on the 2-core CI-class machine\n");
   return 0;

@@ -17,7 +17,7 @@ namespace {
 using namespace effects::tangents;
 
 const Mesh& mesh100k() {
-  static const Mesh m = bench::uvSphere(200, 250);  // 99 500 triangles
+  static const Mesh m = fixtures::uvSphere(200, 250);  // 99 500 triangles
   return m;
 }
 

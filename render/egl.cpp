@@ -32,7 +32,8 @@ Display openDevice() {
   if (!hasExtension(client, "EGL_EXT_platform_device")) return {EGL_NO_DISPLAY, "EGL_EXT_platform_device is missing"};
   auto queryDevices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
   auto queryString = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
-  auto platformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  auto platformDisplay =
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (!queryDevices || !queryString || !platformDisplay) return {EGL_NO_DISPLAY, "EGL device functions are missing"};
   EGLDeviceEXT devices[16];
   EGLint count = 0;
@@ -53,8 +54,10 @@ Display openSurfaceless() {
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   if (!hasExtension(client, "EGL_MESA_platform_surfaceless"))
     return {EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless is missing"};
-  auto platformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  EGLDisplay d = platformDisplay ? platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr) : EGL_NO_DISPLAY;
+  auto platformDisplay =
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  EGLDisplay d =
+      platformDisplay ? platformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr) : EGL_NO_DISPLAY;
   if (d == EGL_NO_DISPLAY || !eglInitialize(d, nullptr, nullptr))
     return {EGL_NO_DISPLAY, "the surfaceless EGL display could not be initialised"};
   return {d, ""};
@@ -88,8 +91,8 @@ Result<EglContext> contextOn(const std::string& platform) {
       c = eglCreateContext(d.display, config, EGL_NO_CONTEXT, attributes);
   }
   if (c == EGL_NO_CONTEXT)
-    return Error{ErrorKind::kUnsatisfiable, "/renderer", platform + ": no OpenGL ES 3 context (EGL error " +
-                                                             std::to_string(eglGetError()) + ")"};
+    return Error{ErrorKind::kUnsatisfiable, "/renderer",
+                 platform + ": no OpenGL ES 3 context (EGL error " + std::to_string(eglGetError()) + ")"};
   if (!eglMakeCurrent(d.display, EGL_NO_SURFACE, EGL_NO_SURFACE, c)) {
     eglDestroyContext(d.display, c);
     return Error{ErrorKind::kUnsatisfiable, "/renderer", platform + ": the context cannot be made current"};

@@ -83,7 +83,8 @@ struct Texture {
   }
 };
 
-inline Texture texture2D(int w, int h, GLenum internal, GLenum format, GLenum type, const void* data, GLenum wrap = GL_REPEAT) {
+inline Texture texture2D(int w, int h, GLenum internal, GLenum format, GLenum type, const void* data,
+                         GLenum wrap = GL_REPEAT) {
   Texture t;
   t.make(GL_TEXTURE_2D);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
@@ -107,7 +108,8 @@ struct Target {
   }
   bool create(int w, int h, GLenum internal, bool withDepth) {
     width = w, height = h;
-    color = texture2D(w, h, internal, GL_RGBA, internal == GL_RGBA32F ? GL_FLOAT : GL_HALF_FLOAT, nullptr, GL_CLAMP_TO_EDGE);
+    color = texture2D(w, h, internal, GL_RGBA, internal == GL_RGBA32F ? GL_FLOAT : GL_HALF_FLOAT, nullptr,
+                      GL_CLAMP_TO_EDGE);
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id, 0);

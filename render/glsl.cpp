@@ -33,8 +33,9 @@ std::string fogGlsl(const FogVariant& v) {
     << "uniform int uFogType[" << slots << "];\n"
     << "uniform vec4 uFogParams[" << slots << "];\n"
     << "uniform vec3 uFogColor[" << slots << "];\n";
-  if (v.regions) s << "uniform vec4 uRegionLo[" << v.regions << "];  // box min | sphere centre; w: 0 box, 1 sphere\n"
-                   << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
+  if (v.regions)
+    s << "uniform vec4 uRegionLo[" << v.regions << "];  // box min | sphere centre; w: 0 box, 1 sphere\n"
+      << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
   if (has(T::kHeight))
     s << "float fogLogG(float x) {  // log((1 - e^-x) / x), stable for every x\n"
          "  if (abs(x) < 1e-3) return -0.5 * x + x * x / 24.0;\n"
@@ -204,7 +205,8 @@ std::string blurFragment() {
          "  vec2 uv = gl_FragCoord.xy / uTargetSize;\n"
          "  vec4 sum = uWeights[0] * texture(uSource, uv);\n"
          "  for (int i = 1; i <= uRadius; ++i)\n"
-         "    sum += uWeights[i] * (texture(uSource, uv + float(i) * uStep) + texture(uSource, uv - float(i) * uStep));\n"
+         "    sum += uWeights[i] * (texture(uSource, uv + float(i) * uStep) + texture(uSource, uv - float(i) * "
+         "uStep));\n"
          "  fragColor = sum;\n}\n";
 }
 
@@ -215,7 +217,8 @@ std::string compositeFragment(bool glow) {
        "void main() {  // added over the scene\n"
        "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
        "  float light = texelFetch(uCore, p, 0).r;\n";
-  if (glow) s += "  light += uGlowStrength * texture(uGlow, gl_FragCoord.xy / vec2(textureSize(uCore, 0))).r;  // upsampled\n";
+  if (glow)
+    s += "  light += uGlowStrength * texture(uGlow, gl_FragCoord.xy / vec2(textureSize(uCore, 0))).r;  // upsampled\n";
   return s + "  fragColor = vec4(uColor * light, min(light, 1.0));\n}\n";
 }
 

@@ -60,10 +60,10 @@ View viewOf(const Scene& s);
 struct FrameState {
   const Scene& scene;
   View view;
-  Target main;                     // premultiplied RGBA float with depth
-  std::optional<FogVariant> fog;   // the fog shader variant when the scene has fog
-  std::string fogKey;              // ":" + its key, part of the program keys that include fog
-  Texture backgroundImage;         // the backdrop image, when it is one
+  Target main;                    // premultiplied RGBA float with depth
+  std::optional<FogVariant> fog;  // the fog shader variant when the scene has fog
+  std::string fogKey;             // ":" + its key, part of the program keys that include fog
+  Texture backgroundImage;        // the backdrop image, when it is one
   Frame frame;
 };
 

@@ -38,7 +38,8 @@ Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
     OIIO::Filesystem::IOMemReader proxy(data, bytes.size());
     auto in = OIIO::ImageInput::create(name, false, nullptr, &proxy);
     OIIO::ImageSpec spec;
-    if (!in || !in->set_ioproxy(&proxy) || !in->open(name, spec)) return invalid("", "cannot be decoded: " + (in ? in->geterror() : std::string("no reader")));
+    if (!in || !in->set_ioproxy(&proxy) || !in->open(name, spec))
+      return invalid("", "cannot be decoded: " + (in ? in->geterror() : std::string("no reader")));
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
       return invalid("", "has no usable pixels");
     const size_t pixels = size_t(spec.width) * size_t(spec.height);

@@ -34,7 +34,7 @@ FogVariant fogVariant(const Fog& fog);
 std::string fogGlsl(const FogVariant& v);
 
 std::string backgroundGlsl(Background::Kind kind);  // vec4 backgroundAt(vec2 uv) (premultiplied)
-std::string screenVertex();                          // full-screen triangle, no attributes
+std::string screenVertex();                         // full-screen triangle, no attributes
 std::string backgroundFragment(Background::Kind kind);
 std::string environmentFragment(Background::Kind kind);  // one cube face: direction -> backdrop
 std::string waveVertex();

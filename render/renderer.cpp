@@ -25,7 +25,6 @@ View viewOf(const Scene& s) {
   return v;
 }
 
-
 }  // namespace detail
 
 struct Renderer::Impl {
@@ -137,7 +136,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::string& platform) 
     colorFloat |= e == "GL_EXT_color_buffer_float";
     m.floatBlend |= e == "GL_EXT_float_blend";
   }
-  if (!colorFloat) return unsatisfiable("/renderer", m.description + " cannot render to float buffers (GL_EXT_color_buffer_float)");
+  if (!colorFloat)
+    return unsatisfiable("/renderer", m.description + " cannot render to float buffers (GL_EXT_color_buffer_float)");
   glGenVertexArrays(1, &m.emptyVao);
   return r;
 }

@@ -39,7 +39,8 @@ std::vector<uint8_t> normalMap(int size, uint64_t seed) {
 std::vector<uint8_t> softPattern(int size, int channels, uint64_t seed, double lo, double hi) {
   Rng rng(seed);
   double f[4][3];
-  for (auto& w : f) w[0] = 1 + std::floor(rng.uniform() * 4), w[1] = 1 + std::floor(rng.uniform() * 4), w[2] = 2 * kPi * rng.uniform();
+  for (auto& w : f)
+    w[0] = 1 + std::floor(rng.uniform() * 4), w[1] = 1 + std::floor(rng.uniform() * 4), w[2] = 2 * kPi * rng.uniform();
   std::vector<uint8_t> out(size_t(size) * size * size_t(channels));
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {

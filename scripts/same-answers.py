@@ -7,9 +7,10 @@ computeMs and the like differ from run to run); PNG and glTF answers byte for by
 
   scripts/same-answers.py OLD_EFFECTD NEW_EFFECTD     exit 0 when every answer is the same
 """
-import base64, glob, http.client, json, math, re, subprocess, sys
+import base64, glob, http.client, json, math, os, re, subprocess, sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+from answers import scrub  # noqa: E402
 
-TIMING = re.compile(r"Ms$|^ms$|^requestId$")  # run times, and the per-request id in problems
 
 
 def start(binary):
@@ -29,14 +30,6 @@ def post(port, path, body, ctype="application/json"):
     r = c.getresponse()
     data = r.read()
     return r.status, r.getheader("Content-Type", ""), data
-
-
-def scrub(v):
-    if isinstance(v, dict):
-        return {k: scrub(x) for k, x in v.items() if not TIMING.search(k)}
-    if isinstance(v, list):
-        return [scrub(x) for x in v]
-    return v
 
 
 def requests():

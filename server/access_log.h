@@ -3,7 +3,10 @@
 
 #include <string>
 
-namespace httplib { struct Request; struct Response; }
+namespace httplib {
+struct Request;
+struct Response;
+}  // namespace httplib
 
 namespace effectd {
 

@@ -34,10 +34,14 @@ Admission::Ticket Admission::admit(size_t bytes, bool heavy) {
   std::unique_lock<std::mutex> lock(mu_);
   if (bytes > o_.budgetBytes) {
     ++c_.refusedTooLarge;
-    throw ApiError{413, "over-memory-budget", "Request exceeds the memory budget",
-                   "this request needs about " + mb(bytes) + " at its peak, more than the server's whole memory budget of " +
-                       mb(o_.budgetBytes) + " (--memory-budget-mb); make it smaller",
-                   {}, {}};
+    throw ApiError{413,
+                   "over-memory-budget",
+                   "Request exceeds the memory budget",
+                   "this request needs about " + mb(bytes) +
+                       " at its peak, more than the server's whole memory budget of " + mb(o_.budgetBytes) +
+                       " (--memory-budget-mb); make it smaller",
+                   {},
+                   {}};
   }
   auto busy = [&](const std::string& why) {
     ++c_.refusedBusy;
@@ -48,7 +52,8 @@ Admission::Ticket Admission::admit(size_t bytes, bool heavy) {
     // Admitted at once.
   } else {
     if (int(queue_[0].size() + queue_[1].size()) >= o_.maxWaiting)
-      throw busy("the admission queue is full (" + std::to_string(o_.maxWaiting) + " requests wait for memory or a heavy slot)");
+      throw busy("the admission queue is full (" + std::to_string(o_.maxWaiting) +
+                 " requests wait for memory or a heavy slot)");
     const uint64_t id = nextId_++;
     queue.push_back(id);
     ++c_.waited;

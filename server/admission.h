@@ -5,9 +5,9 @@
 // It is admitted when its bytes fit in what the budget has left and, if heavy, when a heavy
 // slot is free; otherwise it waits in a bounded queue for a bounded time, first come first
 // served within its class, and is then refused with 503 + Retry-After. Light and heavy
-// requests queue apart: a small request never waits behind bolts waiting for a heavy slot. A request larger than the whole budget
-// can never run: 413 naming --memory-budget-mb. The ticket releases its bytes and slot when
-// destroyed — after the answer has been written, since the answer's bytes count too.
+// requests queue apart: a small request never waits behind bolts waiting for a heavy slot. A request larger than the
+// whole budget can never run: 413 naming --memory-budget-mb. The ticket releases its bytes and slot when destroyed —
+// after the answer has been written, since the answer's bytes count too.
 #pragma once
 
 #include <chrono>

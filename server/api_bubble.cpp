@@ -3,10 +3,10 @@
 
 #include <effects/bubble.h>
 
-#include "codec.h"
-#include "costs.h"
 #include "api_bubble.h"
 #include "api_common.h"
+#include "codec.h"
+#include "costs.h"
 
 namespace effectd {
 
@@ -103,14 +103,16 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
   const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
   bb::ShaderSource s;
-  if (include.has("uniforms") || include.has("shader")) s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
+  if (include.has("uniforms") || include.has("shader"))
+    s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
   if (include.has("uniforms")) out["uniforms"] = uniforms(params, features, s.uniforms, t);
   if (include.has("shader")) {
-    out["shader"] = {{"language", es ? "glsl-es-300" : "glsl-330"},
-                     {"vertex", s.vertex},
-                     {"fragment", s.fragment},
-                     {"uniforms", s.uniforms},
-                     {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
+    out["shader"] = {
+        {"language", es ? "glsl-es-300" : "glsl-330"},
+        {"vertex", s.vertex},
+        {"fragment", s.fragment},
+        {"uniforms", s.uniforms},
+        {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
   }
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
@@ -129,12 +131,9 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
       throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
     }
     const bb::Mesh& mesh = r.value();
-    json mj = {{"vertexCount", mesh.positions.size()},
-               {"positions", flat<3>(mesh.positions)},
-               {"normals", flat<3>(mesh.normals)},
-               {"uvs", flat<2>(mesh.uvs)},
-               {"tangents", flat<4>(mesh.tangents)},
-               {"indices", mesh.indices}};
+    json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
+               {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
+               {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices}};
     if (o.camera) {
       mj["finalVectors"] = flat<3>(mesh.finalVectors);
       mj["rim"] = mesh.rim;
@@ -196,6 +195,8 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   return reply;
 }
 
-void addBubbleEndpoints(Service& service) { service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble, bubbleCost); }
+void addBubbleEndpoints(Service& service) {
+  service.addJsonEndpoint("/v1/bubble", "bubble.json", handleBubble, bubbleCost);
+}
 
 }  // namespace effectd

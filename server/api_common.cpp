@@ -7,9 +7,12 @@
 namespace effectd {
 
 ApiError fieldError(int status, const std::string& pointer, const std::string& message) {
-  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-field",
-                  status == 413 ? "Request exceeds a configured limit" : "Invalid field", pointer + ": " + message,
-                  {{pointer, message}}, {}};
+  return ApiError{status,
+                  status == 413 ? "limit-exceeded" : "invalid-field",
+                  status == 413 ? "Request exceeds a configured limit" : "Invalid field",
+                  pointer + ": " + message,
+                  {{pointer, message}},
+                  {}};
 }
 
 glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }

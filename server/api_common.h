@@ -11,7 +11,9 @@
 
 #include "service.h"
 
-namespace effects { struct Stats; }
+namespace effects {
+struct Stats;
+}
 
 namespace effectd {
 

@@ -3,10 +3,10 @@
 
 #include <effects/fog.h>
 
-#include "codec.h"
-#include "costs.h"
 #include "api_common.h"
 #include "api_fog.h"
+#include "codec.h"
+#include "costs.h"
 
 namespace effectd {
 
@@ -31,8 +31,7 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
 
 fog::Region parseRegion(const json& j, const std::string& pointer) {
   fog::Region r;
-  if (j.contains("box") == j.contains("sphere"))
-    throw fieldError(400, pointer, "give exactly one of box or sphere");
+  if (j.contains("box") == j.contains("sphere")) throw fieldError(400, pointer, "give exactly one of box or sphere");
   if (j.contains("box")) {
     r.shape = fog::Region::Shape::kBox;
     r.min = toVec3(j["box"]["min"]);
@@ -142,10 +141,10 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
     auto t = fog::buildTable(f, tableOptions(tableOpts, ctx.config));
     if (!t.ok()) {
       effects::Error e = t.error();
-      throwError(e, e.field == "/range" || e.field.rfind("/range/", 0) == 0 || e.field == "/size" ||
-                            e.field == "/maxError"
-                        ? "/table"
-                        : pointer);
+      throwError(e,
+                 e.field == "/range" || e.field.rfind("/range/", 0) == 0 || e.field == "/size" || e.field == "/maxError"
+                     ? "/table"
+                     : pointer);
     }
     reply.computeMs += t.value().stats.elapsedMs;
     stats.push_back(statsJson(t.value().stats));
@@ -164,8 +163,7 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
     out["regionTables"] = std::move(list);
   }
   if (include.has("samples")) {
-    if (!body.contains("samples"))
-      throw fieldError(400, "/samples", "is required when include has \"samples\"");
+    if (!body.contains("samples")) throw fieldError(400, "/samples", "is required when include has \"samples\"");
     effects::Stopwatch watch;
     glm::dvec3 camera = toVec3(body["samples"]["camera"]);
     json list = json::array();

@@ -1,10 +1,10 @@
 // POST /v1/lightning — grid + obstacles + start/targets -> bolt tree, polylines, quality.
 #include <effects/lightning.h>
 
-#include "codec.h"
-#include "costs.h"
 #include "api_common.h"
 #include "api_lightning.h"
+#include "codec.h"
+#include "costs.h"
 
 namespace effectd {
 namespace {
@@ -41,7 +41,8 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
     size_t need = (grid.size() + 7) / 8;
     if (bytes->size() != need)
       throw fieldError(400, "/obstacles/bitmap",
-                       "must decode to " + std::to_string(need) + " bytes (width*height bits), got " + std::to_string(bytes->size()));
+                       "must decode to " + std::to_string(need) + " bytes (width*height bits), got " +
+                           std::to_string(bytes->size()));
     for (size_t i = 0; i < grid.size(); ++i)
       if ((uint8_t((*bytes)[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
     any = true;
@@ -61,8 +62,9 @@ LightningRequest parseLightning(const json& body, const Config& config) {
   p.height = body["grid"]["height"];
   const size_t cells = size_t(p.width) * size_t(p.height);
   if (cells > config.limits.maxGridCells)
-    throw fieldError(413, "/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
-                                       std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
+    throw fieldError(413, "/grid",
+                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                         std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
   if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height);
   p.start = cellOf(body["start"]);
   p.targets.clear();
@@ -70,10 +72,11 @@ LightningRequest parseLightning(const json& body, const Config& config) {
   const std::string method = body.value("method", "fast");
   p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
   if (p.method != lt::Method::kFast && cells > config.limits.maxSolverGridCells)
-    throw fieldError(413, "/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
-                                       std::to_string(config.limits.maxSolverGridCells) + " for method " + method +
-                                       " (--max-solver-grid-cells); the fast method takes up to " +
-                                       std::to_string(config.limits.maxGridCells));
+    throw fieldError(413, "/grid",
+                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                         std::to_string(config.limits.maxSolverGridCells) + " for method " + method +
+                         " (--max-solver-grid-cells); the fast method takes up to " +
+                         std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
   p.lifetime = body.value("lifetime", p.lifetime);
   p.axisGrowth = body.value("axisGrowth", p.axisGrowth);

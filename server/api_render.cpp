@@ -7,13 +7,13 @@
 
 #include <effects/bubble.h>
 
-#include "codec.h"
-#include "costs.h"
 #include "api_bubble.h"
 #include "api_common.h"
 #include "api_fog.h"
 #include "api_lightning.h"
 #include "api_render.h"
+#include "codec.h"
+#include "costs.h"
 #include "scene.h"
 
 namespace effectd {
@@ -35,12 +35,13 @@ auto within(const std::string& prefix, F&& f) {
   }
 }
 
-glm::dvec4 rgba(const json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j.size() > 3 ? j[3].get<double>() : 1.0}; }
+glm::dvec4 rgba(const json& j) {
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j.size() > 3 ? j[3].get<double>() : 1.0};
+}
 
 rd::Image image(const json& base64, const std::string& pointer, const Config& config) {
   auto bytes = base64Decode(base64.get<std::string>());
-  if (!bytes)
-    throw fieldError(400, pointer, "is not valid base64 (standard alphabet, padded)");
+  if (!bytes) throw fieldError(400, pointer, "is not valid base64 (standard alphabet, padded)");
   auto decoded = rd::decodeImage(*bytes, config.limits.maxRenderPixels);
   if (!decoded.ok()) {
     effects::Error e = decoded.error();
@@ -70,8 +71,7 @@ std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOption
 }
 
 void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
-  if (v.x == 0 && v.y == 0 && v.z == 0)
-    throw fieldError(400, pointer, "must not be the zero vector");
+  if (v.x == 0 && v.y == 0 && v.z == 0) throw fieldError(400, pointer, "must not be the zero vector");
 }
 
 }  // namespace
@@ -97,12 +97,10 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
   s.camera.nearPlane = cam.value("near", s.camera.nearPlane);
   s.camera.farPlane = cam.value("far", s.camera.farPlane);
   const glm::dvec3 forward = s.camera.target - s.camera.position;
-  if (glm::length(forward) < 1e-12)
-    throw fieldError(400, "/camera/target", "must differ from the camera position");
+  if (glm::length(forward) < 1e-12) throw fieldError(400, "/camera/target", "must differ from the camera position");
   if (!(glm::length(glm::cross(forward, s.camera.up)) > 1e-12 * glm::length(forward) * glm::length(s.camera.up)))
     throw fieldError(400, "/camera/up", "must not be parallel to the view direction (or zero)");
-  if (!(s.camera.farPlane > s.camera.nearPlane))
-    throw fieldError(400, "/camera/far", "must be greater than near");
+  if (!(s.camera.farPlane > s.camera.nearPlane)) throw fieldError(400, "/camera/far", "must be greater than near");
 
   if (body.contains("background")) {
     const json& b = body["background"];
@@ -150,7 +148,8 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
       fog.global = parseFog(f["fog"], "/fog");
       if (f.contains("regions")) {
         if (f["regions"].size() > rd::kMaxFogRegions)
-          throw fieldError(422, "/regions", "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
+          throw fieldError(422, "/regions",
+                           "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
         for (size_t i = 0; i < f["regions"].size(); ++i)
           fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
       }
@@ -247,37 +246,44 @@ JsonReply handleScene(const json& body, const RequestContext& ctx) {
 
 void addRenderEndpoints(Service& service) {
   const Config& config = service.config();
-  auto pool = std::make_shared<rd::RenderPool>(rd::PoolOptions{config.renderThreads, config.renderQueue, config.eglPlatform});
+  auto pool =
+      std::make_shared<rd::RenderPool>(rd::PoolOptions{config.renderThreads, config.renderQueue, config.eglPlatform});
   service.addReadinessCheck("renderer", [pool] { return pool->start(); });
   service.addReadinessInfo("renderer", [pool] { return pool->description(); });
   service.addJsonEndpoint("/v1/scene", "scene.json", handleScene, sceneCost);
   Metrics* metrics = &service.metrics();
-  service.addJsonEndpoint("/v1/render", "scene.json", [pool, metrics](const json& body, const RequestContext& ctx) {
-    JsonReply reply;
-    reply.method = "render";
-    rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
-    const int bitDepth = scene.bitDepth;
-    auto job = pool->submit(std::move(scene));
-    if (!job)
-      throw ApiError{503, "render-queue-full", "Render queue full",
-                     "every render thread is busy and the queue is full; retry shortly (--render-queue)", {},
-                     {{"Retry-After", "1"}}};
-    auto frame = job->get();
-    if (!frame.ok()) throwError(frame.error());
-    const rd::Frame& f = frame.value();
-    effects::Stopwatch encode;
-    auto png = rd::encodePng(f.image, bitDepth);
-    if (!png.ok()) throwError(png.error());
-    for (const auto& p : f.passes) metrics->count("render_passes", p);
-    metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
-    reply.computeMs += f.ms + encode.ms();
-    reply.binary = std::move(png.value());
-    reply.contentType = "image/png";
-    reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
-    reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
-                        {"X-Render-Ms", std::to_string(f.ms)}};
-    return reply;
-  }, renderCost);
+  service.addJsonEndpoint(
+      "/v1/render", "scene.json",
+      [pool, metrics](const json& body, const RequestContext& ctx) {
+        JsonReply reply;
+        reply.method = "render";
+        rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+        const int bitDepth = scene.bitDepth;
+        auto job = pool->submit(std::move(scene));
+        if (!job)
+          throw ApiError{503,
+                         "render-queue-full",
+                         "Render queue full",
+                         "every render thread is busy and the queue is full; retry shortly (--render-queue)",
+                         {},
+                         {{"Retry-After", "1"}}};
+        auto frame = job->get();
+        if (!frame.ok()) throwError(frame.error());
+        const rd::Frame& f = frame.value();
+        effects::Stopwatch encode;
+        auto png = rd::encodePng(f.image, bitDepth);
+        if (!png.ok()) throwError(png.error());
+        for (const auto& p : f.passes) metrics->count("render_passes", p);
+        metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
+        reply.computeMs += f.ms + encode.ms();
+        reply.binary = std::move(png.value());
+        reply.contentType = "image/png";
+        reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
+        reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
+                            {"X-Render-Ms", std::to_string(f.ms)}};
+        return reply;
+      },
+      renderCost);
   // The same scene renders alike on the same renderer: it is part of the render's ETag.
   service.setEtagSalt("/v1/render", [pool] { return pool->start().empty() ? pool->description() : std::string(); });
 }

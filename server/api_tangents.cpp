@@ -3,9 +3,9 @@
 
 #include <effects/tangents.h>
 
-#include "costs.h"
 #include "api_common.h"
 #include "api_tangents.h"
+#include "costs.h"
 #include "glb.h"
 
 namespace effectd {
@@ -26,8 +26,7 @@ tg::Options options(const RequestContext& ctx, tg::Mode mode) {
 
 template <class V, int N>
 std::vector<V> unflatten(const json& a, const std::string& pointer) {
-  if (a.size() % N != 0)
-    throw fieldError(400, pointer, "length must be a multiple of " + std::to_string(N));
+  if (a.size() % N != 0) throw fieldError(400, pointer, "length must be a multiple of " + std::to_string(N));
   std::vector<V> out(a.size() / N);
   for (size_t i = 0; i < out.size(); ++i)
     for (int c = 0; c < N; ++c) out[i][c] = a[i * N + size_t(c)].get<float>();
@@ -37,7 +36,8 @@ std::vector<V> unflatten(const json& a, const std::string& pointer) {
 // Library fields name vertices; the wire has flat arrays ("/positions/7" -> "/mesh/positions/21").
 std::string meshPointer(const std::string& field) {
   for (auto [name, width] : {std::pair{"/positions/", 3}, {"/normals/", 3}, {"/uvs/", 2}})
-    if (field.rfind(name, 0) == 0) return "/mesh" + std::string(name) + std::to_string(std::stoull(field.substr(std::strlen(name))) * width);
+    if (field.rfind(name, 0) == 0)
+      return "/mesh" + std::string(name) + std::to_string(std::stoull(field.substr(std::strlen(name))) * width);
   return "/mesh" + field;
 }
 
@@ -57,8 +57,8 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
   mesh.indices = m["indices"].get<std::vector<uint32_t>>();
   const std::string modeName = body.value("mode", "mikktspace");
   tg::Options opt = options(ctx, modeName == "perTriangle" ? tg::Mode::kPerTriangle
-                                         : modeName == "perVertex" ? tg::Mode::kPerVertex
-                                                                   : tg::Mode::kMikkTSpace);
+                                 : modeName == "perVertex" ? tg::Mode::kPerVertex
+                                                           : tg::Mode::kMikkTSpace);
   opt.measureError = include.has("error") && opt.mode != tg::Mode::kMikkTSpace;
   opt.triangleFrames = include.has("triangleFrames");
   auto r = tg::generate(mesh, opt);
@@ -96,8 +96,11 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
                       {"metric", out.stats.errorMetric},
                       {"reference", out.stats.reference}};
     else
-      res["error"] = {{"meanAngleDeg", 0.0}, {"maxAngleDeg", 0.0}, {"handednessMismatches", 0},
-                      {"metric", "mean angle between corner tangents, degrees"}, {"reference", "mikktspace (this is it)"}};
+      res["error"] = {{"meanAngleDeg", 0.0},
+                      {"maxAngleDeg", 0.0},
+                      {"handednessMismatches", 0},
+                      {"metric", "mean angle between corner tangents, degrees"},
+                      {"reference", "mikktspace (this is it)"}};
   }
   if (include.has("stats")) res["stats"] = statsJson(out.stats);
   reply.body = std::move(res);
@@ -108,14 +111,17 @@ JsonReply handleTangents(const json& body, const RequestContext& ctx) {
 
 namespace {
 
-ApiError gltfProblem(int status, const glb::Problem& p) {
+ApiError gltfProblem(int status, const FieldError& p) {
   std::string where = p.pointer.empty() ? "body" : p.pointer;
-  return ApiError{status, status == 413 ? "limit-exceeded" : "invalid-gltf",
-                  status == 413 ? "Request exceeds a configured limit" : "Unusable glTF", where + ": " + p.message,
-                  {{p.pointer, p.message}}, {}};
+  return ApiError{status,
+                  status == 413 ? "limit-exceeded" : "invalid-gltf",
+                  status == 413 ? "Request exceeds a configured limit" : "Unusable glTF",
+                  where + ": " + p.message,
+                  {{p.pointer, p.message}},
+                  {}};
 }
 
-void check(const std::optional<glb::Problem>& p, int status = 422) {
+void check(const std::optional<FieldError>& p, int status = 422) {
   if (p) throw gltfProblem(status, *p);
 }
 
@@ -143,7 +149,7 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     throw gltfProblem(422, {at + "/attributes", "attribute accessors must have the same count"});
   if (n > config.limits.maxMeshVertices)
     throw gltfProblem(413, {at + "/attributes/POSITION", std::to_string(n) + " vertices exceed the limit of " +
-                                                              std::to_string(config.limits.maxMeshVertices)});
+                                                             std::to_string(config.limits.maxMeshVertices)});
   mesh.positions.resize(n);
   mesh.uvs.resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -165,8 +171,10 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
   auto r = tg::generate(mesh, opt);
   if (!r.ok()) {
     const effects::Error& e = r.error();
-    std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION" : e.field.rfind("/uvs", 0) == 0 ? "TEXCOORD_0"
-                       : e.field.rfind("/normals", 0) == 0                ? "NORMAL" : "";
+    std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION"
+                       : e.field.rfind("/uvs", 0) == 0     ? "TEXCOORD_0"
+                       : e.field.rfind("/normals", 0) == 0 ? "NORMAL"
+                                                           : "";
     std::string pointer = attr.empty() ? at + "/indices" : at + "/attributes/" + attr;
     throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422, {pointer, e.message});
   }
@@ -229,7 +237,8 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
     throw gltfProblem(422, {"", std::string("malformed glTF JSON: ") + e.what()});
   }
   if (done == 0)
-    throw gltfProblem(422, {"/meshes", "no triangle primitive with POSITION and TEXCOORD_0: nothing can have tangents"});
+    throw gltfProblem(422,
+                      {"/meshes", "no triangle primitive with POSITION and TEXCOORD_0: nothing can have tangents"});
   reply.body = glb::serialize(asset);
   reply.contentType = "model/gltf-binary";
   return reply;

@@ -48,17 +48,24 @@ std::function<bool(const std::string&, Config&)> limitField(size_t Limits::*fiel
 const std::vector<Option>& options() {
   static const std::vector<Option> opts = {
       {"host", "EFFECTD_HOST", "address to listen on (default 127.0.0.1)",
-       [](const std::string& s, Config& c) { c.host = s; return !s.empty(); }},
+       [](const std::string& s, Config& c) {
+         c.host = s;
+         return !s.empty();
+       }},
       {"port", "EFFECTD_PORT", "TCP port, 0 = any free port (default 8080)", intField(&Config::port, 0, 65535)},
       {"threads", "EFFECTD_THREADS", "HTTP worker threads kept ready (default 8)", intField(&Config::threads, 1, 1024)},
       {"max-connections", "EFFECTD_MAX_CONNECTIONS",
-       "connections served at once, one thread each, growing from --threads (default 512); slow clients cannot starve the rest below it",
+       "connections served at once, one thread each, growing from --threads (default 512); slow clients cannot starve "
+       "the rest below it",
        intField(&Config::maxConnections, 1, 65536)},
-      {"read-timeout", "EFFECTD_READ_TIMEOUT", "seconds to receive a request (default 10)", intField(&Config::readTimeoutS, 1, 3600)},
-      {"write-timeout", "EFFECTD_WRITE_TIMEOUT", "seconds to send a response (default 10)", intField(&Config::writeTimeoutS, 1, 3600)},
-      {"keep-alive-timeout", "EFFECTD_KEEP_ALIVE_TIMEOUT", "idle seconds before a keep-alive connection closes (default 5)",
-       intField(&Config::keepAliveTimeoutS, 0, 3600)},
-      {"keep-alive-max", "EFFECTD_KEEP_ALIVE_MAX", "requests per connection (default 100)", intField(&Config::keepAliveMaxCount, 1, 1000000)},
+      {"read-timeout", "EFFECTD_READ_TIMEOUT", "seconds to receive a request (default 10)",
+       intField(&Config::readTimeoutS, 1, 3600)},
+      {"write-timeout", "EFFECTD_WRITE_TIMEOUT", "seconds to send a response (default 10)",
+       intField(&Config::writeTimeoutS, 1, 3600)},
+      {"keep-alive-timeout", "EFFECTD_KEEP_ALIVE_TIMEOUT",
+       "idle seconds before a keep-alive connection closes (default 5)", intField(&Config::keepAliveTimeoutS, 0, 3600)},
+      {"keep-alive-max", "EFFECTD_KEEP_ALIVE_MAX", "requests per connection (default 100)",
+       intField(&Config::keepAliveMaxCount, 1, 1000000)},
       {"access-log", "EFFECTD_ACCESS_LOG", "1/0: one JSON line per request on stderr (default 1)",
        [](const std::string& s, Config& c) {
          if (s != "0" && s != "1" && s != "true" && s != "false") return false;
@@ -74,12 +81,14 @@ const std::vector<Option>& options() {
       {"max-solver-grid-cells", "EFFECTD_MAX_SOLVER_GRID_CELLS",
        "largest grid for the dbm and charges methods, whose every step costs O(cells) (default 65536)",
        limitField(&Limits::maxSolverGridCells, 9, 1LL << 28)},
-      {"max-table-size", "EFFECTD_MAX_TABLE_SIZE", "fog table entries (default 65536)", limitField(&Limits::maxTableSize, 2, 1LL << 24)},
+      {"max-table-size", "EFFECTD_MAX_TABLE_SIZE", "fog table entries (default 65536)",
+       limitField(&Limits::maxTableSize, 2, 1LL << 24)},
       {"max-mesh-vertices", "EFFECTD_MAX_MESH_VERTICES", "vertices per mesh (default 2000000)",
        limitField(&Limits::maxMeshVertices, 3, 1LL << 28)},
       {"max-mesh-triangles", "EFFECTD_MAX_MESH_TRIANGLES", "triangles per mesh (default 4000000)",
        limitField(&Limits::maxMeshTriangles, 1, 1LL << 28)},
-      {"max-render-pixels", "EFFECTD_MAX_RENDER_PIXELS", "render width*height and decoded image pixels (default 16777216)",
+      {"max-render-pixels", "EFFECTD_MAX_RENDER_PIXELS",
+       "render width*height and decoded image pixels (default 16777216)",
        limitField(&Limits::maxRenderPixels, 1, 1LL << 28)},
       {"max-thin-film-texels", "EFFECTD_MAX_THIN_FILM_TEXELS", "bubble thin-film table width*height (default 1048576)",
        limitField(&Limits::maxThinFilmTexels, 4, 1LL << 26)},
@@ -100,14 +109,18 @@ const std::vector<Option>& options() {
        "heavy computations (Laplace solvers, huge grids and meshes) at once, so cheap requests keep a core "
        "(default 0 = cores - 1, at least 1)",
        intField(&Config::heavyThreads, 0, 1024)},
-      {"admission-queue", "EFFECTD_ADMISSION_QUEUE", "requests waiting for memory or a heavy slot before 503 (default 64)",
+      {"admission-queue", "EFFECTD_ADMISSION_QUEUE",
+       "requests waiting for memory or a heavy slot before 503 (default 64)",
        intField(&Config::admissionQueue, 0, 100000)},
-      {"admission-timeout-ms", "EFFECTD_ADMISSION_TIMEOUT_MS", "longest wait for memory or a heavy slot before 503 (default 10000)",
+      {"admission-timeout-ms", "EFFECTD_ADMISSION_TIMEOUT_MS",
+       "longest wait for memory or a heavy slot before 503 (default 10000)",
        intField(&Config::admissionTimeoutMs, 0, 3600000)},
-      {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB", "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
+      {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB",
+       "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
        intField(&Config::responseCacheMb, 0, 1LL << 20)},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
-       "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default none)",
+       "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
+       "none)",
        [](const std::string& s, Config& c) {
          c.corsOrigins.clear();
          size_t pos = 0;

@@ -9,35 +9,35 @@
 namespace effectd {
 
 struct Limits {
-  size_t maxBodyBytes = 16u << 20;     // request body
-  size_t maxGridCells = 4096u * 4096u; // lightning grid width*height
-  size_t maxGrowthSteps = 2'000'000;   // lightning cells added per request
+  size_t maxBodyBytes = 16u << 20;          // request body
+  size_t maxGridCells = 4096u * 4096u;      // lightning grid width*height
+  size_t maxGrowthSteps = 2'000'000;        // lightning cells added per request
   size_t maxSolverGridCells = 256u * 256u;  // dbm and charges: every step costs O(cells)
-  size_t maxTableSize = 65536;         // fog table entries (all dimensions together)
-  size_t maxMeshVertices = 2'000'000;  // tangents / bubble meshes
+  size_t maxTableSize = 65536;              // fog table entries (all dimensions together)
+  size_t maxMeshVertices = 2'000'000;       // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;
-  size_t maxRenderPixels = 4096u * 4096u;  // render width*height, and decoded background images
+  size_t maxRenderPixels = 4096u * 4096u;    // render width*height, and decoded background images
   size_t maxThinFilmTexels = 1024u * 1024u;  // bubble thin-film table width*height
 };
 
 struct Config {
   std::string host = "127.0.0.1";
   int port = 8080;
-  int threads = 8;            // HTTP threads kept ready
-  int maxConnections = 512;   // connections served at once (one thread each); more wait
+  int threads = 8;           // HTTP threads kept ready
+  int maxConnections = 512;  // connections served at once (one thread each); more wait
   int readTimeoutS = 10;
   int writeTimeoutS = 10;
   int keepAliveTimeoutS = 5;
   int keepAliveMaxCount = 100;
   bool accessLog = true;
-  int renderThreads = 2;      // render pool: threads, one EGL context each
-  int renderQueue = 8;        // renders waiting beyond the running ones; more -> 503
-  std::string eglPlatform;    // auto | device | surfaceless; "" = EFFECTD_EGL_PLATFORM or auto
-  size_t memoryBudgetMb = 0;  // 0 = kDefaultBudgetFraction of the cgroup limit or physical memory
-  int heavyThreads = 0;       // heavy computations at once; 0 = cores - 1 (at least 1)
-  int admissionQueue = 64;    // requests waiting for memory or a heavy slot; more -> 503
-  int admissionTimeoutMs = 10000;  // longest wait for admission before 503
-  size_t responseCacheMb = 64;     // encoded answers kept for repeats; 0 = off
+  int renderThreads = 2;                 // render pool: threads, one EGL context each
+  int renderQueue = 8;                   // renders waiting beyond the running ones; more -> 503
+  std::string eglPlatform;               // auto | device | surfaceless; "" = EFFECTD_EGL_PLATFORM or auto
+  size_t memoryBudgetMb = 0;             // 0 = kDefaultBudgetFraction of the cgroup limit or physical memory
+  int heavyThreads = 0;                  // heavy computations at once; 0 = cores - 1 (at least 1)
+  int admissionQueue = 64;               // requests waiting for memory or a heavy slot; more -> 503
+  int admissionTimeoutMs = 10000;        // longest wait for admission before 503
+  size_t responseCacheMb = 64;           // encoded answers kept for repeats; 0 = off
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   Limits limits;
 };

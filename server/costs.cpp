@@ -47,14 +47,16 @@ Cost lightningCost(const json& body, const Config& config) {
   // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils).
   const size_t perCell = solver ? 160 : 24;
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
-  const size_t steps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
+  const size_t steps =
+      std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
   const size_t boltCells = std::min({cells, steps, 16 * size_t(std::sqrt(double(cells))) + 4096});
   const Includes include(body, kLightningIncludes);
   size_t numbersPerCell = 0;
   if (include.has("polylines")) numbersPerCell += 5;
   if (include.has("cells")) numbersPerCell += 2;
   if (include.has("tree")) numbersPerCell += 3;
-  return {kBase + cells * perCell + boltCells * (96 + numbersPerCell * kAnswerNumber), solver || cells >= kHeavyGridCells};
+  return {kBase + cells * perCell + boltCells * (96 + numbersPerCell * kAnswerNumber),
+          solver || cells >= kHeavyGridCells};
 }
 
 Cost tangentsCost(const json& body, const Config& config) {
@@ -113,7 +115,8 @@ Cost renderCost(const json& body, const Config& config) {
   // Render targets and read-back (RGBA float), the converted 8/16-bit image, the PNG; a
   // decoded background image.
   c.bytes += pixels * 96;
-  if (body.contains("background") && body["background"].contains("image")) c.bytes += config.limits.maxRenderPixels * 16;
+  if (body.contains("background") && body["background"].contains("image"))
+    c.bytes += config.limits.maxRenderPixels * 16;
   c.heavy = c.heavy || pixels >= (2048u * 2048u);
   return c;
 }

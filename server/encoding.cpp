@@ -55,10 +55,14 @@ Coding negotiate(std::string_view header) {
     size_t semi = item.find(';');
     std::string_view name = trim(item.substr(0, semi));
     double q = semi == std::string_view::npos ? 1.0 : qValue(item.substr(semi + 1));
-    if (iequals(name, "br")) br = q;
-    else if (iequals(name, "gzip") || iequals(name, "x-gzip")) gzip = q;
-    else if (iequals(name, "identity")) identity = q;
-    else if (name == "*") star = q;
+    if (iequals(name, "br"))
+      br = q;
+    else if (iequals(name, "gzip") || iequals(name, "x-gzip"))
+      gzip = q;
+    else if (iequals(name, "identity"))
+      identity = q;
+    else if (name == "*")
+      star = q;
   }
   if (star >= 0) {
     if (br < 0) br = star;

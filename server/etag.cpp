@@ -38,8 +38,12 @@ bool etagMatches(const std::string& ifNoneMatch, const std::string& etag) {
 }
 
 std::string etagFor(const std::string& path, const std::string& salt, const std::string& canonical, Coding coding) {
-  std::string tag = "\"" + sha256Hex(std::string(EFFECTD_VERSION) + "\n" + path + "\n" + salt + "\n" + canonical).substr(0, 32);
-  return tag + (coding == Coding::kIdentity ? "\"" : std::string("-") + codingName(coding) + "\"");
+  std::string identity = EFFECTD_VERSION;
+  for (const std::string* part : {&path, &salt, &canonical}) identity.append("\n").append(*part);
+  std::string tag = "\"";
+  tag.append(sha256Hex(identity), 0, 32);
+  if (coding != Coding::kIdentity) tag.append("-").append(codingName(coding));
+  return tag.append("\"");
 }
 
 }  // namespace effectd

@@ -19,9 +19,12 @@ void put32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(
 
 int componentSize(int type) {
   switch (type) {
-    case 5120: case 5121: return 1;  // BYTE, UNSIGNED_BYTE
-    case 5122: case 5123: return 2;  // SHORT, UNSIGNED_SHORT
-    case 5125: case 5126: return 4;  // UNSIGNED_INT, FLOAT
+    case 5120:
+    case 5121: return 1;  // BYTE, UNSIGNED_BYTE
+    case 5122:
+    case 5123: return 2;  // SHORT, UNSIGNED_SHORT
+    case 5125:
+    case 5126: return 4;  // UNSIGNED_INT, FLOAT
     default: return 0;
   }
 }
@@ -49,20 +52,20 @@ struct View {
   bool zeros = false;  // no bufferView: all elements are zero
 };
 
-std::optional<Problem> view(const Asset& a, int index, View& v) {
+std::optional<FieldError> view(const Asset& a, int index, View& v) {
   std::string at = "/accessors/" + std::to_string(index);
   const json& accessors = member(a.gltf, "accessors");
-  if (index < 0 || size_t(index) >= accessors.size()) return Problem{at, "does not exist"};
+  if (index < 0 || size_t(index) >= accessors.size()) return FieldError{at, "does not exist"};
   const json& acc = accessors[size_t(index)];
   v.accessor = &acc;
-  if (acc.contains("sparse")) return Problem{at + "/sparse", "sparse accessors are not supported"};
+  if (acc.contains("sparse")) return FieldError{at + "/sparse", "sparse accessors are not supported"};
   uint64_t componentType = 0, count = 0, bvIndex = 0, buffer = 0, stride = 0, bvOffset = 0, bvLength = 0, accOffset = 0;
   constexpr uint64_t kAny = SIZE_MAX / 4;  // sums of two stay representable
   if (auto p = unsignedMember(acc, "componentType", at + "/componentType", 0, 0xFFFF, componentType)) return p;
   v.componentType = int(componentType);
   v.components = componentCount(acc.contains("type") && acc["type"].is_string() ? acc["type"].get<std::string>() : "");
   int cs = componentSize(v.componentType);
-  if (!cs || !v.components) return Problem{at, "has an unknown componentType or type"};
+  if (!cs || !v.components) return FieldError{at, "has an unknown componentType or type"};
   if (auto p = unsignedMember(acc, "count", at + "/count", 0, kAny, count)) return p;
   v.count = size_t(count);
   v.elementSize = size_t(cs) * size_t(v.components);
@@ -72,14 +75,14 @@ std::optional<Problem> view(const Asset& a, int index, View& v) {
   }
   if (auto p = unsignedValue(acc["bufferView"], at + "/bufferView", kAny, bvIndex)) return p;
   const json& views = member(a.gltf, "bufferViews");
-  if (bvIndex >= views.size()) return Problem{at + "/bufferView", "does not exist"};
+  if (bvIndex >= views.size()) return FieldError{at + "/bufferView", "does not exist"};
   const json& bv = views[size_t(bvIndex)];
   const std::string bvAt = "/bufferViews/" + std::to_string(bvIndex);
   if (auto p = unsignedMember(bv, "buffer", bvAt + "/buffer", 0, kAny, buffer)) return p;
-  if (buffer != 0) return Problem{bvAt + "/buffer", "only the GLB binary chunk (buffer 0) is supported"};
+  if (buffer != 0) return FieldError{bvAt + "/buffer", "only the GLB binary chunk (buffer 0) is supported"};
   const json& buffers = member(a.gltf, "buffers");
   if (buffers.empty() || buffers[0].contains("uri"))
-    return Problem{"/buffers/0", "must be the GLB binary chunk (no uri)"};
+    return FieldError{"/buffers/0", "must be the GLB binary chunk (no uri)"};
   if (auto p = unsignedMember(bv, "byteStride", bvAt + "/byteStride", 0, 252, stride)) return p;
   if (auto p = unsignedMember(bv, "byteOffset", bvAt + "/byteOffset", 0, kAny, bvOffset)) return p;
   if (auto p = unsignedMember(bv, "byteLength", bvAt + "/byteLength", 0, kAny, bvLength)) return p;
@@ -87,21 +90,45 @@ std::optional<Problem> view(const Asset& a, int index, View& v) {
   v.stride = stride == 0 ? v.elementSize : size_t(stride);
   v.offset = size_t(bvOffset + accOffset);
   size_t bvEnd = size_t(bvOffset + bvLength);
-  if (v.stride < v.elementSize) return Problem{bvAt + "/byteStride", "is smaller than an element"};
+  if (v.stride < v.elementSize) return FieldError{bvAt + "/byteStride", "is smaller than an element"};
   if (v.count > 0 && (v.count - 1 > (SIZE_MAX - v.elementSize - v.offset) / v.stride ||
                       v.offset + (v.count - 1) * v.stride + v.elementSize > std::min(bvEnd, a.bin.size())))
-    return Problem{at, "reaches past the end of its bufferView or of the binary chunk"};
+    return FieldError{at, "reaches past the end of its bufferView or of the binary chunk"};
   return std::nullopt;
 }
 
 double component(const char* p, int type, bool normalized) {
   switch (type) {
-    case 5120: { int8_t x; std::memcpy(&x, p, 1); return normalized ? std::max(x / 127.0, -1.0) : x; }
-    case 5121: { uint8_t x; std::memcpy(&x, p, 1); return normalized ? x / 255.0 : x; }
-    case 5122: { int16_t x; std::memcpy(&x, p, 2); return normalized ? std::max(x / 32767.0, -1.0) : x; }
-    case 5123: { uint16_t x; std::memcpy(&x, p, 2); return normalized ? x / 65535.0 : x; }
-    case 5125: { uint32_t x; std::memcpy(&x, p, 4); return x; }
-    default: { float x; std::memcpy(&x, p, 4); return x; }
+    case 5120: {
+      int8_t x;
+      std::memcpy(&x, p, 1);
+      return normalized ? std::max(x / 127.0, -1.0) : x;
+    }
+    case 5121: {
+      uint8_t x;
+      std::memcpy(&x, p, 1);
+      return normalized ? x / 255.0 : x;
+    }
+    case 5122: {
+      int16_t x;
+      std::memcpy(&x, p, 2);
+      return normalized ? std::max(x / 32767.0, -1.0) : x;
+    }
+    case 5123: {
+      uint16_t x;
+      std::memcpy(&x, p, 2);
+      return normalized ? x / 65535.0 : x;
+    }
+    case 5125: {
+      uint32_t x;
+      std::memcpy(&x, p, 4);
+      return x;
+    }
+    default: {
+      float x;
+      std::memcpy(&x, p, 4);
+      return x;
+    }
   }
 }
 
@@ -128,15 +155,15 @@ int pushAccessor(Asset& a, json accessor) {
 
 }  // namespace
 
-std::optional<Problem> unsignedValue(const json& value, const std::string& pointer, uint64_t max, uint64_t& out) {
+std::optional<FieldError> unsignedValue(const json& value, const std::string& pointer, uint64_t max, uint64_t& out) {
   if (!value.is_number_unsigned() || value.get<uint64_t>() > max)
-    return Problem{pointer, "must be an integer from 0 to " + std::to_string(max)};
+    return FieldError{pointer, "must be an integer from 0 to " + std::to_string(max)};
   out = value.get<uint64_t>();
   return std::nullopt;
 }
 
-std::optional<Problem> unsignedMember(const json& object, const char* key, const std::string& pointer,
-                                      uint64_t fallback, uint64_t max, uint64_t& out) {
+std::optional<FieldError> unsignedMember(const json& object, const char* key, const std::string& pointer,
+                                         uint64_t fallback, uint64_t max, uint64_t& out) {
   auto it = object.find(key);
   if (it == object.end()) {
     out = fallback;
@@ -145,35 +172,39 @@ std::optional<Problem> unsignedMember(const json& object, const char* key, const
   return unsignedValue(*it, pointer, max, out);
 }
 
-std::optional<Problem> parse(const std::string& b, Asset& out) {
-  if (b.size() < 20 || u32(b, 0) != kMagic) return Problem{"", "is not a binary glTF (magic 'glTF' missing)"};
-  if (u32(b, 4) != 2) return Problem{"", "must be glTF version 2"};
-  if (u32(b, 8) != b.size()) return Problem{"", "header length " + std::to_string(u32(b, 8)) + " does not match the body (" + std::to_string(b.size()) + " bytes)"};
+std::optional<FieldError> parse(const std::string& b, Asset& out) {
+  if (b.size() < 20 || u32(b, 0) != kMagic) return FieldError{"", "is not a binary glTF (magic 'glTF' missing)"};
+  if (u32(b, 4) != 2) return FieldError{"", "must be glTF version 2"};
+  if (u32(b, 8) != b.size())
+    return FieldError{"", "header length " + std::to_string(u32(b, 8)) + " does not match the body (" +
+                              std::to_string(b.size()) + " bytes)"};
   size_t at = 12;
   bool haveJson = false;
   while (at + 8 <= b.size()) {
     size_t len = u32(b, at), type = u32(b, at + 4);
-    if (len > b.size() - at - 8) return Problem{"", "a chunk runs past the end of the body"};
+    if (len > b.size() - at - 8) return FieldError{"", "a chunk runs past the end of the body"};
     std::string data = b.substr(at + 8, len);
     if (!haveJson) {
-      if (type != kJson) return Problem{"", "the first chunk must be JSON"};
+      if (type != kJson) return FieldError{"", "the first chunk must be JSON"};
       out.gltf = json::parse(data, nullptr, false);
-      if (out.gltf.is_discarded() || !out.gltf.is_object()) return Problem{"", "the JSON chunk is not a JSON object"};
+      if (out.gltf.is_discarded() || !out.gltf.is_object())
+        return FieldError{"", "the JSON chunk is not a JSON object"};
       haveJson = true;
     } else if (type == kBin) {
       out.bin = std::move(data);
     }
     at += 8 + len;
   }
-  if (!haveJson) return Problem{"", "has no JSON chunk"};
+  if (!haveJson) return FieldError{"", "has no JSON chunk"};
   if (!out.gltf.contains("asset") || !out.gltf["asset"].is_object() || out.gltf["asset"].value("version", "") != "2.0")
-    return Problem{"/asset/version", "must be \"2.0\""};
+    return FieldError{"/asset/version", "must be \"2.0\""};
   // Trust nothing structural: the arrays we index must be arrays of objects.
   for (const char* key : {"accessors", "bufferViews", "buffers", "meshes"}) {
     if (!out.gltf.contains(key)) continue;
-    if (!out.gltf[key].is_array()) return Problem{std::string("/") + key, "must be an array"};
+    if (!out.gltf[key].is_array()) return FieldError{std::string("/") + key, "must be an array"};
     for (size_t i = 0; i < out.gltf[key].size(); ++i)
-      if (!out.gltf[key][i].is_object()) return Problem{std::string("/") + key + "/" + std::to_string(i), "must be an object"};
+      if (!out.gltf[key][i].is_object())
+        return FieldError{std::string("/") + key + "/" + std::to_string(i), "must be an object"};
   }
   return std::nullopt;
 }
@@ -203,13 +234,13 @@ std::string serialize(const Asset& a) {
   return out;
 }
 
-std::optional<Problem> readFloats(const Asset& a, int index, int components, std::vector<float>& out) {
+std::optional<FieldError> readFloats(const Asset& a, int index, int components, std::vector<float>& out) {
   View v;
   if (auto p = view(a, index, v)) return p;
   std::string at = "/accessors/" + std::to_string(index);
-  if (v.components != components) return Problem{at + "/type", std::string("must be ") + typeName(components)};
+  if (v.components != components) return FieldError{at + "/type", std::string("must be ") + typeName(components)};
   bool normalized = v.accessor->value("normalized", false);
-  if (v.componentType != 5126 && !normalized) return Problem{at + "/componentType", "must be FLOAT or normalized"};
+  if (v.componentType != 5126 && !normalized) return FieldError{at + "/componentType", "must be FLOAT or normalized"};
   out.assign(v.count * size_t(components), 0.0f);
   if (v.zeros) return std::nullopt;
   int cs = componentSize(v.componentType);
@@ -220,12 +251,12 @@ std::optional<Problem> readFloats(const Asset& a, int index, int components, std
   return std::nullopt;
 }
 
-std::optional<Problem> readIndices(const Asset& a, int index, std::vector<uint32_t>& out) {
+std::optional<FieldError> readIndices(const Asset& a, int index, std::vector<uint32_t>& out) {
   View v;
   if (auto p = view(a, index, v)) return p;
   std::string at = "/accessors/" + std::to_string(index);
   if (v.components != 1 || (v.componentType != 5121 && v.componentType != 5123 && v.componentType != 5125))
-    return Problem{at, "indices must be SCALAR unsigned byte, short or int"};
+    return FieldError{at, "indices must be SCALAR unsigned byte, short or int"};
   out.assign(v.count, 0);
   if (v.zeros) return std::nullopt;
   for (size_t k = 0; k < v.count; ++k)
@@ -236,7 +267,9 @@ std::optional<Problem> readIndices(const Asset& a, int index, std::vector<uint32
 int addFloatAccessor(Asset& a, const std::vector<float>& data, int components, bool vertexAttribute) {
   std::string bytes(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
   size_t bv = appendBin(a, bytes, vertexAttribute ? 34962 : 0, 0);
-  return pushAccessor(a, {{"bufferView", bv}, {"componentType", 5126}, {"count", data.size() / size_t(components)},
+  return pushAccessor(a, {{"bufferView", bv},
+                          {"componentType", 5126},
+                          {"count", data.size() / size_t(components)},
                           {"type", typeName(components)}});
 }
 
@@ -257,13 +290,14 @@ int addIndexAccessor(Asset& a, const std::vector<uint32_t>& indices) {
   return pushAccessor(a, {{"bufferView", bv}, {"componentType", type}, {"count", indices.size()}, {"type", "SCALAR"}});
 }
 
-std::optional<Problem> addRemappedAccessor(Asset& a, int index, const std::vector<uint32_t>& remap, int& newIndex) {
+std::optional<FieldError> addRemappedAccessor(Asset& a, int index, const std::vector<uint32_t>& remap, int& newIndex) {
   View v;
   if (auto p = view(a, index, v)) return p;
   const size_t row = (v.elementSize + 3) / 4 * 4;  // vertex attributes stay 4-byte aligned
   std::string bytes(remap.size() * row, '\0');
   for (size_t k = 0; k < remap.size(); ++k) {
-    if (remap[k] >= v.count) return Problem{"/accessors/" + std::to_string(index) + "/count", "is smaller than the vertex count"};
+    if (remap[k] >= v.count)
+      return FieldError{"/accessors/" + std::to_string(index) + "/count", "is smaller than the vertex count"};
     if (!v.zeros) std::memcpy(bytes.data() + k * row, a.bin.data() + v.offset + remap[k] * v.stride, v.elementSize);
   }
   size_t bv = appendBin(a, bytes, 34962, row != v.elementSize ? row : 0);

@@ -11,37 +11,40 @@
 
 #include <nlohmann/json.hpp>
 
+#include "field_error.h"
+
 namespace effectd::glb {
+
+using effectd::FieldError;
 
 struct Asset {
   nlohmann::json gltf;
   std::string bin;  // buffer 0's bytes (the BIN chunk), possibly empty
 };
 
-// Problems carry a JSON pointer into the glTF document ("" = the container itself).
-struct Problem {
-  std::string pointer, message;
-};
+// Problems are FieldErrors with a JSON pointer into the glTF document ("" = the container).
 
-std::optional<Problem> parse(const std::string& bytes, Asset& out);
+std::optional<FieldError> parse(const std::string& bytes, Asset& out);
 
 // A glTF index, count or offset: a JSON integer in [0, max]. Anything else (a float such as
-// 5e26, a negative number, a string) is a Problem at `pointer` — never a silent conversion.
-std::optional<Problem> unsignedValue(const nlohmann::json& value, const std::string& pointer, uint64_t max, uint64_t& out);
+// 5e26, a negative number, a string) is a FieldError at `pointer` — never a silent conversion.
+std::optional<FieldError> unsignedValue(const nlohmann::json& value, const std::string& pointer, uint64_t max,
+                                        uint64_t& out);
 // The same for `object[key]`, `fallback` when the key is absent.
-std::optional<Problem> unsignedMember(const nlohmann::json& object, const char* key, const std::string& pointer,
-                                      uint64_t fallback, uint64_t max, uint64_t& out);
+std::optional<FieldError> unsignedMember(const nlohmann::json& object, const char* key, const std::string& pointer,
+                                         uint64_t fallback, uint64_t max, uint64_t& out);
 std::string serialize(const Asset& asset);
 
 // Accessor `index` as floats, `components` per element (normalized integers scaled to [0, 1]
 // or [-1, 1] as the spec has it). Fails for sparse accessors, other buffers, out-of-range views.
-std::optional<Problem> readFloats(const Asset& asset, int index, int components, std::vector<float>& out);
-std::optional<Problem> readIndices(const Asset& asset, int index, std::vector<uint32_t>& out);
+std::optional<FieldError> readFloats(const Asset& asset, int index, int components, std::vector<float>& out);
+std::optional<FieldError> readIndices(const Asset& asset, int index, std::vector<uint32_t>& out);
 
 // New accessors over data appended to the BIN chunk (tightly packed, 4-byte aligned rows).
 int addFloatAccessor(Asset& asset, const std::vector<float>& data, int components, bool vertexAttribute);
 int addIndexAccessor(Asset& asset, const std::vector<uint32_t>& indices);
 // A copy of accessor `index` with element k = original element remap[k] (any type).
-std::optional<Problem> addRemappedAccessor(Asset& asset, int index, const std::vector<uint32_t>& remap, int& newIndex);
+std::optional<FieldError> addRemappedAccessor(Asset& asset, int index, const std::vector<uint32_t>& remap,
+                                              int& newIndex);
 
 }  // namespace effectd::glb

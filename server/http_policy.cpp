@@ -4,10 +4,10 @@
 // metrics and the access log; the admission and cache gauges on /metrics.
 #include <httplib.h>
 
+#include <malloc.h>
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
-#include <malloc.h>
 
 #include "access_log.h"
 #include "encoding.h"
@@ -47,87 +47,7 @@ std::string Service::allowedOrigin(const std::string& origin) const {
 void Service::installHttpPolicy() {
   httplib::Server& s = *http_;
   s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    tl = RequestState{};
-    tl.active = true;
-    tl.start = std::chrono::steady_clock::now();
-    metrics_.requestStarted();
-    std::string given = req.get_header_value("X-Request-ID");
-    tl.requestId = saneRequestId(given) ? given : newRequestId();
-    res.set_header("X-Request-ID", tl.requestId);
-    // effectd negotiates the coding itself (encoding.h): cpp-httplib must not see the header.
-    tl.acceptEncoding = req.get_header_value("Accept-Encoding");
-    const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
-    tl.corsOrigin = allowedOrigin(req.get_header_value("Origin"));
-
-    const Route* route = findRoute(req.path);
-    if (!route && req.path.rfind("/v1/schemas/", 0) == 0) route = findRoute("/v1/schemas/");
-    auto fail = [&](const ApiError& p) {
-      writeProblem(res, p, tl.requestId);
-      return httplib::Server::HandlerResponse::Handled;
-    };
-    if (!route) return fail({404, "not-found", "Not Found", "no resource at " + req.path, {}, {}});
-    tl.route = route->path;
-    bool allowed = false;
-    std::string allow;
-    for (const auto& m : route->methods) {
-      allowed = allowed || m == req.method;
-      allow += (allow.empty() ? "" : ", ") + m;
-    }
-    if (req.method == "OPTIONS") {  // RFC 9110 9.3.7, and the CORS preflight
-      res.status = 204;
-      res.set_header("Allow", allow + ", OPTIONS");
-      if (!tl.corsOrigin.empty()) {
-        res.set_header("Access-Control-Allow-Methods", allow);
-        res.set_header("Access-Control-Allow-Headers", kAllowedRequestHeaders);
-        res.set_header("Access-Control-Max-Age", "600");
-      }
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (!allowed) {
-      return fail({405, "method-not-allowed", "Method Not Allowed",
-                   req.method + " is not allowed on " + route->path + "; allowed: " + allow, {}, {{"Allow", allow}}});
-    }
-    if (req.method != "POST") return httplib::Server::HandlerResponse::Unhandled;
-
-    // Bodies must come with a Content-Length: chunked bodies bypass the payload limit in
-    // cpp-httplib 0.11.4 (CVE-2025-46728), so they are refused before anything is read.
-    if (req.has_header("Transfer-Encoding")) {
-      return fail({411, "length-required", "Length Required",
-                   "chunked request bodies are not accepted; send Content-Length", {}, {{"Connection", "close"}}});
-    }
-    if (!req.has_header("Content-Length")) {
-      return fail({411, "length-required", "Length Required", "a POST needs a Content-Length header", {},
-                   {{"Connection", "close"}}});
-    }
-    const std::string cl = req.get_header_value("Content-Length");
-    char* end = nullptr;
-    unsigned long long length = std::strtoull(cl.c_str(), &end, 10);
-    if (cl.empty() || *end != '\0' || cl[0] == '-') {
-      return fail({400, "bad-request", "Bad Request", "Content-Length is not a number", {}, {{"Connection", "close"}}});
-    }
-    if (length > config_.limits.maxBodyBytes) {
-      return fail({413, "body-too-large", "Content Too Large",
-                   "request body of " + cl + " bytes exceeds the limit of " +
-                       std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
-                   {}, {{"Connection", "close"}}});
-    }
-    std::string type = mediaType(req.get_header_value("Content-Type"));
-    bool typeOk = (type == "application/json" && route->json) || route->binary.count(type);
-    if (!typeOk) {
-      std::string accepted = route->json ? "application/json" : "";
-      for (const auto& [t, h] : route->binary) accepted += (accepted.empty() ? "" : ", ") + t;
-      return fail({415, "unsupported-media-type", "Unsupported Media Type",
-                   "Content-Type '" + type + "' is not accepted here; use " + accepted, {}, {{"Accept-Post", accepted}}});
-    }
-    // The body is read after this handler returns: its memory is reserved before it arrives.
-    try {
-      tl.bodyTicket = admission_->admit(length * (type == "application/json" ? kJsonBodyFactor : kBinaryBodyFactor), false);
-    } catch (const ApiError& e) {
-      ApiError p = e;
-      p.headers["Connection"] = "close";  // the unread body must not be taken for the next request
-      return fail(p);
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
+    return preRoute(req, res) ? httplib::Server::HandlerResponse::Handled : httplib::Server::HandlerResponse::Unhandled;
   });
 
   s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
@@ -136,8 +56,13 @@ void Service::installHttpPolicy() {
     if (tl.requestId.empty()) tl.requestId = newRequestId();
     std::string detail = statusTitle(res.status);
     if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
-    writeProblem(res, {res.status, res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
-                       statusTitle(res.status), detail, {}, {}},
+    writeProblem(res,
+                 {res.status,
+                  res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
+                  statusTitle(res.status),
+                  detail,
+                  {},
+                  {}},
                  tl.requestId);
     return httplib::Server::HandlerResponse::Handled;
   }));
@@ -150,51 +75,16 @@ void Service::installHttpPolicy() {
       what = e.what();
     } catch (...) {
     }
-    std::fprintf(stderr, "{\"level\":\"error\",\"msg\":\"unhandled exception\",\"path\":%s,\"requestId\":%s,\"what\":%s}\n",
+    std::fprintf(stderr,
+                 "{\"level\":\"error\",\"msg\":\"unhandled exception\",\"path\":%s,\"requestId\":%s,\"what\":%s}\n",
                  jsonEscape(req.path).c_str(), jsonEscape(tl.requestId).c_str(), jsonEscape(what).c_str());
     writeProblem(res, {500, "internal", "Internal Server Error", "the server failed to handle the request", {}, {}},
                  tl.requestId);
   });
 
-  s.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
-    if (!res.has_header("X-Request-ID")) res.set_header("X-Request-ID", tl.requestId);
-    if (!tl.corsOrigin.empty()) {
-      res.set_header("Access-Control-Allow-Origin", tl.corsOrigin);
-      res.set_header("Access-Control-Expose-Headers", kExposedHeaders);
-    }
-    const std::string type = res.get_header_value("Content-Type");
-    std::string vary = tl.encoded || compressible(type) ? "Accept-Encoding" : "";
-    if (!config_.corsOrigins.empty() && config_.corsOrigins != std::vector<std::string>{"*"})
-      vary += vary.empty() ? "Origin" : ", Origin";
-    if (!vary.empty()) res.set_header("Vary", vary);
-    // Answers without an ETag (contract documents, metrics, problems) are encoded here.
-    if (!tl.encoded && res.body.size() >= kMinCompressBytes && compressible(type) && !res.has_header("Content-Range")) {
-      Coding coding = negotiate(tl.acceptEncoding);
-      if (coding != Coding::kIdentity) {
-        res.body = encode(coding, res.body);
-        res.set_header("Content-Encoding", codingName(coding));
-        res.headers.erase("Content-Length");  // cpp-httplib set it before this handler runs
-        res.set_header("Content-Length", std::to_string(res.body.size()));
-      }
-    }
-  });
+  s.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) { postRoute(res); });
 
-  s.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
-    if (!tl.active) {  // rejected before routing (e.g. unparsable request line)
-      metrics_.requestStarted();
-      tl.start = std::chrono::steady_clock::now();
-      tl.route = "unmatched";
-    }
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tl.start).count();
-    metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
-    if (config_.accessLog) writeAccessLog(req, res, tl.requestId, seconds);
-    const bool large = tl.bodyTicket.bytes() + tl.workTicket.bytes() >= kTrimAfterBytes;
-    tl = RequestState{};  // releases the reservations: the answer has been written
-    // glibc keeps freed heap pages in its per-thread arenas; after a large request, hand
-    // them back now rather than holding the burst's peak for good.
-    if (large) malloc_trim(0);
-  });
-
+  s.set_logger([this](const httplib::Request& req, const httplib::Response& res) { finishRequest(req, res); });
 
   addReadinessCheck("admission", [this] {
     return admission_->queueFull() ? std::string("admission queue full (--admission-queue)") : std::string();
@@ -206,12 +96,14 @@ void Service::installHttpPolicy() {
     auto metric = [&](const char* name, const char* type, const char* help, double value) {
       char number[32];
       std::snprintf(number, sizeof number, "%.17g", value);
-      out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type + "\neffectd_" +
-             name + " " + number + "\n";
+      out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type +
+             "\neffectd_" + name + " " + number + "\n";
     };
-    metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.", double(a.budgetBytes));
+    metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.",
+           double(a.budgetBytes));
     metric("memory_reserved_bytes", "gauge", "Bytes reserved by requests being served.", double(a.reservedBytes));
-    metric("memory_reserved_peak_bytes", "gauge", "Most bytes reserved at once since start.", double(a.peakReservedBytes));
+    metric("memory_reserved_peak_bytes", "gauge", "Most bytes reserved at once since start.",
+           double(a.peakReservedBytes));
     metric("heavy_running", "gauge", "Heavy computations running.", a.heavyRunning);
     metric("admission_waiting", "gauge", "Requests waiting for memory or a heavy slot.", a.waiting);
     metric("admission_waits_total", "counter", "Requests that had to wait before admission.", double(a.waited));
@@ -226,6 +118,153 @@ void Service::installHttpPolicy() {
     metric("response_cache_bytes", "gauge", "Bytes held by the response cache.", double(c.bytes));
     return out;
   });
+}
+
+// Before routing: the request's state, then every rule that can refuse it before its body is
+// read. True when the response is final (a problem, an OPTIONS answer).
+bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
+  tl = RequestState{};
+  tl.active = true;
+  tl.start = std::chrono::steady_clock::now();
+  metrics_.requestStarted();
+  std::string given = req.get_header_value("X-Request-ID");
+  tl.requestId = saneRequestId(given) ? given : newRequestId();
+  res.set_header("X-Request-ID", tl.requestId);
+  // effectd negotiates the coding itself (encoding.h): cpp-httplib must not see the header.
+  tl.acceptEncoding = req.get_header_value("Accept-Encoding");
+  const_cast<httplib::Request&>(req).headers.erase("Accept-Encoding");
+  tl.corsOrigin = allowedOrigin(req.get_header_value("Origin"));
+
+  const Route* route = findRoute(req.path);
+  if (!route && req.path.rfind("/v1/schemas/", 0) == 0) route = findRoute("/v1/schemas/");
+  auto fail = [&](const ApiError& p) {
+    writeProblem(res, p, tl.requestId);
+    return true;
+  };
+  if (!route) return fail({404, "not-found", "Not Found", "no resource at " + req.path, {}, {}});
+  tl.route = route->path;
+  bool allowed = false;
+  std::string allow;
+  for (const auto& m : route->methods) {
+    allowed = allowed || m == req.method;
+    allow += (allow.empty() ? "" : ", ") + m;
+  }
+  if (req.method == "OPTIONS") {  // RFC 9110 9.3.7, and the CORS preflight
+    res.status = 204;
+    res.set_header("Allow", allow + ", OPTIONS");
+    if (!tl.corsOrigin.empty()) {
+      res.set_header("Access-Control-Allow-Methods", allow);
+      res.set_header("Access-Control-Allow-Headers", kAllowedRequestHeaders);
+      res.set_header("Access-Control-Max-Age", "600");
+    }
+    return true;
+  }
+  if (!allowed) {
+    return fail({405,
+                 "method-not-allowed",
+                 "Method Not Allowed",
+                 req.method + " is not allowed on " + route->path + "; allowed: " + allow,
+                 {},
+                 {{"Allow", allow}}});
+  }
+  if (req.method != "POST") return false;
+
+  // Bodies must come with a Content-Length: chunked bodies bypass the payload limit in
+  // cpp-httplib 0.11.4 (CVE-2025-46728), so they are refused before anything is read.
+  if (req.has_header("Transfer-Encoding")) {
+    return fail({411,
+                 "length-required",
+                 "Length Required",
+                 "chunked request bodies are not accepted; send Content-Length",
+                 {},
+                 {{"Connection", "close"}}});
+  }
+  if (!req.has_header("Content-Length")) {
+    return fail({411,
+                 "length-required",
+                 "Length Required",
+                 "a POST needs a Content-Length header",
+                 {},
+                 {{"Connection", "close"}}});
+  }
+  const std::string cl = req.get_header_value("Content-Length");
+  char* end = nullptr;
+  unsigned long long length = std::strtoull(cl.c_str(), &end, 10);
+  if (cl.empty() || *end != '\0' || cl[0] == '-') {
+    return fail({400, "bad-request", "Bad Request", "Content-Length is not a number", {}, {{"Connection", "close"}}});
+  }
+  if (length > config_.limits.maxBodyBytes) {
+    return fail({413,
+                 "body-too-large",
+                 "Content Too Large",
+                 "request body of " + cl + " bytes exceeds the limit of " +
+                     std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
+                 {},
+                 {{"Connection", "close"}}});
+  }
+  std::string type = mediaType(req.get_header_value("Content-Type"));
+  bool typeOk = (type == "application/json" && route->json) || route->binary.count(type);
+  if (!typeOk) {
+    std::string accepted = route->json ? "application/json" : "";
+    for (const auto& [t, h] : route->binary) accepted += (accepted.empty() ? "" : ", ") + t;
+    return fail({415,
+                 "unsupported-media-type",
+                 "Unsupported Media Type",
+                 "Content-Type '" + type + "' is not accepted here; use " + accepted,
+                 {},
+                 {{"Accept-Post", accepted}}});
+  }
+  // The body is read after this handler returns: its memory is reserved before it arrives.
+  try {
+    tl.bodyTicket =
+        admission_->admit(length * (type == "application/json" ? kJsonBodyFactor : kBinaryBodyFactor), false);
+  } catch (const ApiError& e) {
+    ApiError p = e;
+    p.headers["Connection"] = "close";  // the unread body must not be taken for the next request
+    return fail(p);
+  }
+  return false;
+}
+
+// After the handler: request id, CORS, Vary, and coding of answers that are not cached.
+void Service::postRoute(httplib::Response& res) {
+  if (!res.has_header("X-Request-ID")) res.set_header("X-Request-ID", tl.requestId);
+  if (!tl.corsOrigin.empty()) {
+    res.set_header("Access-Control-Allow-Origin", tl.corsOrigin);
+    res.set_header("Access-Control-Expose-Headers", kExposedHeaders);
+  }
+  const std::string type = res.get_header_value("Content-Type");
+  std::string vary = tl.encoded || compressible(type) ? "Accept-Encoding" : "";
+  if (!config_.corsOrigins.empty() && config_.corsOrigins != std::vector<std::string>{"*"})
+    vary += vary.empty() ? "Origin" : ", Origin";
+  if (!vary.empty()) res.set_header("Vary", vary);
+  // Answers without an ETag (contract documents, metrics, problems) are encoded here.
+  if (!tl.encoded && res.body.size() >= kMinCompressBytes && compressible(type) && !res.has_header("Content-Range")) {
+    Coding coding = negotiate(tl.acceptEncoding);
+    if (coding != Coding::kIdentity) {
+      res.body = encode(coding, res.body);
+      res.set_header("Content-Encoding", codingName(coding));
+      res.headers.erase("Content-Length");  // cpp-httplib set it before this handler runs
+      res.set_header("Content-Length", std::to_string(res.body.size()));
+    }
+  }
+}
+
+// After the answer has been written: metrics, the access log, the reservations released.
+void Service::finishRequest(const httplib::Request& req, const httplib::Response& res) {
+  if (!tl.active) {  // rejected before routing (e.g. unparsable request line)
+    metrics_.requestStarted();
+    tl.start = std::chrono::steady_clock::now();
+    tl.route = "unmatched";
+  }
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tl.start).count();
+  metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
+  if (config_.accessLog) writeAccessLog(req, res, tl.requestId, seconds);
+  const bool large = tl.bodyTicket.bytes() + tl.workTicket.bytes() >= kTrimAfterBytes;
+  tl = RequestState{};  // releases the reservations: the answer has been written
+  // glibc keeps freed heap pages in its per-thread arenas; after a large request, hand
+  // them back now rather than holding the burst's peak for good.
+  if (large) malloc_trim(0);
 }
 
 }  // namespace effectd

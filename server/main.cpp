@@ -36,7 +36,8 @@ int renderCommand(std::vector<std::string> args) {
       flags.push_back(args[i]);
   }
   if (scenePath.empty() || outPath.empty()) {
-    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n", stderr);
+    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n",
+               stderr);
     return 2;
   }
   effectd::Config config;
@@ -59,7 +60,8 @@ int renderCommand(std::vector<std::string> args) {
   effectd::Service service(config);  // for its schemas; it never listens
   auto violations = service.schemas().validate("scene.json", body);
   if (!violations.empty()) {
-    for (const auto& v : violations) std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
+    for (const auto& v : violations)
+      std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
     return 2;
   }
   try {

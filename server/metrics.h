@@ -5,18 +5,18 @@
 #include <array>
 #include <atomic>
 #include <functional>
-#include <vector>
 #include <map>
 #include <mutex>
 #include <string>
 #include <tuple>
+#include <vector>
 
 namespace effectd {
 
 class Metrics {
  public:
   static constexpr std::array<double, 14> kBuckets = {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05,
-                                                      0.1,    0.25,  0.5,    1.0,   2.5,  5.0,  10.0};
+                                                      0.1,    0.25,  0.5,    1.0,   2.5,  5.0,   10.0};
   void requestStarted() { inFlight_.fetch_add(1); }
   void requestFinished(const std::string& route, const std::string& method, int status, double seconds);
   // A named counter (e.g. render passes by kind), exported as effectd_<name>_total{label}.

@@ -30,12 +30,8 @@ ApiError toApiError(const effects::Error& error, const std::string& prefix) {
   ApiError e;
   std::string pointer = prefix + error.field;
   switch (error.kind) {
-    case effects::ErrorKind::kInvalidArgument:
-      e = {400, "invalid-field", "Invalid field", "", {}, {}};
-      break;
-    case effects::ErrorKind::kUnsatisfiable:
-      e = {422, "unsatisfiable", "Request cannot be served", "", {}, {}};
-      break;
+    case effects::ErrorKind::kInvalidArgument: e = {400, "invalid-field", "Invalid field", "", {}, {}}; break;
+    case effects::ErrorKind::kUnsatisfiable: e = {422, "unsatisfiable", "Request cannot be served", "", {}, {}}; break;
     case effects::ErrorKind::kLimitExceeded:
       e = {413, "limit-exceeded", "Request exceeds a configured limit", "", {}, {}};
       break;

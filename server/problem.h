@@ -8,18 +8,22 @@
 
 #include "schema.h"
 
-namespace effects { struct Error; }
-namespace httplib { struct Response; }
+namespace effects {
+struct Error;
+}
+namespace httplib {
+struct Response;
+}
 
 namespace effectd {
 
 // An RFC 9457 problem. Thrown by endpoint code; turned into application/problem+json.
 struct ApiError {
   int status = 400;
-  std::string slug;    // problem type, becomes "https://effectd.dev/problems/<slug>"
+  std::string slug;  // problem type, becomes "https://effectd.dev/problems/<slug>"
   std::string title;
   std::string detail;
-  std::vector<SchemaViolation> errors;
+  std::vector<FieldError> errors;
   std::map<std::string, std::string> headers;  // e.g. Retry-After
 };
 

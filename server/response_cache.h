@@ -16,10 +16,10 @@
 namespace effectd {
 
 struct CachedAnswer {
-  std::string etag;          // the representation's strong ETag
+  std::string etag;  // the representation's strong ETag
   std::string contentType;
-  std::string contentEncoding;  // "" = identity
-  std::string body;          // encoded bytes as sent
+  std::string contentEncoding;                 // "" = identity
+  std::string body;                            // encoded bytes as sent
   std::map<std::string, std::string> headers;  // representation headers (X-Effect-Method, ...)
   size_t bytes() const;
 };
@@ -47,15 +47,15 @@ class ResponseCache {
 
  private:
   struct Node {
-    std::string key;  // "t" + etag or "r" + request key
+    std::string key;                             // "t" + etag or "r" + request key
     std::shared_ptr<const CachedAnswer> answer;  // for tag nodes
-    std::string target;  // for alias nodes: the etag
+    std::string target;                          // for alias nodes: the etag
     size_t bytes = 0;
   };
   using List = std::list<Node>;
   std::shared_ptr<const CachedAnswer> find(const std::string& key);  // mu_ held
-  void insert(Node node);  // mu_ held
-  void evict();            // mu_ held
+  void insert(Node node);                                            // mu_ held
+  void evict();                                                      // mu_ held
 
   const size_t maxBytes_;
   mutable std::mutex mu_;

@@ -2,8 +2,8 @@
 // the command line (`effectd render scene.json -o out.png`).
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <render/render.h>
+#include <nlohmann/json.hpp>
 
 #include "config.h"
 #include "service.h"

@@ -13,9 +13,12 @@ std::string pointerEscape(const std::string& key) {
   std::string out;
   out.reserve(key.size());
   for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
+    if (c == '~')
+      out += "~0";
+    else if (c == '/')
+      out += "~1";
+    else
+      out += c;
   }
   return out;
 }
@@ -23,12 +26,12 @@ std::string pointerEscape(const std::string& key) {
 namespace {
 
 const std::set<std::string> kKeywords = {
-    "type", "enum", "const", "properties", "required", "additionalProperties", "items",
-    "minItems", "maxItems", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",
-    "minLength", "maxLength", "oneOf", "anyOf", "allOf", "$ref", "$defs",
+    "type", "enum", "const", "properties", "required", "additionalProperties", "items", "minItems", "maxItems",
+    "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "minLength", "maxLength", "oneOf", "anyOf", "allOf",
+    "$ref", "$defs",
     // annotations
-    "title", "description", "default", "examples", "$schema", "$id", "$comment", "format",
-    "contentEncoding", "contentMediaType", "deprecated", "readOnly", "writeOnly"};
+    "title", "description", "default", "examples", "$schema", "$id", "$comment", "format", "contentEncoding",
+    "contentMediaType", "deprecated", "readOnly", "writeOnly"};
 
 std::string typeOf(const json& v) {
   switch (v.type()) {
@@ -73,7 +76,7 @@ size_t codePoints(const std::string& s) {
 }  // namespace
 
 struct SchemaRegistry::Ctx {
-  std::vector<SchemaViolation> errors;
+  std::vector<FieldError> errors;
   size_t maxErrors;
   int depth = 0;
   bool full() const { return errors.size() >= maxErrors; }
@@ -131,8 +134,8 @@ const json& SchemaRegistry::resolve(const std::string& ref, const std::string& d
   }
 }
 
-std::vector<SchemaViolation> SchemaRegistry::validate(const std::string& name, const json& instance,
-                                                      size_t maxErrors) const {
+std::vector<FieldError> SchemaRegistry::validate(const std::string& name, const json& instance,
+                                                 size_t maxErrors) const {
   Ctx ctx{{}, maxErrors};
   check(document(name), name, instance, "", ctx);
   return ctx.errors;
@@ -150,7 +153,10 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
     --ctx.depth;
     return;
   }
-  struct DepthGuard { int& d; ~DepthGuard() { --d; } } guard{ctx.depth};
+  struct DepthGuard {
+    int& d;
+    ~DepthGuard() { --d; }
+  } guard{ctx.depth};
 
   if (auto it = s.find("$ref"); it != s.end()) {
     std::string target;
@@ -182,18 +188,25 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
   }
   if (v.is_number()) {
     double d = v.get<double>();
-    if (auto it = s.find("minimum"); it != s.end() && d < it->get<double>()) ctx.add(ptr, "must be >= " + fmtNumber(*it));
-    if (auto it = s.find("maximum"); it != s.end() && d > it->get<double>()) ctx.add(ptr, "must be <= " + fmtNumber(*it));
-    if (auto it = s.find("exclusiveMinimum"); it != s.end() && d <= it->get<double>()) ctx.add(ptr, "must be > " + fmtNumber(*it));
-    if (auto it = s.find("exclusiveMaximum"); it != s.end() && d >= it->get<double>()) ctx.add(ptr, "must be < " + fmtNumber(*it));
+    if (auto it = s.find("minimum"); it != s.end() && d < it->get<double>())
+      ctx.add(ptr, "must be >= " + fmtNumber(*it));
+    if (auto it = s.find("maximum"); it != s.end() && d > it->get<double>())
+      ctx.add(ptr, "must be <= " + fmtNumber(*it));
+    if (auto it = s.find("exclusiveMinimum"); it != s.end() && d <= it->get<double>())
+      ctx.add(ptr, "must be > " + fmtNumber(*it));
+    if (auto it = s.find("exclusiveMaximum"); it != s.end() && d >= it->get<double>())
+      ctx.add(ptr, "must be < " + fmtNumber(*it));
   }
   if (v.is_string()) {
     size_t n = codePoints(v.get_ref<const std::string&>());
-    if (auto it = s.find("minLength"); it != s.end() && n < it->get<size_t>()) ctx.add(ptr, "must have at least " + it->dump() + " characters");
-    if (auto it = s.find("maxLength"); it != s.end() && n > it->get<size_t>()) ctx.add(ptr, "must have at most " + it->dump() + " characters");
+    if (auto it = s.find("minLength"); it != s.end() && n < it->get<size_t>())
+      ctx.add(ptr, "must have at least " + it->dump() + " characters");
+    if (auto it = s.find("maxLength"); it != s.end() && n > it->get<size_t>())
+      ctx.add(ptr, "must have at most " + it->dump() + " characters");
   }
   if (v.is_array()) {
-    if (auto it = s.find("minItems"); it != s.end() && v.size() < it->get<size_t>()) ctx.add(ptr, "must have at least " + it->dump() + " items");
+    if (auto it = s.find("minItems"); it != s.end() && v.size() < it->get<size_t>())
+      ctx.add(ptr, "must have at least " + it->dump() + " items");
     if (auto it = s.find("maxItems"); it != s.end() && v.size() > it->get<size_t>()) {
       ctx.add(ptr, "must have at most " + it->dump() + " items");
       return;  // do not walk an oversized array
@@ -216,8 +229,10 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
       if (props && props->contains(key)) {
         check((*props)[key], doc, val, child, ctx);
       } else if (additional != s.end()) {
-        if (additional->is_boolean() && !additional->get<bool>()) ctx.add(child, "is not a known field");
-        else check(*additional, doc, val, child, ctx);
+        if (additional->is_boolean() && !additional->get<bool>())
+          ctx.add(child, "is not a known field");
+        else
+          check(*additional, doc, val, child, ctx);
       }
     }
   }
@@ -225,12 +240,13 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
     auto it = s.find(kw);
     if (it == s.end()) continue;
     size_t matches = 0;
-    std::vector<SchemaViolation> firstErrors;
+    std::vector<FieldError> firstErrors;
     std::vector<std::string> missing;  // branches that fail only for a missing member
     for (const auto& branch : *it) {
       Ctx sub{{}, 4};
       check(branch, doc, v, ptr, sub);
-      if (sub.errors.empty()) ++matches;
+      if (sub.errors.empty())
+        ++matches;
       else if (firstErrors.empty() || sub.errors.front().pointer.size() > firstErrors.front().pointer.size())
         firstErrors = sub.errors;  // the branch that got deepest is the one the client meant
       if (sub.errors.size() == 1 && sub.errors.front().message == "is required" &&

@@ -15,12 +15,9 @@
 
 #include <nlohmann/json.hpp>
 
-namespace effectd {
+#include "field_error.h"
 
-struct SchemaViolation {
-  std::string pointer;  // JSON pointer into the instance, "" for the root
-  std::string message;
-};
+namespace effectd {
 
 class SchemaRegistry {
  public:
@@ -29,8 +26,8 @@ class SchemaRegistry {
   explicit SchemaRegistry(const std::map<std::string, std::string>& documents);
 
   // Validates `instance` against document `name`; returns at most `maxErrors` violations.
-  std::vector<SchemaViolation> validate(const std::string& name, const nlohmann::json& instance,
-                                        size_t maxErrors = 16) const;
+  std::vector<FieldError> validate(const std::string& name, const nlohmann::json& instance,
+                                   size_t maxErrors = 16) const;
 
   const nlohmann::json& document(const std::string& name) const;
 

@@ -16,8 +16,8 @@
 #include "etag.h"
 #include "json_writer.h"
 #include "request_state.h"
-#include "route.h"
 #include "resources.h"
+#include "route.h"
 
 namespace effectd {
 
@@ -30,8 +30,8 @@ constexpr size_t kMaxJsonDepth = 64;
 // still costs memory and time for nothing; the contract is never deeper than a few levels.
 json parseBody(const std::string& body) {
   json::parser_callback_t limit = [](int depth, json::parse_event_t, json&) {
-    if (depth > static_cast<int>(kMaxJsonDepth)) throw ApiError{400, "invalid-json", "Malformed JSON",
-                                                                "JSON nested deeper than 64 levels", {}, {}};
+    if (depth > static_cast<int>(kMaxJsonDepth))
+      throw ApiError{400, "invalid-json", "Malformed JSON", "JSON nested deeper than 64 levels", {}, {}};
     return true;
   };
   try {
@@ -40,9 +40,12 @@ json parseBody(const std::string& body) {
     std::string what = e.what();
     // nlohmann messages look like "[json.exception.parse_error.101] parse error at line 1, ...".
     auto close = what.find("] ");
-    throw ApiError{400, "invalid-json", "Malformed JSON",
+    throw ApiError{400,
+                   "invalid-json",
+                   "Malformed JSON",
                    "request body is not valid JSON: " + (close == std::string::npos ? what : what.substr(close + 2)),
-                   {{"", "not valid JSON"}}, {}};
+                   {{"", "not valid JSON"}},
+                   {}};
   }
 }
 
@@ -51,8 +54,8 @@ json parseBody(const std::string& body) {
 namespace {
 Admission::Options admissionOptions(const Config& c) {
   Admission::Options o;
-  o.budgetBytes = c.memoryBudgetMb ? c.memoryBudgetMb << 20
-                                   : size_t(double(detectMemoryLimit().bytes) * kDefaultBudgetFraction);
+  o.budgetBytes =
+      c.memoryBudgetMb ? c.memoryBudgetMb << 20 : size_t(double(detectMemoryLimit().bytes) * kDefaultBudgetFraction);
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   o.heavySlots = c.heavyThreads > 0 ? c.heavyThreads : std::max(1, cores - 1);
   o.maxWaiting = c.admissionQueue;

@@ -15,14 +15,21 @@
 #include <effects/parallel.h>
 
 #include "admission.h"
-#include "problem.h"
 #include "config.h"
 #include "metrics.h"
+#include "problem.h"
 #include "response_cache.h"
 #include "schema.h"
 
-namespace effects { struct Error; struct Stats; }
-namespace httplib { class Server; struct Request; struct Response; }
+namespace effects {
+struct Error;
+struct Stats;
+}  // namespace effects
+namespace httplib {
+class Server;
+struct Request;
+struct Response;
+}  // namespace httplib
 
 namespace effectd {
 
@@ -89,9 +96,9 @@ class Service {
   // A fact /readyz reports under "info" (e.g. which renderer is in use).
   void addReadinessInfo(const std::string& name, std::function<std::string()> value);
 
-  int bind();        // binds host:port from the config; returns the port, or -1
-  bool run();        // serves until stop(); in-flight requests finish before it returns
-  void stop();       // safe from any thread, also before run() has started serving
+  int bind();   // binds host:port from the config; returns the port, or -1
+  bool run();   // serves until stop(); in-flight requests finish before it returns
+  void stop();  // safe from any thread, also before run() has started serving
   bool waitUntilRunning(std::chrono::milliseconds timeout) const;
 
   const Config& config() const { return config_; }
@@ -104,6 +111,9 @@ class Service {
   struct Route;
   void installCore();
   void installHttpPolicy();
+  bool preRoute(const httplib::Request& req, httplib::Response& res);  // http_policy.cpp
+  void postRoute(httplib::Response& res);
+  void finishRequest(const httplib::Request& req, const httplib::Response& res);
   void handlePost(const Route& route, const httplib::Request& req, httplib::Response& res);
   const Route* findRoute(const std::string& path) const;
   std::string allowedOrigin(const std::string& origin) const;  // "" when not allowed
@@ -115,7 +125,7 @@ class Service {
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
-  int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
+  int listenSocket_ = -1;                         // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
 };

@@ -54,12 +54,14 @@ TEST(BubbleApi, HugeTimeGivesTheReducedPhases) {
 
 TEST(BubbleApi, MeshThinFilmGltfAndMotion) {
   TestServer s;
-  json req = {{"mesh", {{"level", 2}}},
-              {"camera", {0, 0, 4}},
-              {"motion", {{"from", {0, 0, 0}}, {"to", {2, 0, 0}}, {"s", 0.25}}},
-              {"features", {{"iridescence", true}}},
-              {"thinFilm", {{"width", 16}, {"height", 8}, {"wavelengths", 8}, {"thicknessRange", {100, 700}}, {"encoding", "rgba16f"}}},
-              {"include", {"mesh", "thinFilm", "gltf", "uniforms", "stats"}}};
+  json req = {
+      {"mesh", {{"level", 2}}},
+      {"camera", {0, 0, 4}},
+      {"motion", {{"from", {0, 0, 0}}, {"to", {2, 0, 0}}, {"s", 0.25}}},
+      {"features", {{"iridescence", true}}},
+      {"thinFilm",
+       {{"width", 16}, {"height", 8}, {"wavelengths", 8}, {"thicknessRange", {100, 700}}, {"encoding", "rgba16f"}}},
+      {"include", {"mesh", "thinFilm", "gltf", "uniforms", "stats"}}};
   auto r = s.postJson("/v1/bubble", req);
   ASSERT_EQ(r->status, 200) << r->body;
   json j = json::parse(r->body);
@@ -86,7 +88,8 @@ TEST(BubbleApi, BadInputNamesTheField) {
   EXPECT_TRUE(hasPointer(p, "/mesh/level")) << p.dump();
   p = expectProblem(s.postJson("/v1/bubble", json{{"params", {{"n2", 0.5}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/params/n2")) << p.dump();
-  p = expectProblem(s.postJson("/v1/bubble", json{{"thinFilm", {{"thicknessRange", {500, 100}}}}, {"include", {"thinFilm"}}}), 400);
+  p = expectProblem(
+      s.postJson("/v1/bubble", json{{"thinFilm", {{"thicknessRange", {500, 100}}}}, {"include", {"thinFilm"}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/thinFilm/thicknessRange")) << p.dump();
   p = expectProblem(s.postJson("/v1/bubble", json{{"time", 1e300}}), 400);
   EXPECT_TRUE(hasPointer(p, "/time")) << p.dump();

@@ -75,7 +75,9 @@ TEST(FogApi, SmallestTableForAnError) {
 TEST(FogApi, RegionsAndSamples) {
   TestServer s;
   json req = {{"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.01}}},
-              {"regions", {{{"box", {{"min", {10, -5, -5}}, {"max", {20, 5, 5}}}}, {"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.1}}}}}},
+              {"regions",
+               {{{"box", {{"min", {10, -5, -5}}, {"max", {20, 5, 5}}}},
+                 {"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.1}}}}}},
               {"samples", {{"camera", {0, 0, 0}}, {"points", {{5, 0, 0}, {15, 0, 0}}}}},
               {"include", {"samples", "regionTables"}},
               {"table", {{"size", 8}}}};
@@ -102,13 +104,16 @@ TEST(FogApi, StatsOnlyWhenAsked) {
 
 TEST(FogApi, BadFieldsAre400WithPointers) {
   TestServer s;
-  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 5}}}}), 400);
+  auto p =
+      expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 5}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/fog/end")) << p;
-  p = expectProblem(s.postJson("/v1/fog", json{{"fog", json::object()}, {"regions", {{{"fog", json::object()}}}}}), 400);
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", json::object()}, {"regions", {{{"fog", json::object()}}}}}),
+                    400);
   EXPECT_TRUE(hasPointer(p, "/regions/0")) << p;
   p = expectProblem(s.postJson("/v1/fog", json{{"fog", json::object()}, {"include", {"samples"}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/samples")) << p;
-  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"range", {3, 1}}}}}), 400);
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"range", {3, 1}}}}}),
+                    400);
   EXPECT_TRUE(hasPointer(p, "/table/range/1")) << p;
 }
 
@@ -116,7 +121,8 @@ TEST(FogApi, TableOverTheLimitIs413) {
   Config c = TestServer::quietConfig();
   c.limits.maxTableSize = 1000;
   TestServer s(c);
-  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"size", 1001}}}}), 413);
+  auto p =
+      expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"size", 1001}}}}), 413);
   EXPECT_TRUE(hasPointer(p, "/table/size")) << p;
 }
 

@@ -24,7 +24,8 @@ TEST(LightningApi, OnlyWhatIsIncluded) {
   json j = json::parse(r->body);
   EXPECT_EQ(j["method"], "fast");
   ASSERT_TRUE(j.contains("polylines"));
-  for (const char* absent : {"cells", "tree", "stats", "error", "fractalDimension", "guide"}) EXPECT_FALSE(j.contains(absent)) << absent;
+  for (const char* absent : {"cells", "tree", "stats", "error", "fractalDimension", "guide"})
+    EXPECT_FALSE(j.contains(absent)) << absent;
   const json& main = j["polylines"][0];
   EXPECT_EQ(main["channel"], "main");
   EXPECT_EQ(main["points"].size(), 2 * main["step"].size());

@@ -102,7 +102,9 @@ TEST(TangentsApi, BadMeshesNameTheField) {
 // A GLB with one quad primitive: POSITION + TEXCOORD_0, no NORMAL, 16-bit indices.
 std::string quadGlb() {
   glb::Asset a;
-  a.gltf = {{"asset", {{"version", "2.0"}}}, {"buffers", json::array({json::object()})}, {"bufferViews", json::array()},
+  a.gltf = {{"asset", {{"version", "2.0"}}},
+            {"buffers", json::array({json::object()})},
+            {"bufferViews", json::array()},
             {"accessors", json::array()}};
   int pos = glb::addFloatAccessor(a, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, 3, true);
   int uv = glb::addFloatAccessor(a, {0, 1, 1, 1, 1, 0, 0, 0}, 2, true);  // glTF: v down

@@ -120,9 +120,14 @@ TEST(Api, MetricsCountRequestsByRouteAndStatus) {
   EXPECT_EQ(r->status, 200);
   EXPECT_NE(r->get_header_value("Content-Type").find("text/plain"), std::string::npos);
   const std::string& m = r->body;
-  EXPECT_NE(m.find("effectd_http_requests_total{route=\"/healthz\",method=\"GET\",status=\"200\"} 2"), std::string::npos) << m;
-  EXPECT_NE(m.find("effectd_http_requests_total{route=\"unmatched\",method=\"GET\",status=\"404\"} 1"), std::string::npos) << m;
-  EXPECT_NE(m.find("effectd_http_request_duration_seconds_bucket{route=\"/healthz\",le=\"+Inf\"} 2"), std::string::npos) << m;
+  EXPECT_NE(m.find("effectd_http_requests_total{route=\"/healthz\",method=\"GET\",status=\"200\"} 2"),
+            std::string::npos)
+      << m;
+  EXPECT_NE(m.find("effectd_http_requests_total{route=\"unmatched\",method=\"GET\",status=\"404\"} 1"),
+            std::string::npos)
+      << m;
+  EXPECT_NE(m.find("effectd_http_request_duration_seconds_bucket{route=\"/healthz\",le=\"+Inf\"} 2"), std::string::npos)
+      << m;
   EXPECT_NE(m.find("effectd_http_requests_in_flight 1"), std::string::npos) << m;  // this request
 }
 
@@ -167,7 +172,7 @@ TEST(Api, WrongContentTypeIs415) {
   EXPECT_EQ(r->get_header_value("Accept-Post"), "application/json");
 }
 
-TEST(Api, SchemaViolationsNameTheField) {
+TEST(Api, FieldErrorsNameTheField) {
   TestServer s;
   auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "LINEAR"}}}, {"colour", 1}}), 400);
   EXPECT_TRUE(hasPointer(p, "/colour")) << p;
@@ -187,7 +192,8 @@ TEST(Api, SchemaViolationsNameTheField) {
 TEST(Api, UnservableRequestIs422) {
   TestServer s;
   // d_c = 0: the fog never completes, so the default table range does not exist.
-  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0}}}}), 422);
+  auto p = expectProblem(
+      s.postJson("/v1/fog", json{{"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0}}}}), 422);
   EXPECT_TRUE(hasPointer(p, "/table/range")) << p;
 }
 
@@ -208,7 +214,8 @@ TEST(Api, ChunkedOrLengthlessBodiesAre411) {
   std::string out = rawExchange(s.port(), chunked);
   EXPECT_EQ(out.rfind("HTTP/1.1 411", 0), 0u) << out;
   EXPECT_NE(out.find("application/problem+json"), std::string::npos);
-  std::string lengthless = "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nConnection: close\r\n\r\n";
+  std::string lengthless =
+      "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nConnection: close\r\n\r\n";
   out = rawExchange(s.port(), lengthless);
   EXPECT_EQ(out.rfind("HTTP/1.1 411", 0), 0u) << out;
 }
@@ -227,7 +234,8 @@ TEST(Api, RequestIdIsEchoedWhenSaneAndGeneratedOtherwise) {
   auto r = c.Get("/healthz", {{"X-Request-ID", "abc.DEF_123-x"}});
   ASSERT_TRUE(r);
   EXPECT_EQ(r->get_header_value("X-Request-ID"), "abc.DEF_123-x");
-  for (std::string bad : {std::string(129, 'a'), std::string("has space"), std::string("semi;colon"), std::string("")}) {
+  for (std::string bad :
+       {std::string(129, 'a'), std::string("has space"), std::string("semi;colon"), std::string("")}) {
     r = c.Get("/healthz", {{"X-Request-ID", bad}});
     ASSERT_TRUE(r);
     std::string id = r->get_header_value("X-Request-ID");
@@ -248,9 +256,12 @@ TEST(Api, ExceptionsBecome500WithoutInternals) {
   // An endpoint that throws, registered the way real ones are.
   Config c = TestServer::quietConfig();
   Service svc(c);
-  svc.addJsonEndpoint("/v1/fog", "fog.json", [](const json&, const RequestContext&) -> JsonReply {
-    throw std::runtime_error("secret internal detail /etc/passwd");
-  }, [](const json&, const Config&) { return Cost{}; });
+  svc.addJsonEndpoint(
+      "/v1/fog", "fog.json",
+      [](const json&, const RequestContext&) -> JsonReply {
+        throw std::runtime_error("secret internal detail /etc/passwd");
+      },
+      [](const json&, const Config&) { return Cost{}; });
   int port = svc.bind();
   std::thread t([&] { svc.run(); });
   svc.waitUntilRunning(std::chrono::seconds(5));
@@ -287,7 +298,9 @@ TEST(Api, StrongEtagsAndNotModified) {
   // The canonical request decides: key order and spacing do not.
   auto b = s.postJson("/v1/fog", std::string(R"({"table":{"size":8},"fog":{"density":0.1,"fogType":"GL_EXP"}})"));
   EXPECT_EQ(b->get_header_value("ETag"), tag);
-  EXPECT_NE(s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":0.2}})"))->get_header_value("ETag"), tag);
+  EXPECT_NE(
+      s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":0.2}})"))->get_header_value("ETag"),
+      tag);
   // If-None-Match: 304 without a body; other tags, weak forms and lists behave per RFC 9110.
   httplib::Headers h = {{"If-None-Match", tag}};
   auto c = s.client().Post("/v1/fog", h, body, "application/json");

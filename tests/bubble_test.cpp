@@ -1,9 +1,9 @@
 // effects/bubble: seed 000's eqns 3-11 by hand, extreme cases, long times, shader variants
 // (compiled with glslangValidator), thin-film physics.
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 
@@ -51,11 +51,11 @@ TEST(Bubble, InterfaceEqns4And5ByHand) {
 TEST(Bubble, ReflectionRefractionFinalByHand) {
   Params p;
   const dvec3 N(0, 0, 1), I = glm::normalize(dvec3(0.6, 0, -0.8));  // gamma_out = 0.8
-  expectVec(reflection(I, N), {0.6, 0, 0.8});                        // eqn 6
+  expectVec(reflection(I, N), {0.6, 0, 0.8});                       // eqn 6
   const double eta = 1 / 1.33, nuIn = eta * 0.6, gIn = std::sqrt(1 - nuIn * nuIn);
-  dvec3 T = refraction(p, I, N, 1.0);                                // eqn 7, vector form
+  dvec3 T = refraction(p, I, N, 1.0);  // eqn 7, vector form
   expectVec(T, eta * I + (eta * 0.8 - gIn) * N);
-  EXPECT_NEAR(glm::length(T), 1.0, 1e-12);     // a unit refracted ray
+  EXPECT_NEAR(glm::length(T), 1.0, 1e-12);         // a unit refracted ray
   EXPECT_NEAR(T.x / glm::length(T), nuIn, 1e-12);  // Snell: sin(theta_t) = eta sin(theta_i)
   // Eqn 8 at t = 0: mu_top = 1, mu_bottom = 0.1.
   expectVec(finalVector(p, I, N, 0), reflection(I, N) + 0.1 * T);
@@ -221,7 +221,7 @@ TEST(ThinFilm, ZeroThicknessIsThePlainAirInterface) {
   const double quarterWave = 550 / (4 * 1.33);
   EXPECT_NEAR(filmReflectance(1.33, quarterWave, 1.0, 550), 4 * R12 / ((1 + R12) * (1 + R12)), 1e-12);
   EXPECT_NEAR(filmReflectance(1.33, 2 * quarterWave, 1.0, 550), 0.0, 1e-12);  // half wave: dark
-  EXPECT_NEAR(filmReflectance(1.33, 100, 0.0, 550), 1.0, 1e-12);  // grazing: total reflection
+  EXPECT_NEAR(filmReflectance(1.33, 100, 0.0, 550), 1.0, 1e-12);              // grazing: total reflection
 }
 
 // Hue class of a linear sRGB colour.

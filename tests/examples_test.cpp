@@ -3,8 +3,8 @@
 //   proto/examples/invalid/*.json     {endpoint, body | rawBody, expect: {status, pointer}}
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <fstream>
+#include <map>
 
 #include <malloc.h>
 #include <unistd.h>

@@ -30,7 +30,9 @@ TEST(Faults, ClientsThatVanishMidRequestOrMidResponse) {
     // Mid-request: headers promise 1000 bytes, 10 arrive, the client leaves.
     int fd = connectLoopback(s.port());
     ASSERT_GE(fd, 0);
-    sendAll(fd, "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: 1000\r\n\r\n{\"fog\":{\"");
+    sendAll(fd,
+            "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: "
+            "1000\r\n\r\n{\"fog\":{\"");
     ::close(fd);
     // Mid-response: a large answer, of which the client reads a few bytes and leaves.
     fd = connectLoopback(s.port());

@@ -6,24 +6,16 @@
 
 #include <effects/fog.h>
 
+#include "fixtures.h"
+
 namespace effects::fog {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-Fog make(FogType t) {
-  Fog f;
-  f.type = t;
-  f.visibilityRange = 50;
-  f.start = 5;
-  f.end = 40;
-  f.density = 0.05;
-  f.distanceCoefficient = 0.07;
-  f.heightFalloff = 0.2;
-  return f;
-}
+Fog make(FogType t) { return fixtures::fogOf(t); }
 
-const FogType kAll[] = {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear,       FogType::kGlExp,
+const FogType kAll[] = {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear,         FogType::kGlExp,
                         FogType::kGlExp2,    FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight};
 
 TEST(Fog, PaperWorkedExample) {
@@ -34,7 +26,10 @@ TEST(Fog, PaperWorkedExample) {
   f.type = FogType::kDistanceExp2;
   f.distanceCoefficient = 0.07;
   const glm::dvec3 fogC{0.8}, obj{0.7, 0.2, 0.1};
-  auto colour = [&](double z) { double w = factor(f, z); return w * obj + (1 - w) * fogC; };
+  auto colour = [&](double z) {
+    double w = factor(f, z);
+    return w * obj + (1 - w) * fogC;
+  };
   EXPECT_EQ(colour(0), obj);
   for (double z = 8; z <= 9; z += 0.25)
     for (int c = 0; c < 3; ++c) EXPECT_LE(std::lround(std::fabs(colour(z)[c] - 0.8) * 255), 2) << z;
@@ -60,7 +55,7 @@ TEST(Fog, X3dSemantics) {
   EXPECT_DOUBLE_EQ(factor(ex, 25), std::exp(-1.0));
   EXPECT_DOUBLE_EQ(factor(ex, 50), 0.0);
   EXPECT_LT(factor(ex, std::nextafter(50.0, 0.0)), 1e-300);  // dV -> V: no NaN, no inf
-  lin.visibilityRange = ex.visibilityRange = 0;               // 0 = no fog
+  lin.visibilityRange = ex.visibilityRange = 0;              // 0 = no fog
   EXPECT_EQ(factor(lin, 1e30), 1.0);
   EXPECT_EQ(factor(ex, kInf), 1.0);
 }
@@ -82,7 +77,9 @@ TEST(Fog, BoundedAndMonotoneOverRandomParameters) {
   Rng rng(7);
   for (int trial = 0; trial < 2000; ++trial) {
     Fog f = make(kAll[trial % 8]);
-    auto logUniform = [&](double lo, double hi) { return std::exp(std::log(lo) + rng.uniform() * (std::log(hi) - std::log(lo))); };
+    auto logUniform = [&](double lo, double hi) {
+      return std::exp(std::log(lo) + rng.uniform() * (std::log(hi) - std::log(lo)));
+    };
     f.visibilityRange = logUniform(1e-6, 1e6);
     f.start = logUniform(1e-6, 1e3);
     f.end = f.start + logUniform(1e-6, 1e6);

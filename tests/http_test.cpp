@@ -129,7 +129,8 @@ TEST(Http, RepeatsComeFromTheResponseCache) {
   EXPECT_EQ(b->get_header_value("ETag"), a->get_header_value("ETag"));
   EXPECT_EQ(b->get_header_value("X-Effect-Method"), a->get_header_value("X-Effect-Method"));
   // Another spelling of the same request: found by its ETag.
-  auto c = s.postJson("/v1/fog", std::string(R"({ "table": {"size": 64}, "fog": {"density": 0.07, "fogType": "GL_EXP"} })"));
+  auto c =
+      s.postJson("/v1/fog", std::string(R"({ "table": {"size": 64}, "fog": {"density": 0.07, "fogType": "GL_EXP"} })"));
   EXPECT_EQ(c->get_header_value("Server-Timing"), "cache;desc=\"hit\"");
   EXPECT_EQ(c->body, a->body);
   // Timings in the body are never cached.
@@ -171,8 +172,8 @@ TEST(Http, CorsForConfiguredOrigins) {
   EXPECT_EQ(bad->get_header_value("Access-Control-Allow-Origin"), "https://game.example");
   // The preflight.
   auto pre = s.client().Options("/v1/render", {{"Origin", "https://game.example"},
-                                                {"Access-Control-Request-Method", "POST"},
-                                                {"Access-Control-Request-Headers", "content-type"}});
+                                               {"Access-Control-Request-Method", "POST"},
+                                               {"Access-Control-Request-Headers", "content-type"}});
   ASSERT_TRUE(pre);
   EXPECT_EQ(pre->status, 204);
   EXPECT_EQ(pre->get_header_value("Access-Control-Allow-Origin"), "https://game.example");
@@ -194,11 +195,14 @@ TEST(Http, FloatsInTheirShortestForm) {
     EXPECT_EQ(std::strtof(text.c_str(), nullptr), f) << text;
   }
   TestServer s;
-  auto r = s.postJson("/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":0.1,"color":[0.7,0.2,0.1]},"table":{"size":4}})"));
+  auto r = s.postJson(
+      "/v1/fog", std::string(R"({"fog":{"fogType":"GL_EXP","density":0.1,"color":[0.7,0.2,0.1]},"table":{"size":4}})"));
   EXPECT_EQ(r->body.find("0.699999988"), std::string::npos) << r->body;
 }
 
-TEST(Http, HelpNamesTheRenderCommand) { EXPECT_NE(usage().find("effectd render SCENE.json -o OUT.png"), std::string::npos); }
+TEST(Http, HelpNamesTheRenderCommand) {
+  EXPECT_NE(usage().find("effectd render SCENE.json -o OUT.png"), std::string::npos);
+}
 
 }  // namespace
 }  // namespace effectd::testing

@@ -6,18 +6,12 @@
 
 #include <effects/lightning.h>
 
+#include "fixtures.h"
+
 namespace effects::lightning {
 namespace {
 
-Params basic(int n, Method m = Method::kFast, uint64_t seed = 1) {
-  Params p;
-  p.width = p.height = n;
-  p.start = {n / 2, 0};
-  p.targets = {{n / 2, n - 1}};
-  p.method = m;
-  p.seed = seed;
-  return p;
-}
+Params basic(int n, Method m = Method::kFast, uint64_t seed = 1) { return fixtures::lightningLayout(n, m, seed); }
 
 // The bolt is a tree of 8-connected cells, free of obstacles, from start to every target.
 void expectWellFormed(const Params& p, const Bolt& b) {
@@ -63,7 +57,8 @@ TEST(Lightning, Deterministic) {
       EXPECT_EQ(a.value().nodes[i].parent, b.value().nodes[i].parent);
     }
     bool differs = a.value().nodes.size() != c.value().nodes.size();
-    for (size_t i = 0; !differs && i < a.value().nodes.size(); ++i) differs = !(a.value().nodes[i].cell == c.value().nodes[i].cell);
+    for (size_t i = 0; !differs && i < a.value().nodes.size(); ++i)
+      differs = !(a.value().nodes[i].cell == c.value().nodes[i].cell);
     EXPECT_TRUE(differs) << "another seed should give another bolt";
   }
 }
@@ -319,6 +314,30 @@ TEST(Lightning, BoundaryMapMatchesDirectSum) {
       for (int x = 0; x < n; ++x)
         if (obs[size_t(y) * n + x]) add(x, y);
     EXPECT_NEAR(boundaryPotential(n, n, obs, c), direct, 0.02 * direct);
+  }
+}
+
+}  // namespace
+}  // namespace effects::lightning
+
+namespace effects::lightning {
+namespace {
+
+// A bolt that passes its target must turn back (G folds at the attractor): in a tall grid the
+// unfolded 2^G drove it on towards the far wall, millions of steps (found by
+// tests/schema_truth_test.py at the schema's maximum height).
+TEST(Fast, OvershootTurnsBackInATallGrid) {
+  for (uint64_t seed : {1, 7, 42}) {
+    Params p;
+    p.width = 128;
+    p.height = 32767;
+    p.start = {64, 0};
+    p.targets = {{64, 127}};
+    p.seed = seed;
+    p.maxSteps = 2000;
+    auto r = grow(p);
+    ASSERT_TRUE(r.ok()) << "seed " << seed << ": " << r.error().message;
+    for (const Node& n : r.value().nodes) EXPECT_LT(n.cell.y, 400) << "seed " << seed;
   }
 }
 

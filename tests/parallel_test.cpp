@@ -82,7 +82,9 @@ TEST(ThreadPool, TangentsDoNotDependOnTheSplit) {
     auto a = tangents::generate(m, serial), b = tangents::generate(m, split);
     ASSERT_TRUE(a.ok() && b.ok());
     ASSERT_EQ(a.value().tangents.size(), b.value().tangents.size());
-    EXPECT_EQ(std::memcmp(a.value().tangents.data(), b.value().tangents.data(), a.value().tangents.size() * sizeof(glm::vec4)), 0)
+    EXPECT_EQ(std::memcmp(a.value().tangents.data(), b.value().tangents.data(),
+                          a.value().tangents.size() * sizeof(glm::vec4)),
+              0)
         << tangents::toString(mode);
     EXPECT_EQ(a.value().indices, b.value().indices);
     EXPECT_EQ(a.value().stats.error, b.value().stats.error);

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <future>
 
-#include <glm/geometric.hpp>
 #include <render/render.h>
+#include <glm/geometric.hpp>
 
 #include "../render/internal.h"
 #include "codec.h"
@@ -77,9 +77,8 @@ TEST(Render, ExampleScenesMatchTheirGoldenImages) {
 void expectFogMatchesTable(const TestServer& s, const json& fogDef, int elevations, double cameraHeight) {
   const double range = 40;
   const int size = 9;
-  json tableReq = {{"fog", fogDef},
-                   {"table", {{"size", size}, {"range", {0, range}}}},
-                   {"objectColors", {{0.9, 0.6, 0.2}}}};
+  json tableReq = {
+      {"fog", fogDef}, {"table", {{"size", size}, {"range", {0, range}}}}, {"objectColors", {{0.9, 0.6, 0.2}}}};
   if (elevations) {
     tableReq["table"]["elevations"] = elevations;
     tableReq["table"]["cameraHeight"] = cameraHeight;
@@ -122,20 +121,24 @@ void expectFogMatchesTable(const TestServer& s, const json& fogDef, int elevatio
     glm::vec4 got = pixel(img, x, y);
     for (int c = 0; c < 3; ++c) {
       const double want = colors[size_t(row * size + i) * 3 + size_t(c)].get<double>();
-      EXPECT_NEAR(got[c], want, 2.0 / 255) << fogDef.dump() << " distance " << range * i / (size - 1) << " channel " << c;
+      EXPECT_NEAR(got[c], want, 2.0 / 255)
+          << fogDef.dump() << " distance " << range * i / (size - 1) << " channel " << c;
     }
   }
 }
 
 TEST(Render, FogInARenderMatchesTheFogTableColours) {
   TestServer s;
-  expectFogMatchesTable(s, {{"fogType", "DISTANCE_EXP2"}, {"color", {0.5, 0.6, 0.7}}, {"distanceCoefficient", 0.002}}, 0, 0);
+  expectFogMatchesTable(s, {{"fogType", "DISTANCE_EXP2"}, {"color", {0.5, 0.6, 0.7}}, {"distanceCoefficient", 0.002}},
+                        0, 0);
   expectFogMatchesTable(s, {{"fogType", "EXPONENTIAL"}, {"color", {0.2, 0.3, 0.4}}, {"visibilityRange", 60}}, 0, 0);
   expectFogMatchesTable(s, {{"fogType", "GL_LINEAR"}, {"color", {0.8, 0.8, 0.8}}, {"start", 5}, {"end", 35}}, 0, 0);
-  expectFogMatchesTable(s, {{"fogType", "DISTANCE_GAUSSIAN"}, {"color", {0.1, 0.1, 0.1}}, {"distanceCoefficient", 0.001}}, 0, 0);
-  expectFogMatchesTable(s, {{"fogType", "HEIGHT"}, {"color", {0.6, 0.6, 0.7}}, {"density", 0.08}, {"heightFalloff", 0.5},
-                            {"baseHeight", 0}},
-                        3, 1.5);
+  expectFogMatchesTable(
+      s, {{"fogType", "DISTANCE_GAUSSIAN"}, {"color", {0.1, 0.1, 0.1}}, {"distanceCoefficient", 0.001}}, 0, 0);
+  expectFogMatchesTable(
+      s,
+      {{"fogType", "HEIGHT"}, {"color", {0.6, 0.6, 0.7}}, {"density", 0.08}, {"heightFalloff", 0.5}, {"baseHeight", 0}},
+      3, 1.5);
 }
 
 double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
@@ -150,7 +153,8 @@ TEST(Render, LightningBrightPixelsLieAlongThePolyline) {
   json scene = {{"width", W},
                 {"height", H},
                 {"background", {{"color", {0, 0, 0}}}},
-                {"lightning", {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}, {"seed", 5}}},
+                {"lightning",
+                 {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}, {"seed", 5}}},
                 {"lightningStyle", {{"coreWidth", 1.5}, {"glowSigma", 0}}}};
   auto data = s.postJson("/v1/scene", scene);
   ASSERT_TRUE(data);
@@ -195,7 +199,8 @@ TEST(Render, LightningBrightPixelsLieAlongThePolyline) {
   scene["lightningStyle"]["glowSigma"] = 4;
   r = render(s, scene);
   ASSERT_TRUE(r);
-  EXPECT_EQ(r->get_header_value("X-Render-Passes"), "background,lightning,blurHorizontal,blurVertical,lightningComposite");
+  EXPECT_EQ(r->get_header_value("X-Render-Passes"),
+            "background,lightning,blurHorizontal,blurVertical,lightningComposite");
 }
 
 TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
@@ -254,7 +259,9 @@ TEST(Render, SceneReturnsEachPresentEffectAndNothingElse) {
 
 TEST(Render, SixteenBitPngKeepsTheGradient) {
   TestServer s;
-  json scene = {{"width", 8}, {"height", 256}, {"bitDepth", 16},
+  json scene = {{"width", 8},
+                {"height", 256},
+                {"bitDepth", 16},
                 {"background", {{"gradient", {{"top", {1, 1, 1}}, {"bottom", {0, 0, 0}}}}}}};
   auto r = render(s, scene);
   ASSERT_TRUE(r);
@@ -312,7 +319,8 @@ TEST(Render, SaturatedPoolAnswers503WithRetryAfterAndRecovers) {
   c.renderQueue = 0;
   c.responseCacheMb = 0;  // repeats would be answered from the cache, never reaching the pool
   TestServer s(c);
-  json scene = {{"width", 512}, {"height", 512},
+  json scene = {{"width", 512},
+                {"height", 512},
                 {"lightning", {{"grid", {{"width", 64}, {"height", 64}}}, {"start", {32, 0}}, {"targets", {{32, 63}}}}},
                 {"lightningStyle", {{"glowSigma", 20}}}};
   ASSERT_EQ(render(s, scene)->status, 200);  // the context exists before the burst

@@ -20,7 +20,8 @@ using nlohmann::json;
 std::vector<double> errorsOf(const json& section, const std::string& series, const std::string& settingPrefix = "") {
   std::vector<double> out;
   for (const auto& p : section["points"])
-    if (p["series"] == series && p["setting"].get<std::string>().rfind(settingPrefix, 0) == 0) out.push_back(p["error"].get<double>());
+    if (p["series"] == series && p["setting"].get<std::string>().rfind(settingPrefix, 0) == 0)
+      out.push_back(p["error"].get<double>());
   return out;
 }
 
@@ -34,7 +35,8 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
   const fs::path out = fs::temp_directory_path() / ("effectd_report_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const bool plots = std::system("gnuplot --version >/dev/null 2>&1") == 0;
-  const std::string cmd = std::string(EFFECTD_ERROR_REPORT) + " --quick --out " + out.string() + (plots ? "" : " --no-plots") + " 2>/dev/null";
+  const std::string cmd = std::string(EFFECTD_ERROR_REPORT) + " --quick --out " + out.string() +
+                          (plots ? "" : " --no-plots") + " 2>/dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   ASSERT_TRUE(fs::exists(out / "error-vs-time.md"));
   std::ifstream in(out / "error-vs-time.json");
@@ -50,7 +52,8 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
   // DBM: tighter solver tolerance -> closer to the converged distribution.
   expectShrinks(errorsOf(r["lightning-tv"], "dbm-mgpcg 32²"), "dbm TV over tolerance 1e-2, 1e-4, 1e-6");
   // Fog tables: more entries -> smaller interpolation error, for every type.
-  for (const char* type : {"EXPONENTIAL", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2", "DISTANCE_GAUSSIAN", "GL_LINEAR", "HEIGHT"})
+  for (const char* type :
+       {"EXPONENTIAL", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2", "DISTANCE_GAUSSIAN", "GL_LINEAR", "HEIGHT"})
     expectShrinks(errorsOf(r["fog-tables"], type), type);
   // Height fog: more ray-march steps -> closer to the closed form.
   expectShrinks(errorsOf(r["fog-height-march"], "ray marching"), "ray marching");

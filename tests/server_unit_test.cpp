@@ -13,7 +13,8 @@ namespace {
 using nlohmann::json;
 
 SchemaRegistry registry() {
-  return SchemaRegistry({{"a.json", R"({
+  return SchemaRegistry(
+      {{"a.json", R"({
       "type": "object", "additionalProperties": false, "required": ["n"],
       "properties": {
         "n": {"type": "integer", "minimum": 1, "maximum": 10},
@@ -23,13 +24,15 @@ SchemaRegistry registry() {
         "o": {"oneOf": [{"type": "object", "required": ["p"], "additionalProperties": false, "properties": {"p": {"type": "number"}}},
                         {"type": "object", "required": ["q"], "additionalProperties": false, "properties": {"q": {"type": "number"}}}]}
       }})"},
-                         {"b.json", R"({"$defs": {"vec": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}})"}});
+       {"b.json",
+        R"({"$defs": {"vec": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}})"}});
 }
 
 TEST(Schema, AcceptsValidInstances) {
   auto r = registry();
   EXPECT_TRUE(r.validate("a.json", json{{"n", 3}}).empty());
-  EXPECT_TRUE(r.validate("a.json", json{{"n", 3.0}, {"v", {1, 2.5}}, {"e", "y"}, {"s", "\xc3\xa9\xc3\xa9\xc3\xa9"}}).empty());
+  EXPECT_TRUE(
+      r.validate("a.json", json{{"n", 3.0}, {"v", {1, 2.5}}, {"e", "y"}, {"s", "\xc3\xa9\xc3\xa9\xc3\xa9"}}).empty());
   EXPECT_TRUE(r.validate("a.json", json{{"n", 1}, {"o", {{"q", 1}}}}).empty());
 }
 
@@ -58,7 +61,8 @@ TEST(Schema, RefusesKeywordsItDoesNotCheck) {
 }
 
 TEST(Codec, Base64RoundTripAndStrictness) {
-  for (std::string s : std::vector<std::string>{"", "f", "fo", "foo", "foob", "fooba", "foobar", std::string("\0\xff\x10", 3)}) {
+  for (std::string s :
+       std::vector<std::string>{"", "f", "fo", "foo", "foob", "fooba", "foobar", std::string("\0\xff\x10", 3)}) {
     auto d = base64Decode(base64Encode(s));
     ASSERT_TRUE(d);
     EXPECT_EQ(*d, s);

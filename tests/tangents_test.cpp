@@ -1,8 +1,8 @@
 // effects/tangents: the note's per-triangle formulas by hand, MikkTSpace structure (splits,
 // handedness), degenerate and extreme input. Agreement with the reference MikkTSpace itself is
 // tested against the WebAssembly build in tests/mikktspace/ (ctest tangents_mikktspace_oracle).
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <set>
 
@@ -81,8 +81,8 @@ TEST(TriangleFrame, GramSchmidtRemovesTheNormalComponent) {
 }
 
 TEST(TriangleFrame, DegenerateUvsHaveADefinedFrame) {
-  for (auto uvs : {std::array<dvec2, 3>{dvec2(0.5, 0.5), dvec2(0.5, 0.5), dvec2(0.5, 0.5)},   // identical
-                   std::array<dvec2, 3>{dvec2(0, 0), dvec2(1, 1), dvec2(2, 2)}}) {             // collinear
+  for (auto uvs : {std::array<dvec2, 3>{dvec2(0.5, 0.5), dvec2(0.5, 0.5), dvec2(0.5, 0.5)},  // identical
+                   std::array<dvec2, 3>{dvec2(0, 0), dvec2(1, 1), dvec2(2, 2)}}) {           // collinear
     Frame f = frameOf({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, uvs[0], uvs[1], uvs[2], {0, 0, 1});
     EXPECT_TRUE(f.degenerate);
     expectVec(f.tangent, {1, 0, 0});  // MikkTSpace's placeholder, in N's plane
@@ -168,7 +168,8 @@ TEST(Mikk, ExtremeScalesStayFiniteUnitAndOrthogonal) {
     }
   }
   // Same mesh scaled by 1e20 or 1e-20: the same tangents (the method is scale-invariant).
-  auto a = generate(sphere(12, 24, 1.0), {}), b = generate(sphere(12, 24, 1e20), {}), c = generate(sphere(12, 24, 1e-20), {});
+  auto a = generate(sphere(12, 24, 1.0), {}), b = generate(sphere(12, 24, 1e20), {}),
+       c = generate(sphere(12, 24, 1e-20), {});
   ASSERT_EQ(a.value().tangents.size(), b.value().tangents.size());
   ASSERT_EQ(a.value().tangents.size(), c.value().tangents.size());
   for (size_t i = 0; i < a.value().tangents.size(); ++i) {

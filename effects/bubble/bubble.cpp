@@ -44,9 +44,9 @@ Film film(const Params& p, double t) {
 
 Interface interface(const Params& p, double gammaOut) {
   Interface s;
-  s.gammaOut = std::clamp(gammaOut, -1.0, 1.0);            // eqn 4
+  s.gammaOut = std::clamp(gammaOut, -1.0, 1.0);  // eqn 4
   s.nuOut = std::sqrt(std::max(0.0, 1.0 - s.gammaOut * s.gammaOut));
-  s.nuIn = (p.n1 / p.n2) * s.nuOut;                         // eqn 5 (Snell)
+  s.nuIn = (p.n1 / p.n2) * s.nuOut;  // eqn 5 (Snell)
   s.totalInternalReflection = s.nuIn >= 1.0;
   s.gammaIn = s.totalInternalReflection ? 0.0 : std::sqrt(1.0 - s.nuIn * s.nuIn);
   return s;
@@ -105,12 +105,12 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
   Stopwatch watch;
   // Unit icosahedron, then subdivision with shared midpoints.
   const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<dvec3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                          {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<dvec3> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                          {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   for (auto& x : v) x = glm::normalize(x);
-  std::vector<uint32_t> tri = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6,
-                               7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7,
-                               9, 8, 1};
+  std::vector<uint32_t> tri = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+                               4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+                               6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
   for (int l = 0; l < o.level; ++l) {
     std::unordered_map<uint64_t, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {

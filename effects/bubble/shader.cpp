@@ -46,7 +46,8 @@ ShaderSource shader(const Features& f, Glsl version, const std::string& fragment
   if (f.textureFlow) vs << "out vec2 vUv;\n";
   vs << "void main() {\n  vec3 p = aPosition;\n";
   if (f.wobble)  // eqn 11
-    vs << "  p += uWobbleAmplitude * vec3(sin(uWobblePhase + p.x), cos(uWobblePhase + p.y), sin(uWobblePhase + p.z));\n";
+    vs << "  p += uWobbleAmplitude * vec3(sin(uWobblePhase + p.x), cos(uWobblePhase + p.y), sin(uWobblePhase + "
+          "p.z));\n";
   vs << "  vec4 world = uModel * vec4(p, 1.0);\n  vWorld = world.xyz;\n"
         "  vNormal = mat3(uModel) * aNormal;\n";
   if (f.textureFlow) vs << "  vUv = aUv;\n";
@@ -84,10 +85,12 @@ ShaderSource shader(const Features& f, Glsl version, const std::string& fragment
     if (f.refraction)
       fs << "  float nuIn = uEta * sqrt(max(0.0, 1.0 - gammaOut * gammaOut));  // eqn 5\n"
             "  if (nuIn < 1.0)  // otherwise total internal reflection: no refracted ray\n"
-            "    finalVector += (uEta * I + (uEta * gammaOut - sqrt(1.0 - nuIn * nuIn)) * N) * uFilmBottom;  // eqn 7\n";
+            "    finalVector += (uEta * I + (uEta * gammaOut - sqrt(1.0 - nuIn * nuIn)) * N) * uFilmBottom;  // eqn "
+            "7\n";
     fs << "  color.rgb *= texture(uEnvironment, finalVector).rgb;\n";
   }
-  if (f.textureFlow) fs << "  color.rgb *= texture(uFlowTexture, vUv + vec2(sin(uFlowPhase), cos(uFlowPhase))).rgb;  // eqn 9\n";
+  if (f.textureFlow)
+    fs << "  color.rgb *= texture(uFlowTexture, vUv + vec2(sin(uFlowPhase), cos(uFlowPhase))).rgb;  // eqn 9\n";
   if (f.iridescence) fs << "  color.rgb += texture(uThinFilm, vec2(uThickness, abs(gammaOut))).rgb;\n";
   if (f.rim) fs << "  color.a *= clamp(pow(max(1.0 - gammaOut, 0.0), uRimPower), 0.0, 1.0);  // eqn 10\n";
   fs << fragmentFinish << "  fragColor = color;\n}\n";

@@ -140,8 +140,10 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
   size_t total = 0;
   for (auto it = lru.begin(); it != lru.end();) {
     total += it->bytes();
-    if (total > kBudgetBytes) it = lru.erase(it);
-    else ++it;
+    if (total > kBudgetBytes)
+      it = lru.erase(it);
+    else
+      ++it;
   }
   return map;
 }

@@ -36,18 +36,18 @@ class BoundaryMap {
 
  private:
   struct Level {
-    int w, h;                     // blocks per side
-    std::vector<float> count;     // charges in the block
-    std::vector<float> cx, cy;    // their centroid (domain coordinates)
+    int w, h;                   // blocks per side
+    std::vector<float> count;   // charges in the block
+    std::vector<float> cx, cy;  // their centroid (domain coordinates)
   };
   // Charges of 2x2 cells as a 4-bit mask per block, bit (dx & 1) + 2 (dy & 1).
   uint8_t quad(int qx, int qy) const { return quads_[size_t(qy) * size_t(qw_) + size_t(qx)]; }
   bool charge(int dx, int dy) const { return (quad(dx / 2, dy / 2) >> ((dx & 1) + 2 * (dy & 1))) & 1u; }
   double visit(int level, int bx, int by, double px, double py) const;
-  int dw_, dh_;                   // domain (grid + ring) size
-  int qw_, qh_;                   // 2x2 blocks per side
+  int dw_, dh_;  // domain (grid + ring) size
+  int qw_, qh_;  // 2x2 blocks per side
   std::vector<uint8_t> quads_;
-  std::vector<Level> levels_;     // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2
+  std::vector<Level> levels_;  // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2
 };
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,

@@ -42,10 +42,10 @@ constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 
 struct Candidate {
   Cell cell;
-  int born;      // step at which it last gained a bolt neighbour
+  int born;        // step at which it last gained a bolt neighbour
   int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8
-  int parent;    // node it attaches to if chosen: its newest bolt neighbour
-  double charge; // kCharges: sum over bolt cells of 1/r
+  int parent;      // node it attaches to if chosen: its newest bolt neighbour
+  double charge;   // kCharges: sum over bolt cells of 1/r
 };
 
 class Grower {
@@ -173,9 +173,14 @@ void Grower::logWeights(std::vector<double>& out) {
       }
       for (size_t i = 0; i < cands_.size(); ++i) {
         const Candidate& c = cands_[i];
-        double G = std::floor((c.cell.x - anchor_.x) * ax + (c.cell.y - anchor_.y) * ay);
+        // G counts steps towards the attractor and, past it, back: folded at the attractor's
+        // distance. Unfolded, 2^G kept rewarding cells beyond the target, and a bolt that
+        // overshot in a tall grid ran on to the far wall (128 x 32767: 2 M steps, minutes).
+        const double along = (c.cell.x - anchor_.x) * ax + (c.cell.y - anchor_.y) * ay;
+        double G = std::floor(along <= len ? along : 2 * len - along);
         double P = std::hypot(double(c.cell.x - attractor_.x), double(c.cell.y - attractor_.y));
-        out[i] = G * lnGrowth - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
+        out[i] =
+            G * lnGrowth - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
       }
       break;
     }
@@ -263,8 +268,10 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   double outside = 0;  // probability this method puts outside the reference support (none in practice)
   for (size_t i = 0; i < cands_.size(); ++i) {
     auto it2 = std::lower_bound(cells.begin(), cells.end(), g_.index(cands_[i].cell));
-    if (it2 != cells.end() && *it2 == g_.index(cands_[i].cell)) mine[size_t(it2 - cells.begin())] += p[i];
-    else outside += p[i];
+    if (it2 != cells.end() && *it2 == g_.index(cands_[i].cell))
+      mine[size_t(it2 - cells.begin())] += p[i];
+    else
+      outside += p[i];
   }
   for (size_t k = 0; k < cells.size(); ++k) tv += std::fabs(mine[k] - refPhi[k] / refSum);
   return 0.5 * (tv + outside);
@@ -286,9 +293,10 @@ std::optional<Error> Grower::growSegment(size_t k) {
   Stopwatch guideWatch;
   std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
-  if (path.empty()) return unsatisfiable(field, "target is unreachable from " + std::string(k ? "the previous target" : "start"));
-  const bool useGuide = p_.method != Method::kDbm &&
-                        (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
+  if (path.empty())
+    return unsatisfiable(field, "target is unreachable from " + std::string(k ? "the previous target" : "start"));
+  const bool useGuide =
+      p_.method != Method::kDbm && (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
   std::vector<Cell> waypoints = useGuide ? detail::turningPoints(path) : std::vector<Cell>{target};
   if (useGuide) bolt_.guide.insert(bolt_.guide.end(), waypoints.begin(), waypoints.end());
   size_t wp = 0;
@@ -407,13 +415,13 @@ std::optional<Error> Grower::run() {
 
 Result<Bolt> grow(const Params& params) {
   if (auto e = validate(params)) return *e;
-  if (size_t(params.width) * size_t(params.height) > (size_t(1) << 30))
-    return overLimit("/grid", "grid too large");
+  if (size_t(params.width) * size_t(params.height) > (size_t(1) << 30)) return overLimit("/grid", "grid too large");
   Stopwatch watch;
   Bolt bolt;
   Grower grower(params, bolt);
   if (auto e = grower.run()) return *e;
-  bolt.stats.method = params.method == Method::kDbm ? std::string("dbm-") + toString(params.solver) : toString(params.method);
+  bolt.stats.method =
+      params.method == Method::kDbm ? std::string("dbm-") + toString(params.solver) : toString(params.method);
   bolt.stats.elapsedMs = watch.ms();
   return bolt;
 }

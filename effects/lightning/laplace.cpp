@@ -65,8 +65,9 @@ void Laplace::fix(int x, int y, double value) {
     bvec_[i] = 0;
     unknown_[i] = 0;
     mask_[i] = 0.0;
-    dirty_ = dirty_.empty() ? Box{x, y, x, y}
-                            : Box{std::min(dirty_.x0, x), std::min(dirty_.y0, y), std::max(dirty_.x1, x), std::max(dirty_.y1, y)};
+    dirty_ = dirty_.empty()
+                 ? Box{x, y, x, y}
+                 : Box{std::min(dirty_.x0, x), std::min(dirty_.y0, y), std::max(dirty_.x1, x), std::max(dirty_.y1, y)};
   }
   phi_[i] = value;
   if (delta != 0.0)
@@ -118,8 +119,8 @@ void Laplace::updateCoarse() {
   for (size_t k = 1; k < levels_.size() && !b.empty(); ++k) {
     Level& c = levels_[k];
     // Row J changes when its fine support (2J .. 2J+2) is within one cell of a changed row.
-    Box cb{std::max(0, floorDiv(b.x0 - 2, 2)), std::max(0, floorDiv(b.y0 - 2, 2)), std::min(c.w - 1, floorDiv(b.x1 + 1, 2)),
-           std::min(c.h - 1, floorDiv(b.y1 + 1, 2))};
+    Box cb{std::max(0, floorDiv(b.x0 - 2, 2)), std::max(0, floorDiv(b.y0 - 2, 2)),
+           std::min(c.w - 1, floorDiv(b.x1 + 1, 2)), std::min(c.h - 1, floorDiv(b.y1 + 1, 2))};
     for (int y = cb.y0; y <= cb.y1; ++y)
       for (int x = cb.x0; x <= cb.x1; ++x) galerkinRow(k, x, y);
     b = cb;
@@ -138,7 +139,8 @@ void Laplace::smoothFine(bool forward, bool fromZero) {
     for (int y = 0; y < h_; ++y) {
       const size_t row = size_t(y + 1) * s;
       if (fromZero && pass == 0) {
-        for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x + 1)] = mask_[row + size_t(x + 1)] * 0.25 * r_[row + size_t(x + 1)];
+        for (int x = (y + colour) & 1; x < w_; x += 2)
+          e[row + size_t(x + 1)] = mask_[row + size_t(x + 1)] * 0.25 * r_[row + size_t(x + 1)];
         continue;
       }
       for (int x = (y + colour) & 1; x < w_; x += 2) {
@@ -162,8 +164,10 @@ void Laplace::smoothCoarse(Level& l, bool forward) {
     const double* d = e + i + s;
     double rest = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
     // forward: e[i-1] was just updated, e[i+1] is old; backward the other way round.
-    if (prevOffset == 1) rest -= a[5] * e[i + 1], e[i] = (rest - a[3] * e[i - 1]) * l.invDiag[i];
-    else rest -= a[3] * e[i - 1], e[i] = (rest - a[5] * e[i + 1]) * l.invDiag[i];
+    if (prevOffset == 1)
+      rest -= a[5] * e[i + 1], e[i] = (rest - a[3] * e[i - 1]) * l.invDiag[i];
+    else
+      rest -= a[3] * e[i - 1], e[i] = (rest - a[5] * e[i + 1]) * l.invDiag[i];
   };
   if (forward) {
     for (int y = 0; y < l.h; ++y)
@@ -203,8 +207,8 @@ void Laplace::vcycle(size_t k) {
         const auto& a = l.a[i];
         const double* u = e + i - fs;
         const double* d = e + i + fs;
-        res[i] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) - (a[3] * e[i - 1] + a[4] * e[i] + a[5] * e[i + 1]) -
-                 (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
+        res[i] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) -
+                 (a[3] * e[i - 1] + a[4] * e[i] + a[5] * e[i + 1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
       }
     }
     Level& c = levels_[k + 1];
@@ -231,7 +235,8 @@ void Laplace::vcycle(size_t k) {
       for (size_t j = 0; j < cs; ++j) rowTmp_[j] = odd ? c1[j] : 0.5 * (c0[j] + c1[j]);
       const size_t row = size_t(y + 1) * fs + 1;
       for (int x = 0; x < fw; ++x) {
-        const double v = (x & 1) ? rowTmp_[size_t(x / 2 + 1)] : 0.5 * (rowTmp_[size_t(x / 2)] + rowTmp_[size_t(x / 2 + 1)]);
+        const double v =
+            (x & 1) ? rowTmp_[size_t(x / 2 + 1)] : 0.5 * (rowTmp_[size_t(x / 2)] + rowTmp_[size_t(x / 2 + 1)]);
         e[row + size_t(x)] += m[row + size_t(x)] * v;
       }
     }
@@ -259,8 +264,10 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
   int it = 0;
   const int maxIt = 20 * (w_ + h_) + 1000;  // CG converges in O(sqrt(cond)) ~ O(n) iterations
   if (std::sqrt(rr) > goal) {
-    if (mg) precondition();
-    else z_ = r_;
+    if (mg)
+      precondition();
+    else
+      z_ = r_;
     p_ = z_;
     double rz = 0;
     for (size_t i = 0; i < n; ++i) rz += r_[i] * z_[i];
@@ -282,8 +289,10 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
         ++it;
         break;
       }
-      if (mg) precondition();
-      else z_ = r_;
+      if (mg)
+        precondition();
+      else
+        z_ = r_;
       double rzNew = 0;
       for (size_t i = 0; i < n; ++i) rzNew += r_[i] * z_[i];
       const double beta = rzNew / rz;

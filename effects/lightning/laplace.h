@@ -48,11 +48,11 @@ class Laplace {
 
   int w_, h_, stride_;
   std::vector<double> phi_, bvec_, mask_;  // mask_: 1 on unknowns, 0 on fixed and pad cells
-  std::vector<uint8_t> unknown_;  // padded; the pad is fixed at 0
-  double bb_ = 0;                 // ||b||^2, kept up to date by fix()
+  std::vector<uint8_t> unknown_;           // padded; the pad is fixed at 0
+  double bb_ = 0;                          // ||b||^2, kept up to date by fix()
   std::vector<double> r_, z_, p_, ap_, e0_, rowTmp_;
-  std::vector<Level> levels_;     // levels_[0] is unused: the fine level lives in the members
-  Box dirty_;                     // fine cells fixed since the coarse operators were built
+  std::vector<Level> levels_;  // levels_[0] is unused: the fine level lives in the members
+  Box dirty_;                  // fine cells fixed since the coarse operators were built
 };
 
 }  // namespace effects::lightning::detail

@@ -99,8 +99,7 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height) {
       int ox = (off & 1) ? s / 2 : 0, oy = (off & 2) ? s / 2 : 0;
       if (s == 1 && off) break;
       keys.clear();
-      for (const Cell& c : cells)
-        keys.push_back(uint64_t(uint32_t((c.x + ox) / s)) << 32 | uint32_t((c.y + oy) / s));
+      for (const Cell& c : cells) keys.push_back(uint64_t(uint32_t((c.x + ox) / s)) << 32 | uint32_t((c.y + oy) / s));
       std::sort(keys.begin(), keys.end());
       best = std::min(best, size_t(std::unique(keys.begin(), keys.end()) - keys.begin()));
     }

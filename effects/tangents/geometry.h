@@ -29,12 +29,15 @@ inline dvec3 inPlaneAxis(const dvec3& n) {
 }
 
 // Angle at a corner between the (unnormalised) edges a and b, robust near 0 and pi.
-inline double cornerAngle(const dvec3& a, const dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); }
+inline double cornerAngle(const dvec3& a, const dvec3& b) {
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
 
 inline dvec3 trianglePoint(const Mesh& m, size_t t, int c) { return dvec3(m.positions[m.indices[3 * t + size_t(c)]]); }
 // Unit face normal of triangle t, zero when its area is zero.
 inline dvec3 faceNormal(const Mesh& m, size_t t) {
-  return normalizeOrZero(glm::cross(trianglePoint(m, t, 1) - trianglePoint(m, t, 0), trianglePoint(m, t, 2) - trianglePoint(m, t, 0)));
+  return normalizeOrZero(
+      glm::cross(trianglePoint(m, t, 1) - trianglePoint(m, t, 0), trianglePoint(m, t, 2) - trianglePoint(m, t, 0)));
 }
 
 // Where no frame exists (no UV-valid triangle at the vertex) the reference emits its default

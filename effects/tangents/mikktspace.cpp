@@ -21,7 +21,7 @@ constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not z
 constexpr size_t kGrain = 10000;              // triangles or groups per chunk when split across threads
 
 struct TriInfo {
-  dvec3 os{0}, ot{0};   // unit first-order derivatives, sign-adjusted by orientation
+  dvec3 os{0}, ot{0};  // unit first-order derivatives, sign-adjusted by orientation
   bool orientPreserving = false;
   bool groupWithAny = true;  // UV area or a derivative is zero: joins any group, adds nothing
   bool zeroUvArea = false;
@@ -94,8 +94,8 @@ class Mikk {
       double t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
       dvec3 d1 = v2 - v1, d2 = v3 - v1;
       double area = t21x * t31y - t21y * t31x;  // signed UV area x 2
-      dvec3 os = t31y * d1 - t21y * d2;          // mikktspace.c eq 18
-      dvec3 ot = -t31x * d1 + t21x * d2;         // eq 19
+      dvec3 os = t31y * d1 - t21y * d2;         // mikktspace.c eq 18
+      dvec3 ot = -t31x * d1 + t21x * d2;        // eq 19
       ti.orientPreserving = area > 0;
       if (std::abs(area) > kFloatMin) {
         double lenOs = glm::length(os), lenOt = glm::length(ot), s = ti.orientPreserving ? 1.0 : -1.0;
@@ -216,7 +216,8 @@ class Mikk {
         members.clear();
         for (size_t b = 0; b < k; ++b) {
           bool any = info_[f].groupWithAny || info_[faces[b]].groupWithAny;
-          if (any || a == b || (glm::dot(os[a], os[b]) > -1.0 && glm::dot(ot[a], ot[b]) > -1.0)) members.push_back(faces[b]);
+          if (any || a == b || (glm::dot(os[a], os[b]) > -1.0 && glm::dot(ot[a], ot[b]) > -1.0))
+            members.push_back(faces[b]);
         }
         dvec3 tangent;
         if (members.size() == k) {
@@ -224,7 +225,8 @@ class Mikk {
           tangent = *whole;
         } else {
           std::sort(members.begin(), members.end());
-          auto it = std::find_if(subgroups.begin(), subgroups.end(), [&](const auto& sg) { return sg.first == members; });
+          auto it =
+              std::find_if(subgroups.begin(), subgroups.end(), [&](const auto& sg) { return sg.first == members; });
           if (it == subgroups.end()) {
             std::vector<dvec3> memberOs(members.size());
             for (size_t i = 0; i < members.size(); ++i) memberOs[i] = projected(info_[members[i]].os, n);

@@ -22,8 +22,8 @@ Frame triangleFrame(const dvec3 p[3], const dvec2 uv[3], const dvec3& nIn) {
   dvec3 bRaw = s * (u0 * e1 - u1 * e0);
   dvec3 t = projectToPlane(normalizeOrZero(tRaw), n);
   if (std::abs(det) > 1e-12 * scale && glm::length(t) > 1e-6) {
-    t = glm::normalize(t);                                       // T = normalize(T - (N.T) N)
-    f.w = glm::dot(glm::cross(n, t), bRaw) < 0 ? -1.0f : 1.0f;   // handedness
+    t = glm::normalize(t);                                      // T = normalize(T - (N.T) N)
+    f.w = glm::dot(glm::cross(n, t), bRaw) < 0 ? -1.0f : 1.0f;  // handedness
   } else {
     f.degenerate = true;  // the same default as MikkTSpace's, in N's plane
     glm::vec4 d = fallbackTangent(n);

@@ -19,7 +19,8 @@ CornerTangents perVertex(const Mesh& mesh, const std::vector<dvec3>& normals, Pa
     if (frames[t].degenerate) continue;
     for (int c = 0; c < 3; ++c) {
       dvec3 p = trianglePoint(mesh, t, c);
-      dvec3 a = normalizeOrZero(trianglePoint(mesh, t, (c + 1) % 3) - p), b = normalizeOrZero(trianglePoint(mesh, t, (c + 2) % 3) - p);
+      dvec3 a = normalizeOrZero(trianglePoint(mesh, t, (c + 1) % 3) - p),
+            b = normalizeOrZero(trianglePoint(mesh, t, (c + 2) % 3) - p);
       double angle = cornerAngle(a, b);
       uint32_t v = mesh.indices[3 * t + size_t(c)];
       sum[v] += angle * dvec3(frames[t].tangent);

@@ -48,7 +48,8 @@ double angleDeg(const glm::vec4& a, const glm::vec4& b) {
 std::optional<Error> validate(const Mesh& mesh, const Options& options) {
   const size_t n = mesh.positions.size();
   if (n > options.maxVertices)
-    return overLimit("/positions", std::to_string(n) + " vertices exceed the limit of " + std::to_string(options.maxVertices));
+    return overLimit("/positions",
+                     std::to_string(n) + " vertices exceed the limit of " + std::to_string(options.maxVertices));
   if (mesh.indices.size() % 3 != 0) return invalid("/indices", "must hold three indices per triangle");
   if (mesh.indices.size() / 3 > options.maxTriangles)
     return overLimit("/indices", std::to_string(mesh.indices.size() / 3) + " triangles exceed the limit of " +
@@ -58,7 +59,8 @@ std::optional<Error> validate(const Mesh& mesh, const Options& options) {
     return invalid("/normals", "must be absent or hold one normal per vertex (" + std::to_string(n) + ")");
   auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
   for (size_t i = 0; i < n; ++i) {
-    if (!finite3(mesh.positions[i])) return invalid("/positions/" + std::to_string(i), "vertex " + std::to_string(i) + " is not finite");
+    if (!finite3(mesh.positions[i]))
+      return invalid("/positions/" + std::to_string(i), "vertex " + std::to_string(i) + " is not finite");
     if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y))
       return invalid("/uvs/" + std::to_string(i), "UV " + std::to_string(i) + " is not finite");
     if (!mesh.normals.empty() && !finite3(mesh.normals[i]))
@@ -66,8 +68,8 @@ std::optional<Error> validate(const Mesh& mesh, const Options& options) {
   }
   for (size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= n)
-      return invalid("/indices/" + std::to_string(i),
-                     "index " + std::to_string(mesh.indices[i]) + " is out of range (" + std::to_string(n) + " vertices)");
+      return invalid("/indices/" + std::to_string(i), "index " + std::to_string(mesh.indices[i]) +
+                                                          " is out of range (" + std::to_string(n) + " vertices)");
   return std::nullopt;
 }
 

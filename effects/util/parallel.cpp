@@ -57,7 +57,7 @@ void ThreadPool::forRange(size_t n, size_t grain, const std::function<void(size_
   runChunks(call);
   std::unique_lock<std::mutex> lock(mu_);
   active_.erase(std::find(active_.begin(), active_.end(), &call));  // no new helpers
-  left_.wait(lock, [&] { return call.helpers == 0; });               // running chunks finish
+  left_.wait(lock, [&] { return call.helpers == 0; });              // running chunks finish
 }
 
 void ThreadPool::work() {

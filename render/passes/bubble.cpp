@@ -14,7 +14,8 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   for (int face = 0; face < 6; ++face)
     glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, kEnvironmentSize, kEnvironmentSize, 0, GL_RGBA,
                  GL_HALF_FLOAT, nullptr);
-  auto program = gpu.program("environment:" + std::to_string(int(bg.kind)), screenVertex(), environmentFragment(bg.kind));
+  auto program =
+      gpu.program("environment:" + std::to_string(int(bg.kind)), screenVertex(), environmentFragment(bg.kind));
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
@@ -26,7 +27,8 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, kEnvironmentSize, kEnvironmentSize);
   for (int face = 0; face < 6; ++face) {
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, environment.id, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, environment.id,
+                           0);
     p.set("uFace", face);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
@@ -72,7 +74,8 @@ std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
   Texture flowOwned, thinFilm;
   if (features.textureFlow) gpu.flowTexture(b, flowOwned).bind(1), p.set("uFlowTexture", 1);
   if (features.iridescence) {
-    thinFilm = texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
+    thinFilm =
+        texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
     thinFilm.bind(2), p.set("uThinFilm", 2);
   }
   std::vector<float> data;

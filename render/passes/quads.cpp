@@ -61,13 +61,15 @@ std::optional<Error> quadsPass(Gpu& gpu, FrameState& f) {
   std::vector<float> data;
   for (const Quad& q : scene.quads) {
     glm::dvec3 n = glm::normalize(q.normal), up = q.up - n * glm::dot(q.up, n);
-    if (glm::length(up) < 1e-9) up = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) - n * n.y : glm::dvec3(1, 0, 0) - n * n.x;
+    if (glm::length(up) < 1e-9)
+      up = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) - n * n.y : glm::dvec3(1, 0, 0) - n * n.x;
     up = glm::normalize(up) * (0.5 * q.size.y);
     glm::dvec3 right = glm::normalize(glm::cross(up, n)) * (0.5 * q.size.x);
     const glm::dvec3 corners[6] = {q.center - right - up, q.center + right - up, q.center + right + up,
                                    q.center - right - up, q.center + right + up, q.center - right + up};
     for (const auto& c : corners)
-      data.insert(data.end(), {float(c.x), float(c.y), float(c.z), float(q.color.r), float(q.color.g), float(q.color.b)});
+      data.insert(data.end(),
+                  {float(c.x), float(c.y), float(c.z), float(q.color.r), float(q.color.g), float(q.color.b)});
   }
   auto program = gpu.program("quad" + f.fogKey, quadVertex(), quadFragment(f.fog ? &*f.fog : nullptr));
   if (!program.ok()) return program.error();

@@ -13,9 +13,9 @@
 
 namespace {
 
-using nlohmann::json;
 using effectd::JsonReply;
 using effectd::RequestContext;
+using nlohmann::json;
 
 effectd::Config fuzzConfig() {
   effectd::Config c;

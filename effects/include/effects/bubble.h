@@ -3,7 +3,7 @@
 //
 // Source: seed 000 (soap bubble shader with Snell's law; eqns 3-11, constants of its results
 // section), the Airy formula for a thin film, CIE 1931 colour matching. Digest:
-// shared/design/effects.md section 3.
+// docs/effects.md section 3.
 //
 // Vectors: I = incident direction (camera -> surface, unit), N = unit outward normal,
 // V = -I. gamma_out = N.V (eqn 4). Eqn 7 is printed with scalars; effectd implements the
@@ -31,12 +31,12 @@
 namespace effects::bubble {
 
 struct Params {
-  double n1 = 1.0;            // outside (air)
-  double n2 = 1.33;           // film (water)
-  double deltaSpeed = 2.0;    // wobble angular speed, rad/s (eqn 11)
-  double betaSpeed = 0.4;     // texture-flow angular speed, rad/s (eqn 9)
-  double rimPower = 2.8;      // eqn 10
-  double muSpeed = 0.05;      // film drains: alpha = saturate(muSpeed t) (eqn 3), 1/s
+  double n1 = 1.0;               // outside (air)
+  double n2 = 1.33;              // film (water)
+  double deltaSpeed = 2.0;       // wobble angular speed, rad/s (eqn 11)
+  double betaSpeed = 0.4;        // texture-flow angular speed, rad/s (eqn 9)
+  double rimPower = 2.8;         // eqn 10
+  double muSpeed = 0.05;         // film drains: alpha = saturate(muSpeed t) (eqn 3), 1/s
   double wobbleAmplitude = 1.0;  // eqn 11's sin() term is scaled by this (paper: 1)
 };
 // Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; amplitude [0, 1e6].
@@ -55,7 +55,7 @@ struct Interface {
 };
 Interface interface(const Params& p, double gammaOut);
 
-glm::dvec3 reflection(const glm::dvec3& I, const glm::dvec3& N);                        // eqn 6
+glm::dvec3 reflection(const glm::dvec3& I, const glm::dvec3& N);                                  // eqn 6
 glm::dvec3 refraction(const Params& p, const glm::dvec3& I, const glm::dvec3& N, double bottom);  // eqn 7
 // Eqn 8: R mu_top + T. I and N need not be unit (they are normalised; zero -> +z / -z).
 glm::dvec3 finalVector(const Params& p, const glm::dvec3& I, const glm::dvec3& N, double t);
@@ -63,23 +63,23 @@ double rim(const Params& p, double gammaOut);  // eqn 10, in [0, 1]
 
 // omega t mod 2 pi in [0, 2 pi), computed in long double.
 double reducedPhase(double omega, double t);
-glm::dvec2 flowOffset(const Params& p, double t);               // eqn 9: (sin bt, cos bt)
-glm::dvec3 wobble(const Params& p, const glm::dvec3& x, double t);  // eqn 11
+glm::dvec2 flowOffset(const Params& p, double t);                                // eqn 9: (sin bt, cos bt)
+glm::dvec3 wobble(const Params& p, const glm::dvec3& x, double t);               // eqn 11
 glm::dvec3 moveTowards(const glm::dvec3& from, const glm::dvec3& to, double s);  // lerp, s clamped to [0, 1]
 
 // ---- mesh -----------------------------------------------------------------------------------
 struct MeshOptions {
-  int level = 3;          // icosphere subdivisions: 20 * 4^level triangles
+  int level = 3;  // icosphere subdivisions: 20 * 4^level triangles
   int maxLevel = 7;
   double radius = 1.0;
-  double t = 0.0;         // time for the wobble
+  double t = 0.0;  // time for the wobble
   bool wobble = true;
   std::optional<glm::dvec3> camera;  // when set: per-vertex final vectors and rim
   Parallel* parallel = nullptr;      // for the tangent frames; null = this thread only
 };
 struct Mesh {
   std::vector<glm::vec3> positions, normals;
-  std::vector<glm::vec2> uvs;  // equirectangular; seam triangles run past u = 1 (REPEAT), own copies
+  std::vector<glm::vec2> uvs;       // equirectangular; seam triangles run past u = 1 (REPEAT), own copies
   std::vector<glm::vec4> tangents;  // MikkTSpace
   std::vector<uint32_t> indices;
   std::vector<glm::vec3> finalVectors;  // when camera given
@@ -113,9 +113,9 @@ glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavele
 struct ThinFilmOptions {
   double ior = 1.33;
   double thicknessMinNm = 0, thicknessMaxNm = 1000;
-  int width = 256;   // thickness samples (u)
-  int height = 256;  // cos(theta) samples (v), from 0 (row 0) to 1
-  int wavelengths = 16;  // [3, 400]
+  int width = 256;           // thickness samples (u)
+  int height = 256;          // cos(theta) samples (v), from 0 (row 0) to 1
+  int wavelengths = 16;      // [3, 400]
   bool measureError = true;  // Delta E*ab against the 1 nm reference on a sub-grid
 };
 struct ThinFilmTable {

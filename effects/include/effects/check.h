@@ -27,16 +27,15 @@ std::string operands(const A& a, const B& b) {
 
 }  // namespace effects::detail
 
-#define EFFECTS_CHECK(x) \
-  ((x) ? (void)0 : ::effects::detail::checkFailed(__FILE__, __LINE__, #x, std::string()))
+#define EFFECTS_CHECK(x) ((x) ? (void)0 : ::effects::detail::checkFailed(__FILE__, __LINE__, #x, std::string()))
 
-#define EFFECTS_CHECK_OP(a, op, b)                                                            \
-  do {                                                                                       \
-    const auto& checkA_ = (a);                                                               \
-    const auto& checkB_ = (b);                                                               \
-    if (!(checkA_ op checkB_))                                                               \
-      ::effects::detail::checkFailed(__FILE__, __LINE__, #a " " #op " " #b,                  \
-                                     ::effects::detail::operands(checkA_, checkB_));         \
+#define EFFECTS_CHECK_OP(a, op, b)                                                   \
+  do {                                                                               \
+    const auto& checkA_ = (a);                                                       \
+    const auto& checkB_ = (b);                                                       \
+    if (!(checkA_ op checkB_))                                                       \
+      ::effects::detail::checkFailed(__FILE__, __LINE__, #a " " #op " " #b,          \
+                                     ::effects::detail::operands(checkA_, checkB_)); \
   } while (false)
 
 #define CHECK(x) EFFECTS_CHECK(x)

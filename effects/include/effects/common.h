@@ -38,7 +38,7 @@ struct Error {
 template <class T>
 class Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
   bool ok() const { return v_.index() == 0; }
   T& value() { return std::get<0>(v_); }
@@ -61,12 +61,12 @@ inline Error overLimit(std::string field, std::string message) {
 
 // What every effect reports about the work it did.
 struct Stats {
-  std::string method;                       // e.g. "fast", "dbm-multigrid", "mikktspace"
-  double elapsedMs = 0.0;                   // wall time of the computation itself
-  std::map<std::string, double> counters;   // steps, candidates, iterations, residual ...
-  std::optional<double> error;              // estimated error against the reference
-  std::string errorMetric;                  // what `error` measures, e.g. "max |f - f_exact|"
-  std::string reference;                    // the reference method the error is measured against
+  std::string method;                      // e.g. "fast", "dbm-multigrid", "mikktspace"
+  double elapsedMs = 0.0;                  // wall time of the computation itself
+  std::map<std::string, double> counters;  // steps, candidates, iterations, residual ...
+  std::optional<double> error;             // estimated error against the reference
+  std::string errorMetric;                 // what `error` measures, e.g. "max |f - f_exact|"
+  std::string reference;                   // the reference method the error is measured against
 };
 
 // Wall-clock stopwatch in milliseconds.

@@ -100,30 +100,31 @@ int regionAt(const std::vector<Region>& regions, const glm::dvec3& point);
 
 // ---- Colour tables ---------------------------------------------------------------------
 struct TableOptions {
-  size_t size = 0;           // distance samples N >= 2; 0 = pick the smallest N meeting maxError
-  double maxError = 0.0;     // used when size == 0: largest acceptable interpolation error
-  size_t maxSize = 65536;    // bound on entries (size * elevations)
+  size_t size = 0;                             // distance samples N >= 2; 0 = pick the smallest N meeting maxError
+  double maxError = 0.0;                       // used when size == 0: largest acceptable interpolation error
+  size_t maxSize = 65536;                      // bound on entries (size * elevations)
   std::optional<double> rangeStart, rangeEnd;  // default [0, completeDistance]
-  size_t elevations = 0;     // kHeight only: samples of the ray's y component over [-1, 1];
-                             // 0 = same as size
-  double cameraHeight = 0.0; // kHeight only
-  bool measureError = true;  // dense-sampling error measurement (costs ~8 evaluations/entry)
+  size_t elevations = 0;                       // kHeight only: samples of the ray's y component over [-1, 1];
+                                               // 0 = same as size
+  double cameraHeight = 0.0;                   // kHeight only
+  bool measureError = true;                    // dense-sampling error measurement (costs ~8 evaluations/entry)
 };
 
 struct Table {
-  size_t width = 0;       // distance samples
-  size_t height = 1;      // elevation samples (1 for distance-only fogs)
+  size_t width = 0;   // distance samples
+  size_t height = 1;  // elevation samples (1 for distance-only fogs)
   double rangeStart = 0.0, rangeEnd = 0.0;
   std::vector<float> factor;  // row-major [elevation][distance]; f at d_i = start + i*(end-start)/(width-1),
                               // dirY_j = -1 + 2j/(height-1)
   double maxError = 0.0;      // max |lerp(table) - f_exact| by dense sampling (if measured)
   double errorAtDistance = 0.0;
-  Stats stats;                // method, elapsedMs (table only), counters: entries, evaluations
+  Stats stats;  // method, elapsedMs (table only), counters: entries, evaluations
 };
 
 Result<Table> buildTable(const Fog& fog, const TableOptions& options);
 
 // Max |interpolated - exact| of `table` by dense sampling (subdivisions per interval).
-double measureTableError(const Fog& fog, const Table& table, double cameraHeight, int subdivisions, double* where = nullptr);
+double measureTableError(const Fog& fog, const Table& table, double cameraHeight, int subdivisions,
+                         double* where = nullptr);
 
 }  // namespace effects::fog

@@ -2,7 +2,7 @@
 //
 // Source: seed 002 (Yun & Yoon, "Physically Inspired Fast Lightning Rendering", KAIST 2016),
 // Niemeyer et al. 1984 (DBM), Kim & Lin 2004 (DBM with CG), Kim, Sewall, Sud & Lin 2007
-// (point charges). Digest: shared/design/effects.md section 1.
+// (point charges). Digest: docs/effects.md section 1.
 //
 // Grid: width x height cells, cell (x, y) covers [x, x+1] x [y, y+1]; x right, y down.
 // 8-neighbourhood. The bolt grows one cell per step from `start`; candidate i is picked with
@@ -53,16 +53,16 @@ struct Params {
   Cell start{64, 0};
   std::vector<Cell> targets{{64, 127}};
   Method method = Method::kFast;
-  double eta = 2.0;               // [0, 50]; seed 002: 2..3 looks like lightning
-  int lifetime = 4;               // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
-  double axisGrowth = 2.0;        // kFast: base of eqn 8's 2^G, in [1, 64]; the paper's 2 gives
-                                  // thinner bolts than DBM, ~1.1 matches DBM's D at eta 2
+  double eta = 2.0;         // [0, 50]; seed 002: 2..3 looks like lightning
+  int lifetime = 4;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
+  double axisGrowth = 2.0;  // kFast: base of eqn 8's 2^G, in [1, 64]; the paper's 2 gives
+                            // thinner bolts than DBM, ~1.1 matches DBM's D at eta 2
   Guide guide = Guide::kAuto;
-  Solver solver = Solver::kMgpcg; // kDbm
-  double tolerance = 1e-6;        // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
+  Solver solver = Solver::kMgpcg;  // kDbm
+  double tolerance = 1e-6;         // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
   uint64_t seed = 1;
-  size_t maxSteps = 2'000'000;    // growth budget (cells added)
-  bool measureError = false;      // per-step TV distance to the converged Laplace distribution
+  size_t maxSteps = 2'000'000;  // growth budget (cells added)
+  bool measureError = false;    // per-step TV distance to the converged Laplace distribution
 };
 
 std::optional<Error> validate(const Params& p);
@@ -74,11 +74,11 @@ struct Node {
 };
 
 struct Bolt {
-  std::vector<Node> nodes;          // in growth order
-  std::vector<int> mainChannel;     // node indices, start -> last target
-  std::vector<Cell> guide;          // waypoints used (empty without a guide)
-  Stats stats;                      // counters: steps, candidatesMax, solverIterations, residual,
-                                    // boundaryMapMs, guideMs ...; error: mean TV (measureError)
+  std::vector<Node> nodes;       // in growth order
+  std::vector<int> mainChannel;  // node indices, start -> last target
+  std::vector<Cell> guide;       // waypoints used (empty without a guide)
+  Stats stats;                   // counters: steps, candidatesMax, solverIterations, residual,
+                                 // boundaryMapMs, guideMs ...; error: mean TV (measureError)
 };
 
 Result<Bolt> grow(const Params& params);
@@ -109,23 +109,23 @@ namespace effects::lightning {
 
 // ---- Shape for renderers (seed 002 section 3.3) -------------------------------------
 struct ShapeParams {
-  double jitter = 1.0;          // [0, 1]: vertices move up to jitter/2 cells from cell centres
-  uint64_t jitterSeed = 1;      // separate from the growth seed: same bolt, other jitter
-  double branchWidth = 1.0;     // main channel = 2 x branch width (Reed & Wyvill)
-  double branchIntensity = 0.6; // branch brightness where it leaves the main channel (main: 1)
-  double branchFalloff = 16.0;  // cells of tree distance over which branch brightness falls by e
+  double jitter = 1.0;           // [0, 1]: vertices move up to jitter/2 cells from cell centres
+  uint64_t jitterSeed = 1;       // separate from the growth seed: same bolt, other jitter
+  double branchWidth = 1.0;      // main channel = 2 x branch width (Reed & Wyvill)
+  double branchIntensity = 0.6;  // branch brightness where it leaves the main channel (main: 1)
+  double branchFalloff = 16.0;   // cells of tree distance over which branch brightness falls by e
 };
 
 struct Vertex {
-  float x = 0, y = 0;     // grid units, jittered inside the cell
-  int step = 0;           // growth step of the cell (animate the leader by step, the return
-                          // stroke along the main channel from the last step back)
-  float intensity = 1.0f; // 1 on the main channel, fading along branches
-  int node = 0;           // index into Bolt::nodes
+  float x = 0, y = 0;      // grid units, jittered inside the cell
+  int step = 0;            // growth step of the cell (animate the leader by step, the return
+                           // stroke along the main channel from the last step back)
+  float intensity = 1.0f;  // 1 on the main channel, fading along branches
+  int node = 0;            // index into Bolt::nodes
 };
 
 struct Polyline {
-  bool main = false;      // channel: main (start -> target) or branch
+  bool main = false;  // channel: main (start -> target) or branch
   float width = 1.0f;
   std::vector<Vertex> vertices;  // a branch starts at the vertex it leaves its parent from
 };

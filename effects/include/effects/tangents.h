@@ -2,7 +2,7 @@
 //
 // Source: seed 004 ("Bump Mapping": per-triangle TBN from the edge / UV-delta system, then
 // Gram-Schmidt), and MikkTSpace (Mikkelsen 2008, the reference implementation mikktspace.c
-// that Blender, Unity, Unreal and glTF use). Digest: shared/design/effects.md section 4.
+// that Blender, Unity, Unreal and glTF use). Digest: docs/effects.md section 4.
 //
 // Modes:
 //   kMikkTSpace   the reference algorithm, step for step: vertices welded on identical
@@ -67,7 +67,7 @@ struct Mesh {
 struct Options {
   Mode mode = Mode::kMikkTSpace;
   NormalRule missingNormals = NormalRule::kSmooth;
-  bool measureError = false;  // kPerTriangle/kPerVertex: angle error against MikkTSpace (runs both)
+  bool measureError = false;    // kPerTriangle/kPerVertex: angle error against MikkTSpace (runs both)
   bool triangleFrames = false;  // also return the per-triangle TBN with the face normal
   size_t maxVertices = 2'000'000, maxTriangles = 4'000'000;
   Parallel* parallel = nullptr;  // where the steps may split their work; null = this thread only
@@ -80,12 +80,12 @@ struct Frame {
 };
 
 struct Output {
-  std::vector<glm::vec4> tangents;  // per output vertex: xyz unit, w = +-1
-  std::vector<glm::vec3> normals;   // per output vertex, unit (given, or computed)
-  std::vector<uint32_t> remap;      // output vertex -> input vertex
-  std::vector<uint32_t> indices;    // the triangles over output vertices
+  std::vector<glm::vec4> tangents;    // per output vertex: xyz unit, w = +-1
+  std::vector<glm::vec3> normals;     // per output vertex, unit (given, or computed)
+  std::vector<uint32_t> remap;        // output vertex -> input vertex
+  std::vector<uint32_t> indices;      // the triangles over output vertices
   std::vector<Frame> triangleFrames;  // when Options::triangleFrames
-  Stats stats;  // counters: triangles, inputVertices, outputVertices, degenerateTriangles,
+  Stats stats;                        // counters: triangles, inputVertices, outputVertices, degenerateTriangles,
                 // zeroUvAreaTriangles, groups; kPerTriangle/kPerVertex + measureError: error = mean angle
                 // (degrees) to MikkTSpace, counters maxAngleDeg, handednessMismatches
 };

@@ -64,9 +64,9 @@ struct Background {
 // different directions, lit through the quad's MikkTSpace TBN frame (seed 004), and an alpha
 // texture: "sunlight under water".
 struct SurfaceWave {
-  double strength = 0.35;   // brightness of the ripple highlights
-  double scale = 3;         // normal-map repeats across the quad
-  double speed = 0.03;      // uv units per second
+  double strength = 0.35;  // brightness of the ripple highlights
+  double scale = 3;        // normal-map repeats across the quad
+  double speed = 0.03;     // uv units per second
   glm::dvec3 lightColor{1.0, 0.97, 0.85};
   glm::dvec3 lightDirection{0.2, 0.6, 1.0};  // in the quad's tangent space, towards the light
 };
@@ -92,8 +92,8 @@ struct Lightning {
   int gridWidth = 0, gridHeight = 0;
   glm::dvec4 rect{0, 0, 1, 1};
   glm::dvec3 color{0.75, 0.85, 1.0};
-  double coreWidth = 1.5;     // pixels per unit of polyline width (main 2, branch 1)
-  double glowSigma = 6;       // Gaussian sigma in pixels; 0 = no glow (no blur pass)
+  double coreWidth = 1.5;  // pixels per unit of polyline width (main 2, branch 1)
+  double glowSigma = 6;    // Gaussian sigma in pixels; 0 = no glow (no blur pass)
   double glowStrength = 1.5;
 };
 
@@ -110,11 +110,11 @@ struct Bubble {
   bubble::Features features;
   bubble::Mesh mesh;
   glm::dvec3 center{0, 0, 0};
-  double time = 0;              // seconds (eqns 3, 9, 11)
+  double time = 0;  // seconds (eqns 3, 9, 11)
   glm::dvec4 baseColor{1, 1, 1, 1};
   std::vector<float> thinFilm;  // iridescence: RGB table (bubble::ThinFilmTable::rgb)
   int thinFilmWidth = 0, thinFilmHeight = 0;
-  Image flowTexture;            // eqn 9's texture; empty = a generated soft swirl
+  Image flowTexture;  // eqn 9's texture; empty = a generated soft swirl
 };
 
 struct Scene {
@@ -169,8 +169,8 @@ Result<Image> decodeImage(const std::string& bytes, size_t maxPixels);
 // A fixed pool of render threads, one Renderer each, fed by a bounded queue.
 struct PoolOptions {
   int threads = 2;
-  int queue = 8;          // waiting jobs beyond the running ones
-  std::string platform;   // as for Renderer::create
+  int queue = 8;         // waiting jobs beyond the running ones
+  std::string platform;  // as for Renderer::create
 };
 
 class RenderPool {

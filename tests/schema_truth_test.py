@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""The contract's defaults and ranges are the server's: for every property of every request
+schema (proto/schemas/*.json) that has one,
+  - "default": the answer without the property equals the answer with it set to the default
+    (so the handler's and the library's defaults are the schema's);
+  - "minimum"/"maximum" (and exclusive bounds nudged inside), every "enum" value: a request
+    with that value is not refused with 400 naming that field (so validate() is no stricter
+    than the schema; 413 and 422 remain possible: server limits, impossible combinations).
+Each property is tried on the first example request of its endpoint (proto/examples/<e>/01-*)
+asking for everything the endpoint can answer ("include": every value), its parent objects
+created when absent. Exceptions, each with its reason, are in ALLOWED.
+
+    tests/schema_truth_test.py build/server/effectd
+"""
+import copy, glob, http.client, json, os, subprocess, sys, time
+
+from answers import scrub
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+BIN = sys.argv[1]
+ENDPOINTS = {"fog.json": "/v1/fog", "lightning.json": "/v1/lightning", "bubble.json": "/v1/bubble",
+             "tangents.json": "/v1/tangents", "scene.json": "/v1/scene"}
+# Include values left out of the "everything" request, and why.
+NOT_INCLUDED = {
+    "fog.json": ["samples"],       # needs a "samples" object the example does not have
+    "lightning.json": ["error"],   # runs the converged Laplace reference: seconds per request
+}
+# (schema, pointer, check) -> why the rule does not hold there.
+ALLOWED = {
+    ("bubble.json", "/thinFilm/thicknessRange", "default"):
+        "the thin-film table's default is [0, 1000] nm as stated; the glTF extension block keeps "
+        "KHR_materials_iridescence's own 100-400 nm unless a range is given (api_bubble.cpp)",
+}
+
+schemas = {os.path.basename(f): json.load(open(f)) for f in glob.glob(os.path.join(ROOT, "proto/schemas/*.json"))}
+failures, checked = [], {"default": 0, "range": 0, "enum": 0}
+
+
+def resolve(node, doc):
+    while isinstance(node, dict) and "$ref" in node:
+        ref = node["$ref"]
+        file, _, frag = ref.partition("#")
+        doc = file or doc
+        target = schemas[doc]
+        for part in frag.strip("/").split("/") if frag else []:
+            target = target[part]
+        rest = {k: v for k, v in node.items() if k != "$ref"}
+        node = {**target, **rest}
+    return node, doc
+
+
+def properties(node, doc, pointer=""):
+    """(pointer, property schema, parent schema) for every property reachable through objects."""
+    node, doc = resolve(node, doc)
+    for key, sub in node.get("properties", {}).items():
+        sub_r, sub_doc = resolve(sub, doc)
+        yield pointer + "/" + key, sub_r, node
+        if sub_r.get("type") == "object" or "properties" in sub_r:
+            yield from properties(sub_r, sub_doc, pointer + "/" + key)
+
+
+class Server:
+    def __init__(self):
+        self.p = subprocess.Popen([BIN, "--port", "0", "--access-log", "0", "--response-cache-mb", "0"],
+                                  stderr=subprocess.PIPE, text=True)
+        self.port = json.loads(self.p.stderr.readline())["port"]
+
+    def post(self, path, body):
+        start = time.monotonic()
+        try:
+            return self._post(path, body)
+        finally:
+            if time.monotonic() - start > 2:
+                print(f"slow: {time.monotonic() - start:.1f} s {path} {json.dumps(body)[:300]}", flush=True)
+
+    def _post(self, path, body):
+        c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=120)
+        c.request("POST", path, body=json.dumps(body), headers={"Content-Type": "application/json"})
+        r = c.getresponse()
+        data = r.read()
+        c.close()
+        return r.status, (json.loads(data) if data[:1] in (b"{", b"[") else data)
+
+
+def with_value(base, pointer, value, remove=False):
+    """base with the property at pointer set (or removed); parents created as {}; None when a
+    parent is not an object (e.g. an array in the example)."""
+    body = copy.deepcopy(base)
+    node = body
+    parts = pointer.strip("/").split("/")
+    for part in parts[:-1]:
+        if not isinstance(node, dict):
+            return None
+        node = node.setdefault(part, {})
+    if not isinstance(node, dict):
+        return None
+    if remove:
+        node.pop(parts[-1], None)
+    else:
+        node[parts[-1]] = value
+    return body
+
+
+def names_field(answer, pointer):
+    if not isinstance(answer, dict):
+        return False
+    return any(e.get("pointer") == pointer for e in answer.get("errors", []))
+
+
+def check(schema, pointer, kind, ok, detail):
+    if (schema, pointer, kind) in ALLOWED:
+        return
+    if not ok:
+        failures.append(f"{schema} {pointer} {kind}: {detail}")
+
+
+def main():
+    server = Server()
+    try:
+        for name, path in ENDPOINTS.items():
+            if len(sys.argv) > 2 and name not in sys.argv[2:]:
+                continue
+            example = sorted(glob.glob(os.path.join(ROOT, "proto/examples", path.split("/")[-1], "01-*.json")))[0]
+            base = json.load(open(example))
+            # Everything the endpoint can answer, so that every default can show in the answer.
+            include, _ = resolve(schemas[name].get("properties", {}).get("include", {}), name)
+            items, _ = resolve(include.get("items", {}), name)
+            if "enum" in items:
+                base["include"] = [v for v in items["enum"] if v not in NOT_INCLUDED.get(name, [])]
+            status, _ = server.post(path, base)
+            if status != 200:
+                failures.append(f"{example}: {status}")
+                continue
+            for pointer, prop, parent in properties(schemas[name], name):
+                if "default" in prop:
+                    without = with_value(base, pointer, None, remove=True)
+                    given = with_value(base, pointer, prop["default"])
+                    if without is not None:
+                        a, b = server.post(path, without), server.post(path, given)
+                        checked["default"] += 1
+                        check(name, pointer, "default", a[0] == b[0] and scrub(a[1]) == scrub(b[1]),
+                              f"absent -> {a[0]}, default {json.dumps(prop['default'])} -> {b[0]}; answers differ")
+                values = []
+                if prop.get("type") in ("number", "integer"):
+                    lo, hi = prop.get("minimum"), prop.get("maximum")
+                    if lo is None and "exclusiveMinimum" in prop:
+                        lo = prop["exclusiveMinimum"] + (1 if prop["type"] == "integer" else 1e-9 * max(1, abs(prop["exclusiveMinimum"])))
+                    if hi is None and "exclusiveMaximum" in prop:
+                        hi = prop["exclusiveMaximum"] - (1 if prop["type"] == "integer" else 1e-9 * max(1, abs(prop["exclusiveMaximum"])))
+                    values += [("range", v) for v in (lo, hi) if v is not None]
+                values += [("enum", v) for v in prop.get("enum", [])]
+                for kind, v in values:
+                    body = with_value(base, pointer, v)
+                    if body is None:
+                        continue
+                    checked[kind] += 1
+                    status, answer = server.post(path, body)
+                    check(name, pointer, f"{kind} {json.dumps(v)}", not (status == 400 and names_field(answer, pointer)),
+                          f"{status} {answer.get('detail') if isinstance(answer, dict) else ''}")
+    finally:
+        server.p.terminate()
+        server.p.wait()
+    print(f"checked {checked['default']} defaults, {checked['range']} bounds, {checked['enum']} enum values")
+    for f in failures:
+        print("FAIL " + f)
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
