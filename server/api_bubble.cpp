@@ -82,6 +82,75 @@ json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std:
   return out;
 }
 
+// The wobbled icosphere with its MikkTSpace frames (and per-vertex final vectors and rim
+// when the body gives a camera) as flat arrays.
+json meshJson(const json& body, const bb::Params& params, const bb::Features& features, double t,
+              const RequestContext& ctx, effects::Stats& stats) {
+  const json m = body.value("mesh", json::object());
+  bb::MeshOptions o;
+  o.level = m.value("level", 3);
+  o.maxLevel = kMaxIcosphereLevel;
+  o.radius = m.value("radius", 1.0);
+  o.t = t;
+  o.wobble = features.wobble;
+  o.parallel = ctx.parallel;
+  if (body.contains("camera")) o.camera = toVec3(body["camera"]);
+  auto r = bb::icosphere(params, o);
+  if (!r.ok()) {
+    effects::Error e = r.error();
+    throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
+  }
+  const bb::Mesh& mesh = r.value();
+  json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
+             {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
+             {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices}};
+  if (o.camera) {
+    mj["finalVectors"] = flat<3>(mesh.finalVectors);
+    mj["rim"] = mesh.rim;
+  }
+  stats = mesh.stats;
+  return mj;
+}
+
+// The physical thin-film table over thickness x cos(theta), as JSON numbers or RGBA16F base64.
+json thinFilmJson(const json& body, const bb::Params& params, const json& tf, const json& range,
+                  const RequestContext& ctx, effects::Stats& stats) {
+  const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config);
+  auto r = bb::thinFilmTable(o);
+  if (!r.ok()) {
+    effects::Error e = r.error();
+    throwError(e, "/thinFilm");
+  }
+  const bb::ThinFilmTable& table = r.value();
+  json j = {{"width", table.width},
+            {"height", table.height},
+            {"axes", "u: thickness from thicknessRange[0] (column 0) to [1] nm; v: cos(theta) from 0 (row 0) to 1"},
+            {"thicknessRange", range},
+            {"wavelengths", o.wavelengths},
+            {"colorSpace", "linear sRGB, D65, reflectance of the film (white-balanced: R = 1 gives 1)"},
+            {"meanDeltaE", table.meanDeltaE},
+            {"maxDeltaE", table.maxDeltaE},
+            {"errorMetric", table.stats.errorMetric},
+            {"reference", table.stats.reference}};
+  if (tf.value("encoding", "json") == "json") {
+    json rgb = json::array();
+    for (float v : table.rgb) rgb.push_back(v);
+    j["rgb"] = std::move(rgb);
+  } else {
+    std::string bytes;
+    for (size_t i = 0; i < table.rgb.size(); i += 3)
+      for (float c : {table.rgb[i], table.rgb[i + 1], table.rgb[i + 2], 1.0f}) {
+        uint16_t h = floatToHalf(c);
+        bytes += char(h & 0xFF);
+        bytes += char(h >> 8);
+      }
+    j["encoding"] = "rgba16f";
+    j["data"] = base64Encode(bytes);
+  }
+  stats = table.stats;
+  return j;
+}
+
 }  // namespace
 
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
@@ -116,70 +185,18 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   }
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
-    const json m = body.value("mesh", json::object());
-    bb::MeshOptions o;
-    o.level = m.value("level", 3);
-    o.maxLevel = kMaxIcosphereLevel;
-    o.radius = m.value("radius", 1.0);
-    o.t = t;
-    o.wobble = features.wobble;
-    o.parallel = ctx.parallel;
-    if (body.contains("camera")) o.camera = toVec3(body["camera"]);
-    auto r = bb::icosphere(params, o);
-    if (!r.ok()) {
-      effects::Error e = r.error();
-      throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
-    }
-    const bb::Mesh& mesh = r.value();
-    json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
-               {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
-               {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices}};
-    if (o.camera) {
-      mj["finalVectors"] = flat<3>(mesh.finalVectors);
-      mj["rim"] = mesh.rim;
-    }
-    out["mesh"] = std::move(mj);
-    reply.computeMs += mesh.stats.elapsedMs;
-    stats.push_back(statsJson(mesh.stats));
+    effects::Stats st;
+    out["mesh"] = meshJson(body, params, features, t, ctx, st);
+    reply.computeMs += st.elapsedMs;
+    stats.push_back(statsJson(st));
   }
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
   if (include.has("thinFilm")) {
-    const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config);
-    auto r = bb::thinFilmTable(o);
-    if (!r.ok()) {
-      effects::Error e = r.error();
-      throwError(e, "/thinFilm");
-    }
-    const bb::ThinFilmTable& table = r.value();
-    json j = {{"width", table.width},
-              {"height", table.height},
-              {"axes", "u: thickness from thicknessRange[0] (column 0) to [1] nm; v: cos(theta) from 0 (row 0) to 1"},
-              {"thicknessRange", range},
-              {"wavelengths", o.wavelengths},
-              {"colorSpace", "linear sRGB, D65, reflectance of the film (white-balanced: R = 1 gives 1)"},
-              {"meanDeltaE", table.meanDeltaE},
-              {"maxDeltaE", table.maxDeltaE},
-              {"errorMetric", table.stats.errorMetric},
-              {"reference", table.stats.reference}};
-    if (tf.value("encoding", "json") == "json") {
-      json rgb = json::array();
-      for (float v : table.rgb) rgb.push_back(v);
-      j["rgb"] = std::move(rgb);
-    } else {
-      std::string bytes;
-      for (size_t i = 0; i < table.rgb.size(); i += 3)
-        for (float c : {table.rgb[i], table.rgb[i + 1], table.rgb[i + 2], 1.0f}) {
-          uint16_t h = floatToHalf(c);
-          bytes += char(h & 0xFF);
-          bytes += char(h >> 8);
-        }
-      j["encoding"] = "rgba16f";
-      j["data"] = base64Encode(bytes);
-    }
-    out["thinFilm"] = std::move(j);
-    reply.computeMs += table.stats.elapsedMs;
-    stats.push_back(statsJson(table.stats));
+    effects::Stats st;
+    out["thinFilm"] = thinFilmJson(body, params, tf, range, ctx, st);
+    reply.computeMs += st.elapsedMs;
+    stats.push_back(statsJson(st));
   }
   if (include.has("gltf")) {
     // glTF's default range is 100-400 nm; a request's thicknessRange overrides it.

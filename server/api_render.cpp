@@ -74,6 +74,142 @@ void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
   if (v.x == 0 && v.y == 0 && v.z == 0) throw fieldError(400, pointer, "must not be the zero vector");
 }
 
+void parseCamera(const json& body, rd::Scene& s) {
+  const json cam = body.value("camera", json::object());
+  if (cam.contains("position")) s.camera.position = toVec3(cam["position"]);
+  if (cam.contains("target")) s.camera.target = toVec3(cam["target"]);
+  if (cam.contains("up")) s.camera.up = toVec3(cam["up"]);
+  s.camera.fovYDeg = cam.value("fovY", s.camera.fovYDeg);
+  s.camera.nearPlane = cam.value("near", s.camera.nearPlane);
+  s.camera.farPlane = cam.value("far", s.camera.farPlane);
+  const glm::dvec3 forward = s.camera.target - s.camera.position;
+  if (glm::length(forward) < 1e-12) throw fieldError(400, "/camera/target", "must differ from the camera position");
+  if (!(glm::length(glm::cross(forward, s.camera.up)) > 1e-12 * glm::length(forward) * glm::length(s.camera.up)))
+    throw fieldError(400, "/camera/up", "must not be parallel to the view direction (or zero)");
+  if (!(s.camera.farPlane > s.camera.nearPlane)) throw fieldError(400, "/camera/far", "must be greater than near");
+}
+
+void parseBackground(const json& b, const Config& config, rd::Scene& s) {
+  if (b.contains("color")) s.background.color = rgba(b["color"]);
+  if (b.contains("gradient")) {
+    s.background.kind = rd::Background::Kind::kGradient;
+    s.background.top = rgba(b["gradient"]["top"]);
+    s.background.bottom = rgba(b["gradient"]["bottom"]);
+  }
+  if (b.contains("image")) {
+    s.background.kind = rd::Background::Kind::kImage;
+    s.background.image = image(b["image"], "/background/image", config);
+  }
+}
+
+rd::SurfaceWave parseSurfaceWave(const json& w) {
+  rd::SurfaceWave wave;
+  wave.strength = w.value("strength", wave.strength);
+  wave.scale = w.value("scale", wave.scale);
+  wave.speed = w.value("speed", wave.speed);
+  if (w.contains("lightColor")) wave.lightColor = toVec3(w["lightColor"]);
+  if (w.contains("lightDirection")) wave.lightDirection = toVec3(w["lightDirection"]);
+  requireNonZero(wave.lightDirection, "/surfaceWave/lightDirection");
+  return wave;
+}
+
+void parseQuads(const json& quads, rd::Scene& s) {
+  for (size_t i = 0; i < quads.size(); ++i) {
+    const json& q = quads[i];
+    rd::Quad quad;
+    quad.center = toVec3(q["center"]);
+    if (q.contains("normal")) quad.normal = toVec3(q["normal"]);
+    if (q.contains("up")) quad.up = toVec3(q["up"]);
+    requireNonZero(quad.normal, "/quads/" + std::to_string(i) + "/normal");
+    quad.size = {q["size"][0].get<double>(), q["size"][1].get<double>()};
+    if (q.contains("color")) quad.color = toVec3(q["color"]);
+    s.quads.push_back(quad);
+  }
+}
+
+// Problems from the effect parsers name fields under the scene's "/fog".
+rd::Fog parseSceneFog(const json& f) {
+  return within("/fog", [&] {
+    rd::Fog fog;
+    fog.global = parseFog(f["fog"], "/fog");
+    if (f.contains("regions")) {
+      if (f["regions"].size() > rd::kMaxFogRegions)
+        throw fieldError(422, "/regions",
+                         "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
+      for (size_t i = 0; i < f["regions"].size(); ++i)
+        fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
+    }
+    return fog;
+  });
+}
+
+// The bolt grown by the lightning endpoint's own parser and method, in the scene's style.
+rd::Lightning sceneLightning(const json& body, const Config& config) {
+  rd::Lightning l = within("/lightning", [&] {
+    LightningRequest r = parseLightning(body["lightning"], config);
+    const effects::lightning::Bolt bolt = growBolt(r.params);
+    rd::Lightning grown;
+    grown.polylines = effects::lightning::polylines(bolt, r.shape);
+    grown.gridWidth = r.params.width;
+    grown.gridHeight = r.params.height;
+    return grown;
+  });
+  const json st = body.value("lightningStyle", json::object());
+  if (st.contains("rect")) {
+    const json& r = st["rect"];
+    l.rect = {r[0].get<double>(), r[1].get<double>(), r[2].get<double>(), r[3].get<double>()};
+  }
+  if (st.contains("color")) l.color = toVec3(st["color"]);
+  l.coreWidth = st.value("coreWidth", l.coreWidth);
+  l.glowSigma = st.value("glowSigma", l.glowSigma);
+  l.glowStrength = st.value("glowStrength", l.glowStrength);
+  return l;
+}
+
+// The bubble: its mesh and thin-film table computed once here, wobbled by the shader.
+rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double sceneTime) {
+  const Config& config = ctx.config;
+  rd::Bubble b;
+  const json& bj = body["bubble"];
+  const double t = bj.value("time", sceneTime);
+  within("/bubble", [&] {
+    b.params = parseBubbleParams(bj.value("params", json::object()));
+    b.features = parseBubbleFeatures(bj.value("features", json::object()));
+    bb::MeshOptions o;
+    const json m = bj.value("mesh", json::object());
+    o.level = m.value("level", 4);
+    o.maxLevel = 7;
+    o.radius = m.value("radius", 1.0);
+    o.wobble = false;  // the vertex shader wobbles (eqn 11)
+    o.parallel = ctx.parallel;
+    auto mesh = bb::icosphere(b.params, o);
+    if (!mesh.ok()) {
+      effects::Error e = mesh.error();
+      throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
+    }
+    b.mesh = std::move(mesh.value());
+    if (b.features.iridescence) {
+      bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config);
+      tf.measureError = false;
+      auto table = cachedThinFilm(tf);
+      b.thinFilm = table->rgb;
+      b.thinFilmWidth = table->width;
+      b.thinFilmHeight = table->height;
+    }
+    if (bj.contains("motion")) {
+      const json& mo = bj["motion"];
+      b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
+    }
+    return 0;
+  });
+  const json st = body.value("bubbleStyle", json::object());
+  if (st.contains("center") && !bj.contains("motion")) b.center = toVec3(st["center"]);
+  if (st.contains("baseColor")) b.baseColor = rgba(st["baseColor"]);
+  if (st.contains("flowTexture")) b.flowTexture = image(st["flowTexture"], "/bubbleStyle/flowTexture", config);
+  b.time = t;
+  return b;
+}
+
 }  // namespace
 
 rd::Scene buildScene(const json& body, const RequestContext& ctx, double* computeMs) {
@@ -88,137 +224,15 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
                          std::to_string(config.limits.maxRenderPixels) + " pixels (--max-render-pixels)");
   s.bitDepth = body.value("bitDepth", 8);
   s.time = body.value("time", 0.0);
-
-  const json cam = body.value("camera", json::object());
-  if (cam.contains("position")) s.camera.position = toVec3(cam["position"]);
-  if (cam.contains("target")) s.camera.target = toVec3(cam["target"]);
-  if (cam.contains("up")) s.camera.up = toVec3(cam["up"]);
-  s.camera.fovYDeg = cam.value("fovY", s.camera.fovYDeg);
-  s.camera.nearPlane = cam.value("near", s.camera.nearPlane);
-  s.camera.farPlane = cam.value("far", s.camera.farPlane);
-  const glm::dvec3 forward = s.camera.target - s.camera.position;
-  if (glm::length(forward) < 1e-12) throw fieldError(400, "/camera/target", "must differ from the camera position");
-  if (!(glm::length(glm::cross(forward, s.camera.up)) > 1e-12 * glm::length(forward) * glm::length(s.camera.up)))
-    throw fieldError(400, "/camera/up", "must not be parallel to the view direction (or zero)");
-  if (!(s.camera.farPlane > s.camera.nearPlane)) throw fieldError(400, "/camera/far", "must be greater than near");
-
-  if (body.contains("background")) {
-    const json& b = body["background"];
-    if (b.contains("color")) s.background.color = rgba(b["color"]);
-    if (b.contains("gradient")) {
-      s.background.kind = rd::Background::Kind::kGradient;
-      s.background.top = rgba(b["gradient"]["top"]);
-      s.background.bottom = rgba(b["gradient"]["bottom"]);
-    }
-    if (b.contains("image")) {
-      s.background.kind = rd::Background::Kind::kImage;
-      s.background.image = image(b["image"], "/background/image", config);
-    }
-  }
-  if (body.contains("surfaceWave")) {
-    const json& w = body["surfaceWave"];
-    rd::SurfaceWave wave;
-    wave.strength = w.value("strength", wave.strength);
-    wave.scale = w.value("scale", wave.scale);
-    wave.speed = w.value("speed", wave.speed);
-    if (w.contains("lightColor")) wave.lightColor = toVec3(w["lightColor"]);
-    if (w.contains("lightDirection")) wave.lightDirection = toVec3(w["lightDirection"]);
-    requireNonZero(wave.lightDirection, "/surfaceWave/lightDirection");
-    s.wave = wave;
-  }
+  parseCamera(body, s);
+  if (body.contains("background")) parseBackground(body["background"], config, s);
+  if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"]);
   if (body.contains("cameraBlend"))
     s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
-  if (body.contains("quads")) {
-    for (size_t i = 0; i < body["quads"].size(); ++i) {
-      const json& q = body["quads"][i];
-      rd::Quad quad;
-      quad.center = toVec3(q["center"]);
-      if (q.contains("normal")) quad.normal = toVec3(q["normal"]);
-      if (q.contains("up")) quad.up = toVec3(q["up"]);
-      requireNonZero(quad.normal, "/quads/" + std::to_string(i) + "/normal");
-      quad.size = {q["size"][0].get<double>(), q["size"][1].get<double>()};
-      if (q.contains("color")) quad.color = toVec3(q["color"]);
-      s.quads.push_back(quad);
-    }
-  }
-  if (body.contains("fog")) {
-    within("/fog", [&] {
-      const json& f = body["fog"];
-      rd::Fog fog;
-      fog.global = parseFog(f["fog"], "/fog");
-      if (f.contains("regions")) {
-        if (f["regions"].size() > rd::kMaxFogRegions)
-          throw fieldError(422, "/regions",
-                           "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
-        for (size_t i = 0; i < f["regions"].size(); ++i)
-          fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
-      }
-      s.fog = std::move(fog);
-      return 0;
-    });
-  }
-  if (body.contains("lightning")) {
-    within("/lightning", [&] {
-      LightningRequest r = parseLightning(body["lightning"], config);
-      const effects::lightning::Bolt bolt = growBolt(r.params);
-      rd::Lightning l;
-      l.polylines = effects::lightning::polylines(bolt, r.shape);
-      l.gridWidth = r.params.width;
-      l.gridHeight = r.params.height;
-      s.lightning = std::move(l);
-      return 0;
-    });
-    const json st = body.value("lightningStyle", json::object());
-    if (st.contains("rect")) {
-      const json& r = st["rect"];
-      s.lightning->rect = {r[0].get<double>(), r[1].get<double>(), r[2].get<double>(), r[3].get<double>()};
-    }
-    if (st.contains("color")) s.lightning->color = toVec3(st["color"]);
-    s.lightning->coreWidth = st.value("coreWidth", s.lightning->coreWidth);
-    s.lightning->glowSigma = st.value("glowSigma", s.lightning->glowSigma);
-    s.lightning->glowStrength = st.value("glowStrength", s.lightning->glowStrength);
-  }
-  if (body.contains("bubble")) {
-    rd::Bubble b;
-    const json& bj = body["bubble"];
-    const double t = bj.value("time", s.time);
-    within("/bubble", [&] {
-      b.params = parseBubbleParams(bj.value("params", json::object()));
-      b.features = parseBubbleFeatures(bj.value("features", json::object()));
-      bb::MeshOptions o;
-      const json m = bj.value("mesh", json::object());
-      o.level = m.value("level", 4);
-      o.maxLevel = 7;
-      o.radius = m.value("radius", 1.0);
-      o.wobble = false;  // the vertex shader wobbles (eqn 11)
-      o.parallel = ctx.parallel;
-      auto mesh = bb::icosphere(b.params, o);
-      if (!mesh.ok()) {
-        effects::Error e = mesh.error();
-        throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
-      }
-      b.mesh = std::move(mesh.value());
-      if (b.features.iridescence) {
-        bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config);
-        tf.measureError = false;
-        auto table = cachedThinFilm(tf);
-        b.thinFilm = table->rgb;
-        b.thinFilmWidth = table->width;
-        b.thinFilmHeight = table->height;
-      }
-      if (bj.contains("motion")) {
-        const json& mo = bj["motion"];
-        b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
-      }
-      return 0;
-    });
-    const json st = body.value("bubbleStyle", json::object());
-    if (st.contains("center") && !bj.contains("motion")) b.center = toVec3(st["center"]);
-    if (st.contains("baseColor")) b.baseColor = rgba(st["baseColor"]);
-    if (st.contains("flowTexture")) b.flowTexture = image(st["flowTexture"], "/bubbleStyle/flowTexture", config);
-    b.time = t;
-    s.bubble = std::move(b);
-  }
+  if (body.contains("quads")) parseQuads(body["quads"], s);
+  if (body.contains("fog")) s.fog = parseSceneFog(body["fog"]);
+  if (body.contains("lightning")) s.lightning = sceneLightning(body, config);
+  if (body.contains("bubble")) s.bubble = sceneBubble(body, ctx, s.time);
   if (computeMs) *computeMs = watch.ms();
   return s;
 }
