@@ -10,11 +10,14 @@ using nlohmann::json;
 
 constexpr uint32_t kMagic = 0x46546C67, kJson = 0x4E4F534A, kBin = 0x004E4942;
 
-uint32_t u32(const std::string& s, size_t at) {
-  uint32_t v;
-  std::memcpy(&v, s.data() + at, 4);
+// The value of type T stored at p, any alignment (host order: glTF and x86-64 are little-endian).
+template <class T>
+T load(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
   return v;
 }
+uint32_t u32(const std::string& s, size_t at) { return load<uint32_t>(s.data() + at); }
 void put32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
 
 int componentSize(int type) {
@@ -99,36 +102,12 @@ std::optional<FieldError> view(const Asset& a, int index, View& v) {
 
 double component(const char* p, int type, bool normalized) {
   switch (type) {
-    case 5120: {
-      int8_t x;
-      std::memcpy(&x, p, 1);
-      return normalized ? std::max(x / 127.0, -1.0) : x;
-    }
-    case 5121: {
-      uint8_t x;
-      std::memcpy(&x, p, 1);
-      return normalized ? x / 255.0 : x;
-    }
-    case 5122: {
-      int16_t x;
-      std::memcpy(&x, p, 2);
-      return normalized ? std::max(x / 32767.0, -1.0) : x;
-    }
-    case 5123: {
-      uint16_t x;
-      std::memcpy(&x, p, 2);
-      return normalized ? x / 65535.0 : x;
-    }
-    case 5125: {
-      uint32_t x;
-      std::memcpy(&x, p, 4);
-      return x;
-    }
-    default: {
-      float x;
-      std::memcpy(&x, p, 4);
-      return x;
-    }
+    case 5120: return normalized ? std::max(load<int8_t>(p) / 127.0, -1.0) : load<int8_t>(p);
+    case 5121: return normalized ? load<uint8_t>(p) / 255.0 : load<uint8_t>(p);
+    case 5122: return normalized ? std::max(load<int16_t>(p) / 32767.0, -1.0) : load<int16_t>(p);
+    case 5123: return normalized ? load<uint16_t>(p) / 65535.0 : load<uint16_t>(p);
+    case 5125: return load<uint32_t>(p);
+    default: return load<float>(p);
   }
 }
 

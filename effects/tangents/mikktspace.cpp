@@ -18,7 +18,6 @@ namespace effects::tangents {
 namespace {
 
 constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not zero" bound on UV area
-constexpr size_t kGrain = 10000;              // triangles or groups per chunk when split across threads
 
 struct TriInfo {
   dvec3 os{0}, ot{0};  // unit first-order derivatives, sign-adjusted by orientation
@@ -83,7 +82,7 @@ class Mikk {
   uint32_t corner(size_t g, int i) const { return vert_[3 * size_t(good_[g]) + size_t(i)]; }
 
   void initTriInfo() {
-    forRange(parallel_, good_.size(), kGrain, [this](size_t begin, size_t end) { initTriInfo(begin, end); });
+    forRange(parallel_, good_.size(), kParallelGrain, [this](size_t begin, size_t end) { initTriInfo(begin, end); });
     for (const TriInfo& ti : info_) out_.zeroUvArea += ti.zeroUvArea;
   }
   void initTriInfo(size_t begin, size_t end) {
@@ -195,7 +194,8 @@ class Mikk {
   // whose projected frames are not opposite to its own; nearly always the whole group, so
   // that case is evaluated once per group and other sets are compared as sorted lists.
   void generateTSpaces() {
-    forRange(parallel_, groups_.size(), kGrain, [this](size_t begin, size_t end) { generateTSpaces(begin, end); });
+    forRange(parallel_, groups_.size(), kParallelGrain,
+             [this](size_t begin, size_t end) { generateTSpaces(begin, end); });
   }
   void generateTSpaces(size_t begin, size_t end) {
     std::vector<dvec3> os, ot;
@@ -291,7 +291,7 @@ CornerTangents mikktspace(const Mesh& mesh, const std::vector<dvec3>& normals, P
   CornerTangents out;
   out.tangent.resize(mikk.tangent.size());
   out.fellBack.assign(mikk.tangent.size(), 0);
-  forRange(parallel, out.tangent.size(), kGrain, [&](size_t begin, size_t end) {
+  forRange(parallel, out.tangent.size(), kParallelGrain, [&](size_t begin, size_t end) {
     for (size_t c = begin; c < end; ++c) {
       // Mikk's tangent is already unit and in the plane of this corner's normal.
       const dvec3& t = mikk.tangent[c];

@@ -3,10 +3,6 @@
 #include "steps.h"
 
 namespace effects::tangents {
-namespace {
-constexpr size_t kGrain = 10000;  // corners per chunk when split across threads
-}
-
 Frame triangleFrame(const dvec3 p[3], const dvec2 uv[3], const dvec3& nIn) {
   Frame f;
   dvec3 n = normalizeOrZero(nIn);
@@ -58,7 +54,7 @@ CornerTangents perTriangle(const Mesh& mesh, const std::vector<dvec3>& normals, 
   CornerTangents out;
   out.tangent.resize(mesh.indices.size());
   out.fellBack.assign(mesh.indices.size(), 0);
-  forRange(parallel, mesh.indices.size(), kGrain, [&](size_t begin, size_t end) {
+  forRange(parallel, mesh.indices.size(), kParallelGrain, [&](size_t begin, size_t end) {
     for (size_t c = begin; c < end; ++c) {
       Frame f = meshTriangleFrame(mesh, c / 3, normals[mesh.indices[c]]);
       out.tangent[c] = glm::vec4(f.tangent, f.w);

@@ -3,14 +3,10 @@
 #include "steps.h"
 
 namespace effects::tangents {
-namespace {
-constexpr size_t kGrain = 10000;  // triangles per chunk when split across threads
-}
-
 CornerTangents perVertex(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel) {
   const size_t triCount = mesh.indices.size() / 3, vertCount = mesh.positions.size();
   std::vector<Frame> frames(triCount);
-  forRange(parallel, triCount, kGrain, [&](size_t begin, size_t end) {
+  forRange(parallel, triCount, kParallelGrain, [&](size_t begin, size_t end) {
     for (size_t t = begin; t < end; ++t) frames[t] = faceFrame(mesh, t, normals);
   });
   std::vector<dvec3> sum(vertCount, dvec3(0));

@@ -22,7 +22,11 @@ struct CornerTangents {
   std::vector<uint8_t> fellBack;
 };
 
-// Welding gives corners at the same position (normal, UV) one vertex; see weld.h.
+// Work per chunk when a step splits its loop over the caller's threads (effects/parallel.h).
+inline constexpr size_t kParallelGrain = 10000;
+
+// A unit normal per vertex: given ones normalised; missing ones angle-weighted over every
+// corner at the same position (welded, weld.h); +z where no triangle has area.
 std::vector<dvec3> vertexNormals(const Mesh& mesh);
 // Every corner its own vertex with the face normal (glTF's rule for meshes without normals);
 // cornerToInput[c] = the input vertex of corner c.
@@ -33,7 +37,7 @@ struct MikkStats {
 };
 CornerTangents mikktspace(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel, MikkStats& stats);
 
-// The frame of triangle t with normal n (face normal when the corner's is unusable).
+// The frame of triangle t made orthogonal to the normal n.
 Frame meshTriangleFrame(const Mesh& mesh, size_t t, const dvec3& n);
 // Triangle t's frame with its face normal (the vertex normal of its first corner when the
 // triangle has no area, which marks the frame degenerate).
