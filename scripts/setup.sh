@@ -15,6 +15,7 @@ PACKAGES=(
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
+  json-schema-test-suite  # the official JSON-Schema tests run against server/schema.cpp
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node
 # (e.g. from NodeSource) keep it; otherwise Debian's.

@@ -6,7 +6,8 @@
 // allOf, $ref (within a document, "#/$defs/x", or across documents, "common.json#/$defs/x").
 // Annotation keywords (title, description, default, examples, $schema, $id, x-*) are ignored.
 // A keyword outside this subset is a programming error: the registry refuses to load it, so
-// the contract cannot silently say more than the server checks.
+// the contract cannot silently say more than the server checks. tests/schema_suite_test.cpp
+// runs the official JSON-Schema-Test-Suite on this subset.
 #pragma once
 
 #include <map>
