@@ -13,11 +13,7 @@ namespace effectd {
 using nlohmann::json;
 namespace bb = effects::bubble;
 
-namespace {
-constexpr int kMaxIcosphereLevel = 7;  // 327 680 triangles
-}  // namespace
-
-bb::Params parseBubbleParams(const json& j) {
+bb::Params parseBubbleParams(const json& j, const std::string& pointer) {
   bb::Params p;
   p.n1 = j.value("n1", p.n1);
   p.n2 = j.value("n2", p.n2);
@@ -26,7 +22,7 @@ bb::Params parseBubbleParams(const json& j) {
   p.rimPower = j.value("rimPower", p.rimPower);
   p.muSpeed = j.value("muSpeed", p.muSpeed);
   p.wobbleAmplitude = j.value("wobbleAmplitude", p.wobbleAmplitude);
-  if (auto e = bb::validate(p)) throwError(*e, "/params");
+  if (auto e = bb::validate(p)) throwError(*e, pointer);
   return p;
 }
 
@@ -41,7 +37,8 @@ bb::Features parseBubbleFeatures(const json& j) {
   return f;
 }
 
-bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const Config& config) {
+bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const Config& config,
+                                    const std::string& pointer) {
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
   bb::ThinFilmOptions o;
@@ -52,7 +49,7 @@ bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, 
   o.thicknessMinNm = range[0].get<double>();
   o.thicknessMaxNm = range[1].get<double>();
   if (size_t(o.width) * size_t(o.height) > config.limits.maxThinFilmTexels)
-    throw fieldError(413, "/thinFilm/width",
+    throw fieldError(413, pointer + "/thinFilm/width",
                      "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " table exceeds the limit of " +
                          std::to_string(config.limits.maxThinFilmTexels) + " texels (--max-thin-film-texels)");
   return o;
@@ -88,7 +85,7 @@ json meshJson(const json& body, const bb::Params& params, const bb::Features& fe
               const RequestContext& ctx, effects::Stats& stats) {
   const json m = body.value("mesh", json::object());
   bb::MeshOptions o;
-  o.level = m.value("level", 3);
+  o.level = m.value("level", o.level);
   o.maxLevel = kMaxIcosphereLevel;
   o.radius = m.value("radius", 1.0);
   o.t = t;
@@ -98,7 +95,7 @@ json meshJson(const json& body, const bb::Params& params, const bb::Features& fe
   auto r = bb::icosphere(params, o);
   if (!r.ok()) {
     effects::Error e = r.error();
-    throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
+    throwError(e, ctx.at + (e.field == "/level" || e.field == "/radius" ? "/mesh" : ""));
   }
   const bb::Mesh& mesh = r.value();
   json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
@@ -115,11 +112,11 @@ json meshJson(const json& body, const bb::Params& params, const bb::Features& fe
 // The physical thin-film table over thickness x cos(theta), as JSON numbers or RGBA16F base64.
 json thinFilmJson(const json& body, const bb::Params& params, const json& tf, const json& range,
                   const RequestContext& ctx, effects::Stats& stats) {
-  const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config);
+  const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config, ctx.at);
   auto r = bb::thinFilmTable(o);
   if (!r.ok()) {
     effects::Error e = r.error();
-    throwError(e, "/thinFilm");
+    throwError(e, ctx.at + "/thinFilm");
   }
   const bb::ThinFilmTable& table = r.value();
   json j = {{"width", table.width},
@@ -155,7 +152,7 @@ json thinFilmJson(const json& body, const bb::Params& params, const json& tf, co
 
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   Includes include(body, kBubbleIncludes);
-  const bb::Params params = parseBubbleParams(body.value("params", json::object()));
+  const bb::Params params = parseBubbleParams(body.value("params", json::object()), ctx.at + "/params");
   const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
   const double t = body.value("time", 0.0);
   JsonReply reply;

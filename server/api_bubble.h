@@ -15,10 +15,17 @@ namespace effectd {
 
 void addBubbleEndpoints(Service& service);
 JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
-effects::bubble::Params parseBubbleParams(const nlohmann::json& j);
+// The parts of a bubble body; `pointer` is where that part sits in the request (problems name
+// fields under it): params at "/params", the body itself at "" (or "/bubble" in a scene).
+effects::bubble::Params parseBubbleParams(const nlohmann::json& j, const std::string& pointer);
 effects::bubble::Features parseBubbleFeatures(const nlohmann::json& j);
 effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
-                                                 const Config& config);  // throws 413 over --max-thin-film-texels
+                                                 const Config& config,
+                                                 const std::string& pointer);  // throws 413 over --max-thin-film-texels
+// Icosphere subdivisions: the most a request may ask for (327 680 triangles), and the default
+// of a rendered bubble (a /v1/bubble mesh defaults to MeshOptions{}.level).
+inline constexpr int kMaxIcosphereLevel = 7;
+inline constexpr int kRenderedIcosphereLevel = 4;
 // What /v1/bubble answers when the body has no "include" list (the handler and costs.cpp).
 inline const std::vector<std::string> kBubbleIncludes = {"uniforms", "shader"};
 

@@ -125,11 +125,11 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
 
 JsonReply handleFog(const json& body, const RequestContext& ctx) {
   Includes include(body, kFogIncludes);
-  fog::Fog global = parseFog(body["fog"], "/fog");
+  fog::Fog global = parseFog(body["fog"], ctx.at + "/fog");
   std::vector<fog::Region> regions;
   if (body.contains("regions"))
     for (size_t i = 0; i < body["regions"].size(); ++i)
-      regions.push_back(parseRegion(body["regions"][i], "/regions/" + std::to_string(i)));
+      regions.push_back(parseRegion(body["regions"][i], ctx.at + "/regions/" + std::to_string(i)));
   const json tableOpts = body.value("table", json::object());
   const json objectColors = body.contains("objectColors") ? body["objectColors"] : json();
 
@@ -143,7 +143,7 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
       effects::Error e = t.error();
       throwError(e,
                  e.field == "/range" || e.field.rfind("/range/", 0) == 0 || e.field == "/size" || e.field == "/maxError"
-                     ? "/table"
+                     ? ctx.at + "/table"
                      : pointer);
     }
     reply.computeMs += t.value().stats.elapsedMs;
@@ -151,7 +151,7 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
     return tableJson(t.value(), f, tableOpts, objectColors);
   };
   if (include.has("table")) {
-    out["table"] = build(global, "/fog");
+    out["table"] = build(global, ctx.at + "/fog");
     out["error"] = {{"maxError", out["table"]["maxError"]},
                     {"metric", "max |linear interpolation of the table - exact f|"},
                     {"reference", "exact closed form"}};
@@ -159,11 +159,12 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
   if (include.has("regionTables")) {
     json list = json::array();
     for (size_t i = 0; i < regions.size(); ++i)
-      list.push_back(build(regions[i].fog, "/regions/" + std::to_string(i) + "/fog"));
+      list.push_back(build(regions[i].fog, ctx.at + "/regions/" + std::to_string(i) + "/fog"));
     out["regionTables"] = std::move(list);
   }
   if (include.has("samples")) {
-    if (!body.contains("samples")) throw fieldError(400, "/samples", "is required when include has \"samples\"");
+    if (!body.contains("samples"))
+      throw fieldError(400, ctx.at + "/samples", "is required when include has \"samples\"");
     effects::Stopwatch watch;
     glm::dvec3 camera = toVec3(body["samples"]["camera"]);
     json list = json::array();

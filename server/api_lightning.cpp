@@ -12,7 +12,7 @@ namespace {
 using nlohmann::json;
 namespace lt = effects::lightning;
 
-std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
+std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::string& at) {
   std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
   bool any = false;
   if (o.contains("rects")) {
@@ -27,7 +27,7 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
     const json& rows = o["rows"];
     for (size_t i = 0; i < rows.size(); ++i) {
       int y = rows[i]["y"];
-      if (y >= h) throw fieldError(400, "/obstacles/rows/" + std::to_string(i) + "/y", "is outside the grid");
+      if (y >= h) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/y", "is outside the grid");
       for (const auto& run : rows[i]["runs"]) {
         int x0 = run[0], len = run[1];
         for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;
@@ -37,10 +37,10 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h) {
   }
   if (o.contains("bitmap")) {
     auto bytes = base64Decode(o["bitmap"].get<std::string>());
-    if (!bytes) throw fieldError(400, "/obstacles/bitmap", "is not valid base64 (standard alphabet, padded)");
+    if (!bytes) throw fieldError(400, at + "/bitmap", "is not valid base64 (standard alphabet, padded)");
     size_t need = (grid.size() + 7) / 8;
     if (bytes->size() != need)
-      throw fieldError(400, "/obstacles/bitmap",
+      throw fieldError(400, at + "/bitmap",
                        "must decode to " + std::to_string(need) + " bytes (width*height bits), got " +
                            std::to_string(bytes->size()));
     for (size_t i = 0; i < grid.size(); ++i)
@@ -55,24 +55,24 @@ lt::Cell cellOf(const json& j) { return {j[0].get<int>(), j[1].get<int>()}; }
 
 }  // namespace
 
-LightningRequest parseLightning(const json& body, const Config& config) {
+LightningRequest parseLightning(const json& body, const Config& config, const std::string& at) {
   LightningRequest r;
   lt::Params& p = r.params;
   p.width = body["grid"]["width"];
   p.height = body["grid"]["height"];
   const size_t cells = size_t(p.width) * size_t(p.height);
   if (cells > config.limits.maxGridCells)
-    throw fieldError(413, "/grid",
+    throw fieldError(413, at + "/grid",
                      "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
                          std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
-  if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height);
+  if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
   p.start = cellOf(body["start"]);
   p.targets.clear();
   for (const auto& t : body["targets"]) p.targets.push_back(cellOf(t));
   const std::string method = body.value("method", "fast");
   p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
   if (p.method != lt::Method::kFast && cells > config.limits.maxSolverGridCells)
-    throw fieldError(413, "/grid",
+    throw fieldError(413, at + "/grid",
                      "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
                          std::to_string(config.limits.maxSolverGridCells) + " for method " + method +
                          " (--max-solver-grid-cells); the fast method takes up to " +
@@ -96,22 +96,22 @@ LightningRequest parseLightning(const json& body, const Config& config) {
   return r;
 }
 
-lt::Bolt growBolt(const lt::Params& p) {
+lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
   auto grown = lt::grow(p);
   if (!grown.ok()) {
     effects::Error e = grown.error();
     if (e.field == "/maxSteps") e.message += " (--max-growth-steps / maxSteps)";
-    throwError(e);
+    throwError(e, at);
   }
   return std::move(grown.value());
 }
 
 JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   Includes include(body, kLightningIncludes);
-  LightningRequest request = parseLightning(body, ctx.config);
+  LightningRequest request = parseLightning(body, ctx.config, ctx.at);
   const lt::Params& p = request.params;
   request.params.measureError = include.has("error");
-  const lt::Bolt bolt = growBolt(p);
+  const lt::Bolt bolt = growBolt(p, ctx.at);
   JsonReply reply;
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;

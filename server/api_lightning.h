@@ -18,8 +18,9 @@ struct LightningRequest {
   effects::lightning::Params params;
   effects::lightning::ShapeParams shape;
 };
-LightningRequest parseLightning(const nlohmann::json& body, const Config& config);
-effects::lightning::Bolt growBolt(const effects::lightning::Params& params);  // throws ApiError
+// The request at JSON pointer `at` ("" for the endpoint's body); problems name fields under it.
+LightningRequest parseLightning(const nlohmann::json& body, const Config& config, const std::string& at);
+effects::lightning::Bolt growBolt(const effects::lightning::Params& params, const std::string& at);  // throws ApiError
 // What /v1/lightning answers when the body has no "include" list (the handler and costs.cpp).
 inline const std::vector<std::string> kLightningIncludes = {"polylines"};
 

@@ -23,18 +23,6 @@ using nlohmann::json;
 namespace rd = effects::render;
 namespace bb = effects::bubble;
 
-// Runs `f`, re-rooting the pointers of any problem it throws under `prefix`.
-template <class F>
-auto within(const std::string& prefix, F&& f) {
-  try {
-    return f();
-  } catch (ApiError e) {
-    for (auto& v : e.errors) v.pointer = prefix + v.pointer;
-    e.detail = (e.detail.rfind("/", 0) == 0 ? prefix : prefix + ": ") + e.detail;
-    throw e;
-  }
-}
-
 glm::dvec4 rgba(const json& j) {
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>(), j.size() > 3 ? j[3].get<double>() : 1.0};
 }
@@ -53,7 +41,7 @@ rd::Image image(const json& base64, const std::string& pointer, const Config& co
 
 // Thin-film tables are deterministic in their options and cost tens of milliseconds: renders
 // share them through a small process-wide cache.
-std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOptions& o) {
+std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOptions& o, const std::string& pointer) {
   static std::mutex mu;
   static std::map<std::string, std::shared_ptr<const bb::ThinFilmTable>> cache;
   const std::string key = json{o.ior, o.thicknessMinNm, o.thicknessMaxNm, o.width, o.height, o.wavelengths}.dump();
@@ -62,7 +50,7 @@ std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOption
     if (auto it = cache.find(key); it != cache.end()) return it->second;
   }
   auto table = bb::thinFilmTable(o);
-  if (!table.ok()) throwError(table.error(), "/thinFilm");
+  if (!table.ok()) throwError(table.error(), pointer + "/thinFilm");
   auto shared = std::make_shared<const bb::ThinFilmTable>(std::move(table.value()));
   std::lock_guard<std::mutex> lock(mu);
   if (cache.size() >= 16) cache.clear();
@@ -127,33 +115,28 @@ void parseQuads(const json& quads, rd::Scene& s) {
   }
 }
 
-// Problems from the effect parsers name fields under the scene's "/fog".
+// The scene's "/fog": a /v1/fog body, parsed by that endpoint's parsers.
 rd::Fog parseSceneFog(const json& f) {
-  return within("/fog", [&] {
-    rd::Fog fog;
-    fog.global = parseFog(f["fog"], "/fog");
-    if (f.contains("regions")) {
-      if (f["regions"].size() > rd::kMaxFogRegions)
-        throw fieldError(422, "/regions",
-                         "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
-      for (size_t i = 0; i < f["regions"].size(); ++i)
-        fog.regions.push_back(parseRegion(f["regions"][i], "/regions/" + std::to_string(i)));
-    }
-    return fog;
-  });
+  rd::Fog fog;
+  fog.global = parseFog(f["fog"], "/fog/fog");
+  if (f.contains("regions")) {
+    if (f["regions"].size() > rd::kMaxFogRegions)
+      throw fieldError(422, "/fog/regions",
+                       "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
+    for (size_t i = 0; i < f["regions"].size(); ++i)
+      fog.regions.push_back(parseRegion(f["regions"][i], "/fog/regions/" + std::to_string(i)));
+  }
+  return fog;
 }
 
 // The bolt grown by the lightning endpoint's own parser and method, in the scene's style.
 rd::Lightning sceneLightning(const json& body, const Config& config) {
-  rd::Lightning l = within("/lightning", [&] {
-    LightningRequest r = parseLightning(body["lightning"], config);
-    const effects::lightning::Bolt bolt = growBolt(r.params);
-    rd::Lightning grown;
-    grown.polylines = effects::lightning::polylines(bolt, r.shape);
-    grown.gridWidth = r.params.width;
-    grown.gridHeight = r.params.height;
-    return grown;
-  });
+  const LightningRequest r = parseLightning(body["lightning"], config, "/lightning");
+  const effects::lightning::Bolt bolt = growBolt(r.params, "/lightning");
+  rd::Lightning l;
+  l.polylines = effects::lightning::polylines(bolt, r.shape);
+  l.gridWidth = r.params.width;
+  l.gridHeight = r.params.height;
   const json st = body.value("lightningStyle", json::object());
   if (st.contains("rect")) {
     const json& r = st["rect"];
@@ -172,36 +155,33 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
   rd::Bubble b;
   const json& bj = body["bubble"];
   const double t = bj.value("time", sceneTime);
-  within("/bubble", [&] {
-    b.params = parseBubbleParams(bj.value("params", json::object()));
-    b.features = parseBubbleFeatures(bj.value("features", json::object()));
-    bb::MeshOptions o;
-    const json m = bj.value("mesh", json::object());
-    o.level = m.value("level", 4);
-    o.maxLevel = 7;
-    o.radius = m.value("radius", 1.0);
-    o.wobble = false;  // the vertex shader wobbles (eqn 11)
-    o.parallel = ctx.parallel;
-    auto mesh = bb::icosphere(b.params, o);
-    if (!mesh.ok()) {
-      effects::Error e = mesh.error();
-      throwError(e, e.field == "/level" || e.field == "/radius" ? "/mesh" : "");
-    }
-    b.mesh = std::move(mesh.value());
-    if (b.features.iridescence) {
-      bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config);
-      tf.measureError = false;
-      auto table = cachedThinFilm(tf);
-      b.thinFilm = table->rgb;
-      b.thinFilmWidth = table->width;
-      b.thinFilmHeight = table->height;
-    }
-    if (bj.contains("motion")) {
-      const json& mo = bj["motion"];
-      b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
-    }
-    return 0;
-  });
+  b.params = parseBubbleParams(bj.value("params", json::object()), "/bubble/params");
+  b.features = parseBubbleFeatures(bj.value("features", json::object()));
+  bb::MeshOptions o;
+  const json m = bj.value("mesh", json::object());
+  o.level = m.value("level", kRenderedIcosphereLevel);
+  o.maxLevel = kMaxIcosphereLevel;
+  o.radius = m.value("radius", 1.0);
+  o.wobble = false;  // the vertex shader wobbles (eqn 11)
+  o.parallel = ctx.parallel;
+  auto mesh = bb::icosphere(b.params, o);
+  if (!mesh.ok()) {
+    effects::Error e = mesh.error();
+    throwError(e, e.field == "/level" || e.field == "/radius" ? "/bubble/mesh" : "/bubble");
+  }
+  b.mesh = std::move(mesh.value());
+  if (b.features.iridescence) {
+    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, "/bubble");
+    tf.measureError = false;
+    auto table = cachedThinFilm(tf, "/bubble");
+    b.thinFilm = table->rgb;
+    b.thinFilmWidth = table->width;
+    b.thinFilmHeight = table->height;
+  }
+  if (bj.contains("motion")) {
+    const json& mo = bj["motion"];
+    b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
+  }
   const json st = body.value("bubbleStyle", json::object());
   if (st.contains("center") && !bj.contains("motion")) b.center = toVec3(st["center"]);
   if (st.contains("baseColor")) b.baseColor = rgba(st["baseColor"]);
@@ -245,7 +225,9 @@ JsonReply handleScene(const json& body, const RequestContext& ctx) {
   json out = json::object();
   auto add = [&](const char* name, JsonReply (*handler)(const json&, const RequestContext&)) {
     if (!body.contains(name)) return;
-    JsonReply r = within(std::string("/") + name, [&] { return handler(body[name], ctx); });
+    RequestContext part = ctx;  // the part's problems name fields under "/<name>"
+    part.at = std::string("/") + name;
+    JsonReply r = handler(body[name], part);
     out[name] = std::move(r.body);
     reply.computeMs += r.computeMs;
   };

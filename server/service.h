@@ -62,6 +62,9 @@ struct RequestContext {
   std::string requestId;
   const Config& config;
   effects::Parallel* parallel = nullptr;  // the process's compute threads, for work that splits
+  // The JSON pointer, within the request body, of the object the handler reads: "" for an
+  // endpoint's own body, "/fog" for the fog part of a /v1/scene. Problems name fields under it.
+  std::string at = "";
 };
 
 using JsonHandler = std::function<JsonReply(const nlohmann::json& body, const RequestContext& ctx)>;
