@@ -73,16 +73,155 @@ size_t codePoints(const std::string& s) {
   return n;
 }
 
-}  // namespace
-
-struct SchemaRegistry::Ctx {
+// The violations found so far, capped: once `maxErrors` are in, the rest are dropped.
+struct Errors {
   std::vector<FieldError> errors;
   size_t maxErrors;
-  int depth = 0;
   bool full() const { return errors.size() >= maxErrors; }
   void add(const std::string& pointer, std::string message) {
     if (!full()) errors.push_back({pointer, std::move(message)});
   }
+};
+
+// The keyword families of SchemaRegistry::check, in the order it applies them. Those that
+// descend into members take `walk(schema, value, pointer)`, which checks one member against
+// its subschema with the same errors and depth.
+
+// "type"; false when `v` has the wrong type: the remaining keywords would only repeat the
+// same complaint.
+bool checkType(const json& s, const json& v, const std::string& ptr, Errors& out) {
+  auto it = s.find("type");
+  if (it == s.end()) return true;
+  bool ok = false;
+  std::string expected;
+  if (it->is_string()) {
+    ok = hasType(v, it->get<std::string>());
+    expected = it->get<std::string>();
+  } else {
+    for (const auto& t : *it) {
+      ok = ok || hasType(v, t.get<std::string>());
+      expected += (expected.empty() ? "" : " or ") + t.get<std::string>();
+    }
+  }
+  if (!ok) out.add(ptr, "must be " + expected + ", got " + typeOf(v));
+  return ok;
+}
+
+// "const" and "enum".
+void checkValue(const json& s, const json& v, const std::string& ptr, Errors& out) {
+  if (auto it = s.find("const"); it != s.end() && v != *it) out.add(ptr, "must be " + it->dump());
+  if (auto it = s.find("enum"); it != s.end()) {
+    bool found = false;
+    for (const auto& e : *it) found = found || e == v;
+    if (!found) out.add(ptr, "must be one of " + it->dump());
+  }
+}
+
+// "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum".
+void checkNumber(const json& s, const json& v, const std::string& ptr, Errors& out) {
+  if (!v.is_number()) return;
+  double d = v.get<double>();
+  if (auto it = s.find("minimum"); it != s.end() && d < it->get<double>()) out.add(ptr, "must be >= " + fmtNumber(*it));
+  if (auto it = s.find("maximum"); it != s.end() && d > it->get<double>()) out.add(ptr, "must be <= " + fmtNumber(*it));
+  if (auto it = s.find("exclusiveMinimum"); it != s.end() && d <= it->get<double>())
+    out.add(ptr, "must be > " + fmtNumber(*it));
+  if (auto it = s.find("exclusiveMaximum"); it != s.end() && d >= it->get<double>())
+    out.add(ptr, "must be < " + fmtNumber(*it));
+}
+
+// "minLength", "maxLength", in code points.
+void checkString(const json& s, const json& v, const std::string& ptr, Errors& out) {
+  if (!v.is_string()) return;
+  size_t n = codePoints(v.get_ref<const std::string&>());
+  if (auto it = s.find("minLength"); it != s.end() && n < it->get<size_t>())
+    out.add(ptr, "must have at least " + it->dump() + " characters");
+  if (auto it = s.find("maxLength"); it != s.end() && n > it->get<size_t>())
+    out.add(ptr, "must have at most " + it->dump() + " characters");
+}
+
+// "minItems", "maxItems", "items"; false for an array over maxItems, which is not walked and
+// ends the check.
+template <typename Walk>
+bool checkArray(const json& s, const json& v, const std::string& ptr, Errors& out, const Walk& walk) {
+  if (!v.is_array()) return true;
+  if (auto it = s.find("minItems"); it != s.end() && v.size() < it->get<size_t>())
+    out.add(ptr, "must have at least " + it->dump() + " items");
+  if (auto it = s.find("maxItems"); it != s.end() && v.size() > it->get<size_t>()) {
+    out.add(ptr, "must have at most " + it->dump() + " items");
+    return false;
+  }
+  if (auto it = s.find("items"); it != s.end()) {
+    for (size_t i = 0; i < v.size() && !out.full(); ++i) walk(*it, v[i], ptr + "/" + std::to_string(i));
+  }
+  return true;
+}
+
+// "required", "properties", "additionalProperties".
+template <typename Walk>
+void checkObject(const json& s, const json& v, const std::string& ptr, Errors& out, const Walk& walk) {
+  if (!v.is_object()) return;
+  const json* props = nullptr;
+  if (auto it = s.find("properties"); it != s.end()) props = &*it;
+  if (auto it = s.find("required"); it != s.end()) {
+    for (const auto& r : *it) {
+      if (!v.contains(r.get<std::string>())) out.add(ptr + "/" + pointerEscape(r.get<std::string>()), "is required");
+    }
+  }
+  auto additional = s.find("additionalProperties");
+  for (const auto& [key, val] : v.items()) {
+    std::string child = ptr + "/" + pointerEscape(key);
+    if (props && props->contains(key)) {
+      walk((*props)[key], val, child);
+    } else if (additional != s.end()) {
+      if (additional->is_boolean() && !additional->get<bool>())
+        out.add(child, "is not a known field");
+      else
+        walk(*additional, val, child);
+    }
+  }
+}
+
+// "oneOf" and "anyOf". `tryBranch(schema)` checks the value at `ptr` against one alternative
+// on its own (a few errors at most) and returns what it found; the report names the
+// alternative the client most likely meant.
+template <typename TryBranch>
+void checkAlternatives(const json& s, const std::string& ptr, Errors& out, const TryBranch& tryBranch) {
+  for (const char* kw : {"oneOf", "anyOf"}) {
+    auto it = s.find(kw);
+    if (it == s.end()) continue;
+    size_t matches = 0;
+    std::vector<FieldError> firstErrors;
+    std::vector<std::string> missing;  // branches that fail only for a missing member
+    for (const auto& branch : *it) {
+      std::vector<FieldError> errors = tryBranch(branch);
+      if (errors.empty())
+        ++matches;
+      else if (firstErrors.empty() || errors.front().pointer.size() > firstErrors.front().pointer.size())
+        firstErrors = errors;  // the branch that got deepest is the one the client meant
+      if (errors.size() == 1 && errors.front().message == "is required" &&
+          errors.front().pointer.rfind(ptr + "/", 0) == 0)
+        missing.push_back(errors.front().pointer.substr(ptr.size() + 1));
+    }
+    bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
+    if (!ok) {
+      if (matches > 1) {
+        out.add(ptr, "matches more than one alternative");
+      } else if (missing.size() == it->size()) {  // none of the alternatives' members given
+        std::string names;
+        for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;
+        out.add(ptr, "needs one of: " + names);
+      } else {
+        for (auto& e : firstErrors) out.add(e.pointer, e.message);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+struct SchemaRegistry::Ctx : Errors {
+  explicit Ctx(size_t maxErrors) : Errors{{}, maxErrors} {}
+  int depth = 0;  // $ref nesting, to stop a cyclic reference
 };
 
 SchemaRegistry::SchemaRegistry(const std::map<std::string, std::string>& documents) {
@@ -136,7 +275,7 @@ const json& SchemaRegistry::resolve(const std::string& ref, const std::string& d
 
 std::vector<FieldError> SchemaRegistry::validate(const std::string& name, const json& instance,
                                                  size_t maxErrors) const {
-  Ctx ctx{{}, maxErrors};
+  Ctx ctx{maxErrors};
   check(document(name), name, instance, "", ctx);
   return ctx.errors;
 }
@@ -157,115 +296,27 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
     int& d;
     ~DepthGuard() { --d; }
   } guard{ctx.depth};
+  auto walk = [&](const json& sub, const json& member, const std::string& memberPtr) {
+    check(sub, doc, member, memberPtr, ctx);
+  };
+  auto tryBranch = [&](const json& branch) {
+    Ctx sub{4};
+    check(branch, doc, v, ptr, sub);
+    return std::move(sub.errors);
+  };
 
   if (auto it = s.find("$ref"); it != s.end()) {
     std::string target;
     const json& sub = resolve(it->get<std::string>(), doc, target);
     check(sub, target, v, ptr, ctx);
   }
-  if (auto it = s.find("type"); it != s.end()) {
-    bool ok = false;
-    std::string expected;
-    if (it->is_string()) {
-      ok = hasType(v, it->get<std::string>());
-      expected = it->get<std::string>();
-    } else {
-      for (const auto& t : *it) {
-        ok = ok || hasType(v, t.get<std::string>());
-        expected += (expected.empty() ? "" : " or ") + t.get<std::string>();
-      }
-    }
-    if (!ok) {
-      ctx.add(ptr, "must be " + expected + ", got " + typeOf(v));
-      return;  // the remaining keywords would only repeat the same complaint
-    }
-  }
-  if (auto it = s.find("const"); it != s.end() && v != *it) ctx.add(ptr, "must be " + it->dump());
-  if (auto it = s.find("enum"); it != s.end()) {
-    bool found = false;
-    for (const auto& e : *it) found = found || e == v;
-    if (!found) ctx.add(ptr, "must be one of " + it->dump());
-  }
-  if (v.is_number()) {
-    double d = v.get<double>();
-    if (auto it = s.find("minimum"); it != s.end() && d < it->get<double>())
-      ctx.add(ptr, "must be >= " + fmtNumber(*it));
-    if (auto it = s.find("maximum"); it != s.end() && d > it->get<double>())
-      ctx.add(ptr, "must be <= " + fmtNumber(*it));
-    if (auto it = s.find("exclusiveMinimum"); it != s.end() && d <= it->get<double>())
-      ctx.add(ptr, "must be > " + fmtNumber(*it));
-    if (auto it = s.find("exclusiveMaximum"); it != s.end() && d >= it->get<double>())
-      ctx.add(ptr, "must be < " + fmtNumber(*it));
-  }
-  if (v.is_string()) {
-    size_t n = codePoints(v.get_ref<const std::string&>());
-    if (auto it = s.find("minLength"); it != s.end() && n < it->get<size_t>())
-      ctx.add(ptr, "must have at least " + it->dump() + " characters");
-    if (auto it = s.find("maxLength"); it != s.end() && n > it->get<size_t>())
-      ctx.add(ptr, "must have at most " + it->dump() + " characters");
-  }
-  if (v.is_array()) {
-    if (auto it = s.find("minItems"); it != s.end() && v.size() < it->get<size_t>())
-      ctx.add(ptr, "must have at least " + it->dump() + " items");
-    if (auto it = s.find("maxItems"); it != s.end() && v.size() > it->get<size_t>()) {
-      ctx.add(ptr, "must have at most " + it->dump() + " items");
-      return;  // do not walk an oversized array
-    }
-    if (auto it = s.find("items"); it != s.end()) {
-      for (size_t i = 0; i < v.size() && !ctx.full(); ++i) check(*it, doc, v[i], ptr + "/" + std::to_string(i), ctx);
-    }
-  }
-  if (v.is_object()) {
-    const json* props = nullptr;
-    if (auto it = s.find("properties"); it != s.end()) props = &*it;
-    if (auto it = s.find("required"); it != s.end()) {
-      for (const auto& r : *it) {
-        if (!v.contains(r.get<std::string>())) ctx.add(ptr + "/" + pointerEscape(r.get<std::string>()), "is required");
-      }
-    }
-    auto additional = s.find("additionalProperties");
-    for (const auto& [key, val] : v.items()) {
-      std::string child = ptr + "/" + pointerEscape(key);
-      if (props && props->contains(key)) {
-        check((*props)[key], doc, val, child, ctx);
-      } else if (additional != s.end()) {
-        if (additional->is_boolean() && !additional->get<bool>())
-          ctx.add(child, "is not a known field");
-        else
-          check(*additional, doc, val, child, ctx);
-      }
-    }
-  }
-  for (const char* kw : {"oneOf", "anyOf"}) {
-    auto it = s.find(kw);
-    if (it == s.end()) continue;
-    size_t matches = 0;
-    std::vector<FieldError> firstErrors;
-    std::vector<std::string> missing;  // branches that fail only for a missing member
-    for (const auto& branch : *it) {
-      Ctx sub{{}, 4};
-      check(branch, doc, v, ptr, sub);
-      if (sub.errors.empty())
-        ++matches;
-      else if (firstErrors.empty() || sub.errors.front().pointer.size() > firstErrors.front().pointer.size())
-        firstErrors = sub.errors;  // the branch that got deepest is the one the client meant
-      if (sub.errors.size() == 1 && sub.errors.front().message == "is required" &&
-          sub.errors.front().pointer.rfind(ptr + "/", 0) == 0)
-        missing.push_back(sub.errors.front().pointer.substr(ptr.size() + 1));
-    }
-    bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
-    if (!ok) {
-      if (matches > 1) {
-        ctx.add(ptr, "matches more than one alternative");
-      } else if (missing.size() == it->size()) {  // none of the alternatives' members given
-        std::string names;
-        for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;
-        ctx.add(ptr, "needs one of: " + names);
-      } else {
-        for (auto& e : firstErrors) ctx.add(e.pointer, e.message);
-      }
-    }
-  }
+  if (!checkType(s, v, ptr, ctx)) return;
+  checkValue(s, v, ptr, ctx);
+  checkNumber(s, v, ptr, ctx);
+  checkString(s, v, ptr, ctx);
+  if (!checkArray(s, v, ptr, ctx, walk)) return;
+  checkObject(s, v, ptr, ctx, walk);
+  checkAlternatives(s, ptr, ctx, tryBranch);
   if (auto it = s.find("allOf"); it != s.end()) {
     for (const auto& branch : *it) check(branch, doc, v, ptr, ctx);
   }
