@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <optional>
 
 #include "access_log.h"
 #include "encoding.h"
@@ -30,6 +31,123 @@ constexpr const char* kExposedHeaders =
     "X-Render-Ms, X-Shader-Variants-Compiled, Retry-After";
 constexpr const char* kAllowedRequestHeaders = "Content-Type, If-None-Match, X-Request-ID";
 
+// The error handler: a bare status (no body from a handler) gets its problem document.
+httplib::Server::HandlerResponse answerBareStatus(const httplib::Request&, httplib::Response& res) {
+  // Bodies set by a handler (problems, /readyz's 503) stand; fill in only bare statuses.
+  if (!res.body.empty()) return httplib::Server::HandlerResponse::Handled;
+  if (tl.requestId.empty()) tl.requestId = newRequestId();
+  std::string detail = statusTitle(res.status);
+  if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
+  writeProblem(res,
+               {res.status,
+                res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
+                statusTitle(res.status),
+                detail,
+                {},
+                {}},
+               tl.requestId);
+  return httplib::Server::HandlerResponse::Handled;
+}
+
+// The exception handler: logged, and answered with a 500 problem.
+void answerException(const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
+  std::string what = "unknown exception";
+  try {
+    std::rethrow_exception(ep);
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+  }
+  std::fprintf(stderr,
+               "{\"level\":\"error\",\"msg\":\"unhandled exception\",\"path\":%s,\"requestId\":%s,\"what\":%s}\n",
+               jsonEscape(req.path).c_str(), jsonEscape(tl.requestId).c_str(), jsonEscape(what).c_str());
+  writeProblem(res, {500, "internal", "Internal Server Error", "the server failed to handle the request", {}, {}},
+               tl.requestId);
+}
+
+// The admission and response cache gauges and counters, in the Prometheus text format.
+std::string admissionMetrics(const Admission::Counts& a, const ResponseCache::Counts& c) {
+  std::string out;
+  auto metric = [&](const char* name, const char* type, const char* help, double value) {
+    char number[32];
+    std::snprintf(number, sizeof number, "%.17g", value);
+    out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type + "\neffectd_" +
+           name + " " + number + "\n";
+  };
+  metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.", double(a.budgetBytes));
+  metric("memory_reserved_bytes", "gauge", "Bytes reserved by requests being served.", double(a.reservedBytes));
+  metric("memory_reserved_peak_bytes", "gauge", "Most bytes reserved at once since start.",
+         double(a.peakReservedBytes));
+  metric("heavy_running", "gauge", "Heavy computations running.", a.heavyRunning);
+  metric("admission_waiting", "gauge", "Requests waiting for memory or a heavy slot.", a.waiting);
+  metric("admission_waits_total", "counter", "Requests that had to wait before admission.", double(a.waited));
+  metric("admission_refused_busy_total", "counter", "Requests refused with 503 after waiting or with the queue full.",
+         double(a.refusedBusy));
+  metric("admission_refused_too_large_total", "counter", "Requests refused with 413: larger than the whole budget.",
+         double(a.refusedTooLarge));
+  metric("response_cache_hits_total", "counter", "Answers served from the response cache.", double(c.hits));
+  metric("response_cache_misses_total", "counter", "Cacheable answers that had to be computed.", double(c.misses));
+  metric("response_cache_evictions_total", "counter", "Cache entries evicted to stay within --response-cache-mb.",
+         double(c.evictions));
+  metric("response_cache_bytes", "gauge", "Bytes held by the response cache.", double(c.bytes));
+  return out;
+}
+
+// A route's methods as an Allow header value ("GET, HEAD").
+std::string allowHeader(const std::vector<std::string>& methods) {
+  std::string allow;
+  for (const auto& m : methods) allow += (allow.empty() ? "" : ", ") + m;
+  return allow;
+}
+
+// The answer to OPTIONS (RFC 9110 9.3.7), and to the CORS preflight from an allowed origin.
+void answerOptions(const std::string& allow, const std::string& corsOrigin, httplib::Response& res) {
+  res.status = 204;
+  res.set_header("Allow", allow + ", OPTIONS");
+  if (!corsOrigin.empty()) {
+    res.set_header("Access-Control-Allow-Methods", allow);
+    res.set_header("Access-Control-Allow-Headers", kAllowedRequestHeaders);
+    res.set_header("Access-Control-Max-Age", "600");
+  }
+}
+
+// A problem that also closes the connection: the unread body must not be taken for the next request.
+ApiError closing(int status, std::string slug, std::string title, std::string detail) {
+  return {status, std::move(slug), std::move(title), std::move(detail), {}, {{"Connection", "close"}}};
+}
+
+// A POST's Content-Length rules, before anything of its body is read: the problem that
+// refuses it, or none with `length` set.
+std::optional<ApiError> lengthProblem(const httplib::Request& req, size_t maxBodyBytes, unsigned long long& length) {
+  // Bodies must come with a Content-Length: chunked bodies bypass the payload limit in
+  // cpp-httplib 0.11.4 (CVE-2025-46728), so they are refused before anything is read.
+  if (req.has_header("Transfer-Encoding"))
+    return closing(411, "length-required", "Length Required",
+                   "chunked request bodies are not accepted; send Content-Length");
+  if (!req.has_header("Content-Length"))
+    return closing(411, "length-required", "Length Required", "a POST needs a Content-Length header");
+  const std::string cl = req.get_header_value("Content-Length");
+  char* end = nullptr;
+  length = std::strtoull(cl.c_str(), &end, 10);
+  if (cl.empty() || *end != '\0' || cl[0] == '-')
+    return closing(400, "bad-request", "Bad Request", "Content-Length is not a number");
+  if (length > maxBodyBytes)
+    return closing(413, "body-too-large", "Content Too Large",
+                   "request body of " + cl + " bytes exceeds the limit of " + std::to_string(maxBodyBytes) +
+                       " bytes (--max-body-bytes)");
+  return std::nullopt;
+}
+
+// The answer to a POST body of a media type the route does not take: which ones it does.
+ApiError unsupportedMediaType(const std::string& type, const std::string& accepted) {
+  return {415,
+          "unsupported-media-type",
+          "Unsupported Media Type",
+          "Content-Type '" + type + "' is not accepted here; use " + accepted,
+          {},
+          {{"Accept-Post", accepted}}};
+}
+
 }  // namespace
 
 std::string Service::allowedOrigin(const std::string& origin) const {
@@ -50,38 +168,8 @@ void Service::installHttpPolicy() {
     return preRoute(req, res) ? httplib::Server::HandlerResponse::Handled : httplib::Server::HandlerResponse::Unhandled;
   });
 
-  s.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
-    // Bodies set by a handler (problems, /readyz's 503) stand; fill in only bare statuses.
-    if (!res.body.empty()) return httplib::Server::HandlerResponse::Handled;
-    if (tl.requestId.empty()) tl.requestId = newRequestId();
-    std::string detail = statusTitle(res.status);
-    if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
-    writeProblem(res,
-                 {res.status,
-                  res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
-                  statusTitle(res.status),
-                  detail,
-                  {},
-                  {}},
-                 tl.requestId);
-    return httplib::Server::HandlerResponse::Handled;
-  }));
-
-  s.set_exception_handler([](const httplib::Request& req, httplib::Response& res, std::exception_ptr ep) {
-    std::string what = "unknown exception";
-    try {
-      std::rethrow_exception(ep);
-    } catch (const std::exception& e) {
-      what = e.what();
-    } catch (...) {
-    }
-    std::fprintf(stderr,
-                 "{\"level\":\"error\",\"msg\":\"unhandled exception\",\"path\":%s,\"requestId\":%s,\"what\":%s}\n",
-                 jsonEscape(req.path).c_str(), jsonEscape(tl.requestId).c_str(), jsonEscape(what).c_str());
-    writeProblem(res, {500, "internal", "Internal Server Error", "the server failed to handle the request", {}, {}},
-                 tl.requestId);
-  });
-
+  s.set_error_handler(httplib::Server::HandlerWithResponse(answerBareStatus));
+  s.set_exception_handler(answerException);
   s.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) { postRoute(res); });
 
   s.set_logger([this](const httplib::Request& req, const httplib::Response& res) { finishRequest(req, res); });
@@ -89,35 +177,7 @@ void Service::installHttpPolicy() {
   addReadinessCheck("admission", [this] {
     return admission_->queueFull() ? std::string("admission queue full (--admission-queue)") : std::string();
   });
-  metrics_.addSource([this] {
-    const Admission::Counts a = admission_->counts();
-    const ResponseCache::Counts c = cache_.counts();
-    std::string out;
-    auto metric = [&](const char* name, const char* type, const char* help, double value) {
-      char number[32];
-      std::snprintf(number, sizeof number, "%.17g", value);
-      out += std::string("# HELP effectd_") + name + " " + help + "\n# TYPE effectd_" + name + " " + type +
-             "\neffectd_" + name + " " + number + "\n";
-    };
-    metric("memory_budget_bytes", "gauge", "Bytes requests may reserve at their estimated peaks.",
-           double(a.budgetBytes));
-    metric("memory_reserved_bytes", "gauge", "Bytes reserved by requests being served.", double(a.reservedBytes));
-    metric("memory_reserved_peak_bytes", "gauge", "Most bytes reserved at once since start.",
-           double(a.peakReservedBytes));
-    metric("heavy_running", "gauge", "Heavy computations running.", a.heavyRunning);
-    metric("admission_waiting", "gauge", "Requests waiting for memory or a heavy slot.", a.waiting);
-    metric("admission_waits_total", "counter", "Requests that had to wait before admission.", double(a.waited));
-    metric("admission_refused_busy_total", "counter", "Requests refused with 503 after waiting or with the queue full.",
-           double(a.refusedBusy));
-    metric("admission_refused_too_large_total", "counter", "Requests refused with 413: larger than the whole budget.",
-           double(a.refusedTooLarge));
-    metric("response_cache_hits_total", "counter", "Answers served from the response cache.", double(c.hits));
-    metric("response_cache_misses_total", "counter", "Cacheable answers that had to be computed.", double(c.misses));
-    metric("response_cache_evictions_total", "counter", "Cache entries evicted to stay within --response-cache-mb.",
-           double(c.evictions));
-    metric("response_cache_bytes", "gauge", "Bytes held by the response cache.", double(c.bytes));
-    return out;
-  });
+  metrics_.addSource([this] { return admissionMetrics(admission_->counts(), cache_.counts()); });
 }
 
 // Before routing: the request's state, then every rule that can refuse it before its body is
@@ -143,23 +203,12 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
   };
   if (!route) return fail({404, "not-found", "Not Found", "no resource at " + req.path, {}, {}});
   tl.route = route->path;
-  bool allowed = false;
-  std::string allow;
-  for (const auto& m : route->methods) {
-    allowed = allowed || m == req.method;
-    allow += (allow.empty() ? "" : ", ") + m;
-  }
-  if (req.method == "OPTIONS") {  // RFC 9110 9.3.7, and the CORS preflight
-    res.status = 204;
-    res.set_header("Allow", allow + ", OPTIONS");
-    if (!tl.corsOrigin.empty()) {
-      res.set_header("Access-Control-Allow-Methods", allow);
-      res.set_header("Access-Control-Allow-Headers", kAllowedRequestHeaders);
-      res.set_header("Access-Control-Max-Age", "600");
-    }
+  const std::string allow = allowHeader(route->methods);
+  if (req.method == "OPTIONS") {
+    answerOptions(allow, tl.corsOrigin, res);
     return true;
   }
-  if (!allowed) {
+  if (std::find(route->methods.begin(), route->methods.end(), req.method) == route->methods.end()) {
     return fail({405,
                  "method-not-allowed",
                  "Method Not Allowed",
@@ -168,51 +217,14 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
                  {{"Allow", allow}}});
   }
   if (req.method != "POST") return false;
-
-  // Bodies must come with a Content-Length: chunked bodies bypass the payload limit in
-  // cpp-httplib 0.11.4 (CVE-2025-46728), so they are refused before anything is read.
-  if (req.has_header("Transfer-Encoding")) {
-    return fail({411,
-                 "length-required",
-                 "Length Required",
-                 "chunked request bodies are not accepted; send Content-Length",
-                 {},
-                 {{"Connection", "close"}}});
-  }
-  if (!req.has_header("Content-Length")) {
-    return fail({411,
-                 "length-required",
-                 "Length Required",
-                 "a POST needs a Content-Length header",
-                 {},
-                 {{"Connection", "close"}}});
-  }
-  const std::string cl = req.get_header_value("Content-Length");
-  char* end = nullptr;
-  unsigned long long length = std::strtoull(cl.c_str(), &end, 10);
-  if (cl.empty() || *end != '\0' || cl[0] == '-') {
-    return fail({400, "bad-request", "Bad Request", "Content-Length is not a number", {}, {{"Connection", "close"}}});
-  }
-  if (length > config_.limits.maxBodyBytes) {
-    return fail({413,
-                 "body-too-large",
-                 "Content Too Large",
-                 "request body of " + cl + " bytes exceeds the limit of " +
-                     std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
-                 {},
-                 {{"Connection", "close"}}});
-  }
+  unsigned long long length = 0;
+  if (auto problem = lengthProblem(req, config_.limits.maxBodyBytes, length)) return fail(*problem);
   std::string type = mediaType(req.get_header_value("Content-Type"));
   bool typeOk = (type == "application/json" && route->json) || route->binary.count(type);
   if (!typeOk) {
     std::string accepted = route->json ? "application/json" : "";
     for (const auto& [t, h] : route->binary) accepted += (accepted.empty() ? "" : ", ") + t;
-    return fail({415,
-                 "unsupported-media-type",
-                 "Unsupported Media Type",
-                 "Content-Type '" + type + "' is not accepted here; use " + accepted,
-                 {},
-                 {{"Accept-Post", accepted}}});
+    return fail(unsupportedMediaType(type, accepted));
   }
   // The body is read after this handler returns: its memory is reserved before it arrives.
   try {
