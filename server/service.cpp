@@ -49,6 +49,102 @@ json parseBody(const std::string& body) {
   }
 }
 
+// A JSON body that the route's schema refuses: a 400 problem naming the first violation and
+// listing them all.
+void throwIfInvalid(const std::vector<FieldError>& violations) {
+  if (violations.empty()) return;
+  std::string detail = violations.front().pointer + ": " + violations.front().message;
+  if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
+  throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
+}
+
+// Parses a JSON body into `body` and checks it against `schema`. Returns the canonical
+// request, "" when the answer is not cacheable (it asks for timings).
+std::string parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema,
+                             json& body) {
+  body = parseBody(text);
+  throwIfInvalid(schemas.validate(schema, body));
+  return asksForTimings(body) ? std::string() : "application/json\n" + body.dump();
+}
+
+// Writes `a` as the response, or a 304 when it carries an ETag that If-None-Match names.
+void sendAnswer(const CachedAnswer& a, const std::string& inm, httplib::Response& res) {
+  if (!a.etag.empty()) {  // "" = an answer with timings in it: no validator, never cached
+    res.set_header("ETag", a.etag);
+    if (etagMatches(inm, a.etag)) {
+      res.status = 304;
+      return;
+    }
+  }
+  for (const auto& [name, value] : a.headers) res.set_header(name, value);
+  if (!a.contentEncoding.empty()) res.set_header("Content-Encoding", a.contentEncoding);
+  res.set_content(a.body, a.contentType);
+}
+
+// Runs a binary body's handler into `answer`; returns its compute time.
+double answerBinary(const BinaryHandler& handler, const std::string& body, const RequestContext& ctx,
+                    CachedAnswer& answer) {
+  BinaryReply reply = handler(body, ctx);
+  if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
+  answer.body = std::move(reply.body);
+  answer.contentType = reply.contentType;
+  return reply.computeMs;
+}
+
+// Runs a JSON body's handler into `answer` (JSON, or the bytes it answers with instead) and
+// frees the request document; the run's own headers go to `res` only. Returns its compute time.
+double answerJson(const JsonHandler& handler, json& body, const RequestContext& ctx, CachedAnswer& answer,
+                  httplib::Response& res) {
+  JsonReply reply = handler(body, ctx);
+  body = json();  // the request document is no longer needed
+  if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
+  answer.headers.insert(reply.headers.begin(), reply.headers.end());
+  for (const auto& [name, value] : reply.runHeaders) res.set_header(name, value);
+  if (!reply.contentType.empty()) {
+    answer.body = std::move(reply.binary);
+    answer.contentType = reply.contentType;
+  } else {
+    answer.body = writeJson(reply.body);
+    answer.contentType = "application/json";
+  }
+  return reply.computeMs;
+}
+
+// Encodes an answer worth compressing in the negotiated coding.
+void encodeAnswer(Coding coding, CachedAnswer& answer) {
+  if (coding != Coding::kIdentity && compressible(answer.contentType) && answer.body.size() >= kMinCompressBytes) {
+    answer.body = encode(coding, answer.body);
+    answer.contentEncoding = codingName(coding);
+  }
+}
+
+using Probes = std::vector<std::pair<std::string, std::function<std::string()>>>;
+
+// /readyz: each component "ready" or why not (503 when one is not), and the info values.
+void answerReadiness(const Probes& readiness, const Probes& info, httplib::Response& res) {
+  json components = json::object();
+  bool ready = true;
+  for (const auto& [name, probe] : readiness) {
+    std::string why = probe();
+    components[name] = why.empty() ? json("ready") : json(why);
+    ready = ready && why.empty();
+  }
+  json out = {{"status", ready ? "ready" : "not ready"}, {"components", components}};
+  for (const auto& [name, value] : info) out["info"][name] = value();
+  res.status = ready ? 200 : 503;
+  res.set_content(out.dump(), "application/json");
+}
+
+// /v1/schemas/<name>: a contract document.
+void answerSchemaDocument(const httplib::Request& req, httplib::Response& res) {
+  auto it = resources().find("schemas/" + req.matches[1].str());
+  if (it == resources().end()) {
+    writeProblem(res, {404, "not-found", "Not Found", "no such schema", {}, {}}, tl.requestId);
+    return;
+  }
+  res.set_content(std::string(it->second), "application/schema+json");
+}
+
 }  // namespace
 
 namespace {
@@ -120,19 +216,8 @@ void Service::installCore() {
   addGet("/healthz", [](const httplib::Request&, httplib::Response& res) {
     res.set_content("{\"status\":\"ok\"}", "application/json");
   });
-  addGet("/readyz", [this](const httplib::Request&, httplib::Response& res) {
-    json components = json::object();
-    bool ready = true;
-    for (const auto& [name, probe] : readiness_) {
-      std::string why = probe();
-      components[name] = why.empty() ? json("ready") : json(why);
-      ready = ready && why.empty();
-    }
-    json out = {{"status", ready ? "ready" : "not ready"}, {"components", components}};
-    for (const auto& [name, value] : info_) out["info"][name] = value();
-    res.status = ready ? 200 : 503;
-    res.set_content(out.dump(), "application/json");
-  });
+  addGet("/readyz",
+         [this](const httplib::Request&, httplib::Response& res) { answerReadiness(readiness_, info_, res); });
   addGet("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
   });
@@ -141,14 +226,7 @@ void Service::installCore() {
   });
   // Route table entry "/v1/schemas/" stands for every schema document below it.
   addGet("/v1/schemas/", nullptr);
-  http_->Get(R"(/v1/schemas/([A-Za-z0-9_.-]+))", [](const httplib::Request& req, httplib::Response& res) {
-    auto it = resources().find("schemas/" + req.matches[1].str());
-    if (it == resources().end()) {
-      writeProblem(res, {404, "not-found", "Not Found", "no such schema", {}, {}}, tl.requestId);
-      return;
-    }
-    res.set_content(std::string(it->second), "application/schema+json");
-  });
+  http_->Get(R"(/v1/schemas/([A-Za-z0-9_.-]+))", answerSchemaDocument);
 }
 
 void Service::addJsonEndpoint(const std::string& path, const std::string& schema, JsonHandler handler,
@@ -194,38 +272,17 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
   const std::string requestKey = req.body.size() <= ResponseCache::kMaxAliasKeyBytes
                                      ? route.path + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
                                      : std::string();
-  auto send = [&](const CachedAnswer& a) {
-    if (!a.etag.empty()) {  // "" = an answer with timings in it: no validator, never cached
-      res.set_header("ETag", a.etag);
-      if (etagMatches(inm, a.etag)) {
-        res.status = 304;
-        return;
-      }
-    }
-    for (const auto& [name, value] : a.headers) res.set_header(name, value);
-    if (!a.contentEncoding.empty()) res.set_header("Content-Encoding", a.contentEncoding);
-    res.set_content(a.body, a.contentType);
-  };
   try {
     if (auto hit = cache_.byRequest(requestKey)) {
       res.set_header("Server-Timing", "cache;desc=\"hit\"");
-      return send(*hit);
+      return sendAnswer(*hit, inm, res);
     }
     const auto binary = route.binary.find(type);
     json body;
-    std::string canonical;  // what determines the answer; "" = not cacheable
-    if (binary != route.binary.end()) {
-      canonical = type + "\n" + req.body;
-    } else {
-      body = parseBody(req.body);
-      auto violations = schemas_->validate(route.schema, body);
-      if (!violations.empty()) {
-        std::string detail = violations.front().pointer + ": " + violations.front().message;
-        if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
-        throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
-      }
-      if (!asksForTimings(body)) canonical = "application/json\n" + body.dump();
-    }
+    // What determines the answer; "" = not cacheable.
+    const std::string canonical = binary != route.binary.end()
+                                      ? type + "\n" + req.body
+                                      : parseJsonRequest(req.body, *schemas_, route.schema, body);
     // Deterministic answers: a strong validator per representation (request and coding).
     std::string tag;
     if (!canonical.empty()) {
@@ -238,7 +295,7 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
       if (auto hit = cache_.byTag(tag)) {
         cache_.alias(requestKey, tag);
         res.set_header("Server-Timing", "cache;desc=\"hit\"");
-        return send(*hit);
+        return sendAnswer(*hit, inm, res);
       }
     }
     // Admission: the estimated peak is reserved until the answer has been written.
@@ -248,34 +305,11 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
 
     auto answer = std::make_shared<CachedAnswer>();
     answer->etag = tag;
-    double computeMs = 0;
-    if (binary != route.binary.end()) {
-      BinaryReply reply = binary->second.handler(req.body, ctx);
-      computeMs = reply.computeMs;
-      if (!reply.method.empty()) answer->headers["X-Effect-Method"] = reply.method;
-      answer->body = std::move(reply.body);
-      answer->contentType = reply.contentType;
-    } else {
-      JsonReply reply = route.json(body, ctx);
-      body = json();  // the request document is no longer needed
-      computeMs = reply.computeMs;
-      if (!reply.method.empty()) answer->headers["X-Effect-Method"] = reply.method;
-      answer->headers.insert(reply.headers.begin(), reply.headers.end());
-      for (const auto& [name, value] : reply.runHeaders) res.set_header(name, value);
-      if (!reply.contentType.empty()) {
-        answer->body = std::move(reply.binary);
-        answer->contentType = reply.contentType;
-      } else {
-        answer->body = writeJson(reply.body);
-        answer->contentType = "application/json";
-      }
-    }
-    if (coding != Coding::kIdentity && compressible(answer->contentType) && answer->body.size() >= kMinCompressBytes) {
-      answer->body = encode(coding, answer->body);
-      answer->contentEncoding = codingName(coding);
-    }
+    const double computeMs = binary != route.binary.end() ? answerBinary(binary->second.handler, req.body, ctx, *answer)
+                                                          : answerJson(route.json, body, ctx, *answer, res);
+    encodeAnswer(coding, *answer);
     res.set_header("Server-Timing", "compute;dur=" + std::to_string(computeMs));
-    send(*answer);
+    sendAnswer(*answer, inm, res);
     if (!tag.empty()) cache_.put(std::move(answer), requestKey);
   } catch (const ApiError& e) {
     res.headers.erase("ETag");  // problems are not cacheable representations
