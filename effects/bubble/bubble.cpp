@@ -96,14 +96,16 @@ dvec3 moveTowards(const dvec3& from, const dvec3& to, double s) {
   return from + (to - from) * s;
 }
 
-Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
-  if (auto e = validate(p)) return *e;
-  if (o.level < 0 || o.level > o.maxLevel)
-    return overLimit("/level", "must be in [0, " + std::to_string(o.maxLevel) + "]");
-  if (!(o.radius > 0) || !std::isfinite(o.radius) || o.radius > 1e6) return invalid("/radius", "must be in (0, 1e6]");
-  if (!std::isfinite(o.t)) return invalid("/t", "must be finite");
-  Stopwatch watch;
-  // Unit icosahedron, then subdivision with shared midpoints.
+namespace {
+
+// The icosphere's vertices on the unit sphere, and its triangles (three indices each).
+struct Sphere {
+  std::vector<dvec3> v;
+  std::vector<uint32_t> tri;
+};
+
+// Unit icosahedron, then `level` subdivisions with shared midpoints.
+Sphere subdivide(int level) {
   const double g = (1 + std::sqrt(5.0)) / 2;
   std::vector<dvec3> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
@@ -111,7 +113,7 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
   std::vector<uint32_t> tri = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
                                4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
                                6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
-  for (int l = 0; l < o.level; ++l) {
+  for (int l = 0; l < level; ++l) {
     std::unordered_map<uint64_t, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {
       uint64_t key = (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
@@ -128,7 +130,37 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
     }
     tri.swap(next);
   }
-  // Equirectangular UVs; triangles across the u = 0/1 seam and at the poles get own copies.
+  return {std::move(v), std::move(tri)};
+}
+
+// Equirectangular UVs (u, w) of one triangle's corners `x`: a triangle across the u = 0/1
+// seam gets u > 1 on its far side, and a pole the mean u of the other two corners.
+void cornerUVs(const dvec3* const x[3], double u[3], double w[3]) {
+  bool pole[3];
+  for (int c = 0; c < 3; ++c) {
+    pole[c] = std::abs(x[c]->y) > 1 - 1e-12;
+    u[c] = std::atan2(x[c]->z, x[c]->x) / (2 * kPi) + 0.5;
+    w[c] = 1.0 - std::acos(std::clamp(x[c]->y, -1.0, 1.0)) / kPi;
+  }
+  double lo = 1, hi = 0;
+  for (int c = 0; c < 3; ++c)
+    if (!pole[c]) lo = std::min(lo, u[c]), hi = std::max(hi, u[c]);
+  if (hi - lo > 0.5)
+    for (int c = 0; c < 3; ++c)
+      if (!pole[c] && u[c] < 0.5) u[c] += 1.0;
+  for (int c = 0; c < 3; ++c)
+    if (pole[c]) {  // the pole takes the mean u of the other two corners
+      double s = 0;
+      int n = 0;
+      for (int d = 0; d < 3; ++d)
+        if (!pole[d]) s += u[d], ++n;
+      u[c] = n ? s / n : 0.5;
+    }
+}
+
+// The sphere scaled to the radius, wobbled if asked, with equirectangular UVs; triangles
+// across the u = 0/1 seam and at the poles get own copies of their vertices.
+tangents::Mesh project(const Sphere& s, const Params& p, const MeshOptions& o) {
   tangents::Mesh m;
   std::unordered_map<uint64_t, uint32_t> copies;
   auto vertex = [&](uint32_t base, double u, double vv) {
@@ -137,39 +169,46 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
     std::memcpy(&bits, &fu, 4);
     auto [it, fresh] = copies.emplace((uint64_t(base) << 32) | bits, uint32_t(m.positions.size()));
     if (fresh) {
-      dvec3 x = v[base] * o.radius;
+      dvec3 x = s.v[base] * o.radius;
       if (o.wobble) x = wobble(p, x, o.t);
       m.positions.push_back(glm::vec3(x));
       m.uvs.push_back({fu, float(vv)});
     }
     return it->second;
   };
-  for (size_t t = 0; t < tri.size(); t += 3) {
+  for (size_t t = 0; t < s.tri.size(); t += 3) {
+    const dvec3* const x[3] = {&s.v[s.tri[t]], &s.v[s.tri[t + 1]], &s.v[s.tri[t + 2]]};
     double u[3], w[3];
-    bool pole[3];
-    for (int c = 0; c < 3; ++c) {
-      const dvec3& x = v[tri[t + c]];
-      pole[c] = std::abs(x.y) > 1 - 1e-12;
-      u[c] = std::atan2(x.z, x.x) / (2 * kPi) + 0.5;
-      w[c] = 1.0 - std::acos(std::clamp(x.y, -1.0, 1.0)) / kPi;
-    }
-    double lo = 1, hi = 0;
-    for (int c = 0; c < 3; ++c)
-      if (!pole[c]) lo = std::min(lo, u[c]), hi = std::max(hi, u[c]);
-    if (hi - lo > 0.5)
-      for (int c = 0; c < 3; ++c)
-        if (!pole[c] && u[c] < 0.5) u[c] += 1.0;
-    for (int c = 0; c < 3; ++c)
-      if (pole[c]) {  // the pole takes the mean u of the other two corners
-        double s = 0;
-        int n = 0;
-        for (int d = 0; d < 3; ++d)
-          if (!pole[d]) s += u[d], ++n;
-        u[c] = n ? s / n : 0.5;
-      }
-    for (int c = 0; c < 3; ++c) m.indices.push_back(vertex(tri[t + c], u[c], w[c]));
+    cornerUVs(x, u, w);
+    for (int c = 0; c < 3; ++c) m.indices.push_back(vertex(s.tri[t + c], u[c], w[c]));
   }
-  tangents::Options to;  // normals after the wobble: angle-weighted, smooth across the seam
+  return m;
+}
+
+// The camera-dependent shading of every vertex: the final vector (eqn 8) and the rim (eqn 10).
+void shade(const Params& p, const MeshOptions& o, Mesh& out) {
+  for (size_t i = 0; i < out.positions.size(); ++i) {
+    dvec3 I = unitOr(dvec3(out.positions[i]) - *o.camera, {0, 0, -1}), N(out.normals[i]);
+    out.finalVectors.push_back(glm::vec3(finalVector(p, I, N, o.t)));
+    out.rim.push_back(float(rim(p, glm::dot(N, -I))));
+  }
+}
+
+}  // namespace
+
+Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
+  if (auto e = validate(p)) return *e;
+  if (o.level < 0 || o.level > o.maxLevel)
+    return overLimit("/level", "must be in [0, " + std::to_string(o.maxLevel) + "]");
+  if (!(o.radius > 0) || !std::isfinite(o.radius) || o.radius > 1e6) return invalid("/radius", "must be in (0, 1e6]");
+  if (!std::isfinite(o.t)) return invalid("/t", "must be finite");
+  Stopwatch watch;
+  // Unit icosahedron, then subdivision with shared midpoints.
+  const Sphere sphere = subdivide(o.level);
+  // Equirectangular UVs; triangles across the u = 0/1 seam and at the poles get own copies.
+  const tangents::Mesh m = project(sphere, p, o);
+  // Frames: normals after the wobble, angle-weighted and smooth across the seam.
+  tangents::Options to;
   to.parallel = o.parallel;
   auto frames = tangents::generate(m, to);
   if (!frames.ok()) return frames.error();
@@ -183,13 +222,7 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
   out.normals = f.normals;
   out.tangents = f.tangents;
   out.indices = f.indices;
-  if (o.camera) {
-    for (size_t i = 0; i < out.positions.size(); ++i) {
-      dvec3 I = unitOr(dvec3(out.positions[i]) - *o.camera, {0, 0, -1}), N(out.normals[i]);
-      out.finalVectors.push_back(glm::vec3(finalVector(p, I, N, o.t)));
-      out.rim.push_back(float(rim(p, glm::dot(N, -I))));
-    }
-  }
+  if (o.camera) shade(p, o, out);
   out.stats.method = "icosphere";
   out.stats.elapsedMs = watch.ms();
   out.stats.counters = {{"level", double(o.level)},
