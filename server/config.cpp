@@ -45,6 +45,26 @@ std::function<bool(const std::string&, Config&)> limitField(size_t Limits::*fiel
   };
 }
 
+// --cors-origins: a comma list of origins (scheme://host[:port]) or "*"; spaces around an
+// entry and trailing slashes are dropped.
+bool setCorsOrigins(const std::string& s, Config& c) {
+  c.corsOrigins.clear();
+  size_t pos = 0;
+  while (pos <= s.size()) {
+    size_t end = std::min(s.find(',', pos), s.size());
+    std::string o = s.substr(pos, end - pos);
+    while (!o.empty() && o.front() == ' ') o.erase(0, 1);
+    while (!o.empty() && (o.back() == ' ' || o.back() == '/')) o.pop_back();
+    if (!o.empty()) {
+      if (o != "*" && o.find("://") == std::string::npos) return false;
+      c.corsOrigins.push_back(o);
+    }
+    pos = end + 1;
+  }
+  return true;
+}
+
+// Long because it is the flag table, one entry per flag in --help order: it reads best whole.
 const std::vector<Option>& options() {
   static const std::vector<Option> opts = {
       {"host", "EFFECTD_HOST", "address to listen on (default 127.0.0.1)",
@@ -121,22 +141,7 @@ const std::vector<Option>& options() {
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
        "none)",
-       [](const std::string& s, Config& c) {
-         c.corsOrigins.clear();
-         size_t pos = 0;
-         while (pos <= s.size()) {
-           size_t end = std::min(s.find(',', pos), s.size());
-           std::string o = s.substr(pos, end - pos);
-           while (!o.empty() && o.front() == ' ') o.erase(0, 1);
-           while (!o.empty() && (o.back() == ' ' || o.back() == '/')) o.pop_back();
-           if (!o.empty()) {
-             if (o != "*" && o.find("://") == std::string::npos) return false;
-             c.corsOrigins.push_back(o);
-           }
-           pos = end + 1;
-         }
-         return true;
-       }},
+       setCorsOrigins},
   };
   return opts;
 }
