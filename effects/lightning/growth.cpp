@@ -48,6 +48,8 @@ struct Candidate {
   double charge;   // kCharges: sum over bolt cells of 1/r
 };
 
+bool adjacent(Cell a, Cell b) { return std::abs(a.x - b.x) <= 1 && std::abs(a.y - b.y) <= 1; }
+
 class Grower {
  public:
   Grower(const Params& p, Bolt& bolt) : p_(p), g_{p.width, p.height, &p.obstacles}, bolt_(bolt) {
@@ -75,6 +77,11 @@ class Grower {
   void logWeights(std::vector<double>& out);
   double boundary(Cell c);
   std::optional<Error> growSegment(size_t k);
+  std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
+  std::unique_ptr<detail::Laplace> dbmProblem(Cell target) const;
+  void reviveFrontier(int from, size_t segmentFirstNode);
+  void weighCandidates(std::vector<double>& logPhi);
+  void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
   double stepError(const std::vector<double>& logPhi);
 
   const Params& p_;
@@ -277,13 +284,9 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   return 0.5 * (tv + outside);
 }
 
-std::optional<Error> Grower::growSegment(size_t k) {
-  const Cell target = p_.targets[k];
-  const int from = k == 0 ? 0 : int(bolt_.nodes.size()) - 1;  // previous target's node
-  const std::string field = "/targets/" + std::to_string(k);
-  const Cell fromCell = bolt_.nodes[size_t(from)].cell;
-
-  // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
+// The path from the segment's start to its target on the grid with the bolt so far blocked,
+// except the start: empty when the target cannot be reached. Its turns guide the growth.
+std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
   std::vector<uint8_t> blocked = p_.obstacles;
   if (k > 0) {
     if (blocked.empty()) blocked.assign(nodeOf_.size(), 0);
@@ -293,6 +296,61 @@ std::optional<Error> Grower::growSegment(size_t k) {
   Stopwatch guideWatch;
   std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
+  return path;
+}
+
+// The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1.
+std::unique_ptr<detail::Laplace> Grower::dbmProblem(Cell target) const {
+  auto lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
+  for (int y = 0; y < p_.height; ++y)
+    for (int x = 0; x < p_.width; ++x)
+      if (g_.blocked(x, y)) lap->fix(x, y, 0.0);
+  for (const Node& n : bolt_.nodes) lap->fix(n.cell.x, n.cell.y, 0.0);
+  lap->fix(target.x, target.y, 1.0);
+  return lap;
+}
+
+// Every candidate expired or the sub-bolt is boxed in: the candidates around the segment's
+// start and every node it added come back.
+void Grower::reviveFrontier(int from, size_t segmentFirstNode) {
+  bolt_.stats.counters["revivals"] += 1;
+  addCandidatesAround(from);
+  for (size_t n = segmentFirstNode; n < bolt_.nodes.size(); ++n) addCandidatesAround(int(n));
+}
+
+// log Phi of every candidate for this step (after the DBM solve), and its error against the
+// converged solution when measured.
+void Grower::weighCandidates(std::vector<double>& logPhi) {
+  if (laplace_) {
+    double res = 0;
+    solverIterations_ += laplace_->solve(p_.solver, p_.tolerance, &res);
+    lastResidual_ = res;
+  }
+  logWeights(logPhi);
+  if (reference_) {
+    errorSum_ += stepError(logPhi);
+    ++errorSteps_;
+  }
+}
+
+// Seed 002 section 3.2: move on to the next waypoint early when the newest bolt cell is next
+// to the current one or sees the next one.
+void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp) {
+  while (wp + 1 < waypoints.size() &&
+         (adjacent(newest, waypoints[wp]) || detail::lineOfSight(g_, newest, waypoints[wp + 1]))) {
+    anchor_ = newest;
+    attractor_ = waypoints[++wp];
+  }
+}
+
+std::optional<Error> Grower::growSegment(size_t k) {
+  const Cell target = p_.targets[k];
+  const int from = k == 0 ? 0 : int(bolt_.nodes.size()) - 1;  // previous target's node
+  const std::string field = "/targets/" + std::to_string(k);
+  const Cell fromCell = bolt_.nodes[size_t(from)].cell;
+
+  // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
+  std::vector<Cell> path = guidePath(k, fromCell, target);
   if (path.empty())
     return unsatisfiable(field, "target is unreachable from " + std::string(k ? "the previous target" : "start"));
   const bool useGuide =
@@ -302,23 +360,11 @@ std::optional<Error> Grower::growSegment(size_t k) {
   size_t wp = 0;
   anchor_ = fromCell;
   attractor_ = waypoints[0];
-
-  // The DBM problem of this segment: bolt so far, obstacles (and outside) at 0, target at 1.
-  auto dbmProblem = [&] {
-    auto lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
-    for (int y = 0; y < p_.height; ++y)
-      for (int x = 0; x < p_.width; ++x)
-        if (g_.blocked(x, y)) lap->fix(x, y, 0.0);
-    for (const Node& n : bolt_.nodes) lap->fix(n.cell.x, n.cell.y, 0.0);
-    lap->fix(target.x, target.y, 1.0);
-    return lap;
-  };
-  if (p_.method == Method::kDbm) laplace_ = dbmProblem();
-  if (p_.measureError) reference_ = dbmProblem();
+  if (p_.method == Method::kDbm) laplace_ = dbmProblem(target);
+  if (p_.measureError) reference_ = dbmProblem(target);
 
   // Chain lightning: the new segment grows from the previous target only.
   for (size_t i = cands_.size(); i-- > 0;) removeCandidate(i);
-  auto adjacent = [](Cell a, Cell b) { return std::abs(a.x - b.x) <= 1 && std::abs(a.y - b.y) <= 1; };
   int last = from;
   std::vector<double> logPhi, scratch;
   size_t segmentFirstNode = bolt_.nodes.size();
@@ -329,33 +375,15 @@ std::optional<Error> Grower::growSegment(size_t k) {
     ++step_;
     expireCandidates();
     if (cands_.empty()) {
-      // Every candidate expired or the sub-bolt is boxed in: revive the segment's frontier.
-      bolt_.stats.counters["revivals"] += 1;
-      addCandidatesAround(from);
-      for (size_t n = segmentFirstNode; n < bolt_.nodes.size(); ++n) addCandidatesAround(int(n));
+      reviveFrontier(from, segmentFirstNode);
       if (cands_.empty()) return unsatisfiable(field, "the bolt enclosed itself before reaching the target");
     }
-    if (laplace_) {
-      double res = 0;
-      solverIterations_ += laplace_->solve(p_.solver, p_.tolerance, &res);
-      lastResidual_ = res;
-    }
-    logWeights(logPhi);
-    if (reference_) {
-      errorSum_ += stepError(logPhi);
-      ++errorSteps_;
-    }
+    weighCandidates(logPhi);
     size_t pick = sample(logPhi, p_.eta, rng_, scratch);
     Candidate chosen = cands_[pick];
     last = addNode(chosen.cell, chosen.parent);
     addCandidatesAround(last);
-    // Seed 002 section 3.2: move on to the next waypoint early when the newest bolt cell is
-    // next to the current one or sees the next one.
-    while (wp + 1 < waypoints.size() &&
-           (adjacent(chosen.cell, waypoints[wp]) || detail::lineOfSight(g_, chosen.cell, waypoints[wp + 1]))) {
-      anchor_ = chosen.cell;
-      attractor_ = waypoints[++wp];
-    }
+    followWaypoints(chosen.cell, waypoints, wp);
   }
   ++step_;
   reserved_[g_.index(target)] = 0;
