@@ -132,24 +132,22 @@ int accessorIndex(const json& value, const std::string& pointer) {
   return int(index);
 }
 
-// Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
-// Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
-bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const RequestContext& ctx, double& ms) {
-  const Config& config = ctx.config;
-  json& attrs = prim["attributes"];
-  if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
+// The mesh of one triangle primitive: its POSITION, TEXCOORD_0 and NORMAL (where given,
+// `hadNormals`) accessors, and its indices (or the vertices in order when it has none).
+tg::Mesh readPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::string& at, size_t maxVertices,
+                       bool& hadNormals) {
   tg::Mesh mesh;
   std::vector<float> pos, nrm, uv;
   check(glb::readFloats(asset, accessorIndex(attrs["POSITION"], at + "/attributes/POSITION"), 3, pos));
   check(glb::readFloats(asset, accessorIndex(attrs["TEXCOORD_0"], at + "/attributes/TEXCOORD_0"), 2, uv));
-  const bool hadNormals = attrs.contains("NORMAL");
+  hadNormals = attrs.contains("NORMAL");
   if (hadNormals) check(glb::readFloats(asset, accessorIndex(attrs["NORMAL"], at + "/attributes/NORMAL"), 3, nrm));
   const size_t n = pos.size() / 3;
   if (uv.size() / 2 != n || (hadNormals && nrm.size() / 3 != n))
     throw gltfProblem(422, {at + "/attributes", "attribute accessors must have the same count"});
-  if (n > config.limits.maxMeshVertices)
-    throw gltfProblem(413, {at + "/attributes/POSITION", std::to_string(n) + " vertices exceed the limit of " +
-                                                             std::to_string(config.limits.maxMeshVertices)});
+  if (n > maxVertices)
+    throw gltfProblem(413, {at + "/attributes/POSITION",
+                            std::to_string(n) + " vertices exceed the limit of " + std::to_string(maxVertices)});
   mesh.positions.resize(n);
   mesh.uvs.resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -166,18 +164,53 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     mesh.indices.resize(n - n % 3);
     for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
   }
+  return mesh;
+}
+
+// A library error on a primitive's mesh, as a problem at the accessor it came from.
+[[noreturn]] void throwPrimitiveError(const effects::Error& e, const std::string& at) {
+  std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION"
+                     : e.field.rfind("/uvs", 0) == 0     ? "TEXCOORD_0"
+                     : e.field.rfind("/normals", 0) == 0 ? "NORMAL"
+                                                         : "";
+  std::string pointer = attr.empty() ? at + "/indices" : at + "/attributes/" + attr;
+  throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422, {pointer, e.message});
+}
+
+// The vertices were split (`remap`): every vertex attribute but those being written (and every
+// morph target) gets a remapped copy of its accessor, and the primitive new indices.
+void remapPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::string& at, const tg::Output& out,
+                    bool hadNormals) {
+  for (auto& [name, index] : attrs.items()) {
+    if (name == "TANGENT" || (name == "NORMAL" && !hadNormals)) continue;
+    int copy = 0;
+    check(glb::addRemappedAccessor(asset, accessorIndex(index, at + "/attributes/" + name), out.remap, copy));
+    index = copy;
+  }
+  if (prim.contains("targets") && prim["targets"].is_array())
+    for (size_t ti = 0; ti < prim["targets"].size(); ++ti)
+      for (auto& [name, index] : prim["targets"][ti].items()) {
+        int copy = 0;
+        const std::string pointer = at + "/targets/" + std::to_string(ti) + "/" + name;
+        check(glb::addRemappedAccessor(asset, accessorIndex(index, pointer), out.remap, copy));
+        index = copy;
+      }
+  prim["indices"] = glb::addIndexAccessor(asset, out.indices);
+}
+
+// Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
+// Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
+bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const RequestContext& ctx, double& ms) {
+  const Config& config = ctx.config;
+  json& attrs = prim["attributes"];
+  if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
+  bool hadNormals = false;
+  const tg::Mesh mesh = readPrimitive(asset, prim, attrs, at, config.limits.maxMeshVertices, hadNormals);
+  const size_t n = mesh.positions.size();
   tg::Options opt = options(ctx, tg::Mode::kMikkTSpace);
   opt.missingNormals = tg::NormalRule::kFlat;
   auto r = tg::generate(mesh, opt);
-  if (!r.ok()) {
-    const effects::Error& e = r.error();
-    std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION"
-                       : e.field.rfind("/uvs", 0) == 0     ? "TEXCOORD_0"
-                       : e.field.rfind("/normals", 0) == 0 ? "NORMAL"
-                                                           : "";
-    std::string pointer = attr.empty() ? at + "/indices" : at + "/attributes/" + attr;
-    throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422, {pointer, e.message});
-  }
+  if (!r.ok()) throwPrimitiveError(r.error(), at);
   tg::Output& out = r.value();
   flipW(out);  // glTF's UV origin is top-left
   ms += out.stats.elapsedMs;
@@ -186,23 +219,7 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
   tangents.reserve(out.tangents.size() * 4);
   for (const auto& t : out.tangents) tangents.insert(tangents.end(), {t.x, t.y, t.z, t.w});
   const bool identity = out.remap.size() == n;
-  if (!identity) {  // every vertex attribute (and morph target) follows the split
-    for (auto& [name, index] : attrs.items()) {
-      if (name == "TANGENT" || (name == "NORMAL" && !hadNormals)) continue;
-      int copy = 0;
-      check(glb::addRemappedAccessor(asset, accessorIndex(index, at + "/attributes/" + name), out.remap, copy));
-      index = copy;
-    }
-    if (prim.contains("targets") && prim["targets"].is_array())
-      for (size_t ti = 0; ti < prim["targets"].size(); ++ti)
-        for (auto& [name, index] : prim["targets"][ti].items()) {
-          int copy = 0;
-          const std::string pointer = at + "/targets/" + std::to_string(ti) + "/" + name;
-          check(glb::addRemappedAccessor(asset, accessorIndex(index, pointer), out.remap, copy));
-          index = copy;
-        }
-    prim["indices"] = glb::addIndexAccessor(asset, out.indices);
-  }
+  if (!identity) remapPrimitive(asset, prim, attrs, at, out, hadNormals);  // every attribute follows the split
   if (!hadNormals) {
     std::vector<float> normals;
     for (const auto& v : out.normals) normals.insert(normals.end(), {v.x, v.y, v.z});
