@@ -70,47 +70,42 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
   return worst;
 }
 
-Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
-  if (auto e = validate(fog)) return *e;
-  const bool twoD = fog.type == FogType::kHeight;
-  double start = o.rangeStart.value_or(0.0);
-  double end = o.rangeEnd ? *o.rangeEnd : completeDistance(fog, o.cameraHeight);
-  if (!std::isfinite(start) || start < 0.0) return invalid("/range/0", "must be a finite distance >= 0");
-  if (!o.rangeEnd && !(std::isfinite(end) && end > start))
-    return unsatisfiable("/range", "this fog never reaches 1/255 within a finite distance; give range explicitly");
-  if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
+namespace {
 
-  constexpr int kSub1D = 8, kSub2D = 4;
-  const int sub = twoD ? kSub2D : kSub1D;
-  auto entries = [&](size_t n, size_t m) { return n * (twoD ? m : 1); };
-  auto measure = [&](Table& t) {
-    Stopwatch w;
-    t.maxError = measureTableError(fog, t, o.cameraHeight, sub, &t.errorAtDistance);
-    t.stats.counters["errorMs"] = w.ms();
-    t.stats.error = t.maxError;
-    t.stats.errorMetric = "max |lerp(table) - f| over " + std::to_string(sub) + "x denser sampling";
-    t.stats.reference = "exact closed form";
-  };
+// Table entries for N distances (and M elevations, for height fog's 2D tables).
+size_t entries(bool twoD, size_t n, size_t m) { return n * (twoD ? m : 1); }
 
-  if (o.size != 0) {
-    size_t m = twoD ? (o.elevations ? o.elevations : o.size) : 1;
-    if (o.size < 2 || (twoD && m < 2)) return invalid("/size", "must be >= 2");
-    if (entries(o.size, m) > o.maxSize)
-      return overLimit("/size", "table of " + std::to_string(entries(o.size, m)) + " entries exceeds the limit of " +
-                                    std::to_string(o.maxSize));
-    auto t = sized(fog, o, o.size, m, start, end);
-    if (o.measureError) measure(t.value());
-    return t;
-  }
+// Measures a table's interpolation error against the exact fog at `sub`x denser sampling.
+void measure(const Fog& fog, const TableOptions& o, int sub, Table& t) {
+  Stopwatch w;
+  t.maxError = measureTableError(fog, t, o.cameraHeight, sub, &t.errorAtDistance);
+  t.stats.counters["errorMs"] = w.ms();
+  t.stats.error = t.maxError;
+  t.stats.errorMetric = "max |lerp(table) - f| over " + std::to_string(sub) + "x denser sampling";
+  t.stats.reference = "exact closed form";
+}
 
-  // Smallest N with error <= maxError: double N until it meets the bound, then bisect.
-  // (Height fog tables stay square.) The error of linear interpolation falls like 1/N^2 for
-  // smooth f, so the search ends after a handful of measurements.
+// The table of the size asked for (o.size, and o.elevations for height fog).
+Result<Table> fixedSize(const Fog& fog, const TableOptions& o, bool twoD, int sub, double start, double end) {
+  size_t m = twoD ? (o.elevations ? o.elevations : o.size) : 1;
+  if (o.size < 2 || (twoD && m < 2)) return invalid("/size", "must be >= 2");
+  if (entries(twoD, o.size, m) > o.maxSize)
+    return overLimit("/size", "table of " + std::to_string(entries(twoD, o.size, m)) +
+                                  " entries exceeds the limit of " + std::to_string(o.maxSize));
+  auto t = sized(fog, o, o.size, m, start, end);
+  if (o.measureError) measure(fog, o, sub, t.value());
+  return t;
+}
+
+// Smallest N with error <= maxError: double N until it meets the bound, then bisect.
+// (Height fog tables stay square.) The error of linear interpolation falls like 1/N^2 for
+// smooth f, so the search ends after a handful of measurements.
+Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD, int sub, double start, double end) {
   if (!(o.maxError > 0.0)) return invalid("/maxError", "must be > 0 when size is not given");
   Stopwatch total;
   auto errorFor = [&](size_t n) {
     auto t = sized(fog, o, n, twoD ? n : 1, start, end);
-    measure(t.value());
+    measure(fog, o, sub, t.value());
     return t;
   };
   const size_t cap = twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize;  // largest N allowed
@@ -119,7 +114,7 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   int measurements = 1;
   while (best.value().maxError > o.maxError) {
     lo = hi;
-    if (entries(hi * 2, hi * 2) > o.maxSize) {
+    if (entries(twoD, hi * 2, hi * 2) > o.maxSize) {
       if (cap <= hi) return unsatisfiable("/maxError", "not reachable within the table size limit");
       hi = cap;
     } else {
@@ -145,6 +140,24 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   best.value().stats.counters["searchMeasurements"] = measurements;
   best.value().stats.counters["searchMs"] = total.ms();
   return best;
+}
+
+}  // namespace
+
+Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
+  if (auto e = validate(fog)) return *e;
+  const bool twoD = fog.type == FogType::kHeight;
+  double start = o.rangeStart.value_or(0.0);
+  double end = o.rangeEnd ? *o.rangeEnd : completeDistance(fog, o.cameraHeight);
+  if (!std::isfinite(start) || start < 0.0) return invalid("/range/0", "must be a finite distance >= 0");
+  if (!o.rangeEnd && !(std::isfinite(end) && end > start))
+    return unsatisfiable("/range", "this fog never reaches 1/255 within a finite distance; give range explicitly");
+  if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
+
+  constexpr int kSub1D = 8, kSub2D = 4;
+  const int sub = twoD ? kSub2D : kSub1D;
+  if (o.size != 0) return fixedSize(fog, o, twoD, sub, start, end);
+  return smallestForError(fog, o, twoD, sub, start, end);
 }
 
 }  // namespace effects::fog
