@@ -14,38 +14,63 @@ void jitterOf(uint64_t seed, int node, double& u, double& v) {
   v = r.uniform();
 }
 
+// The bolt as a tree: each node's children, the height of its subtree, and its tree distance
+// from the main channel.
+struct Tree {
+  std::vector<std::vector<int>> children;
+  std::vector<int> depth, fromMain;
+};
+
+Tree treeOf(const Bolt& bolt) {
+  const size_t n = bolt.nodes.size();
+  Tree t;
+  t.children.resize(n);
+  for (size_t i = 1; i < n; ++i) t.children[size_t(bolt.nodes[i].parent)].push_back(int(i));
+  // Height of each subtree (nodes are in growth order: children come after parents).
+  t.depth.assign(n, 0);
+  for (size_t i = n; i-- > 1;) {
+    int p = bolt.nodes[i].parent;
+    t.depth[size_t(p)] = std::max(t.depth[size_t(p)], t.depth[i] + 1);
+  }
+  // Tree distance from the main channel.
+  t.fromMain.assign(n, -1);
+  for (int m : bolt.mainChannel) t.fromMain[size_t(m)] = 0;
+  for (size_t i = 1; i < n; ++i)
+    if (t.fromMain[i] < 0) t.fromMain[i] = t.fromMain[size_t(bolt.nodes[i].parent)] + 1;
+  return t;
+}
+
+// The child with the deepest subtree (ties: the earliest), which continues its parent's
+// line; -1 for a leaf.
+int deepestChild(const Tree& t, size_t node) {
+  int best = -1;
+  for (int d : t.children[node])
+    if (best < 0 || t.depth[size_t(d)] > t.depth[size_t(best)]) best = d;
+  return best;
+}
+
+// A node's polyline vertex: its cell's centre, jittered, and the intensity of its branch.
+Vertex vertexOf(const Bolt& bolt, const ShapeParams& s, const Tree& t, int node) {
+  const Node& nd = bolt.nodes[size_t(node)];
+  double u = 0.5, v = 0.5;
+  if (s.jitter > 0) jitterOf(s.jitterSeed, node, u, v);
+  Vertex out;
+  out.x = float(nd.cell.x + 0.5 + s.jitter * (u - 0.5));
+  out.y = float(nd.cell.y + 0.5 + s.jitter * (v - 0.5));
+  out.step = nd.step;
+  out.node = node;
+  out.intensity = t.fromMain[size_t(node)] == 0
+                      ? 1.0f
+                      : float(s.branchIntensity * std::exp(-(t.fromMain[size_t(node)] - 1) / s.branchFalloff));
+  return out;
+}
+
 }  // namespace
 
 std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& s) {
   const size_t n = bolt.nodes.size();
-  std::vector<std::vector<int>> children(n);
-  for (size_t i = 1; i < n; ++i) children[size_t(bolt.nodes[i].parent)].push_back(int(i));
-  // Height of each subtree (nodes are in growth order: children come after parents).
-  std::vector<int> depth(n, 0);
-  for (size_t i = n; i-- > 1;) {
-    int p = bolt.nodes[i].parent;
-    depth[size_t(p)] = std::max(depth[size_t(p)], depth[i] + 1);
-  }
-  // Tree distance from the main channel.
-  std::vector<int> fromMain(n, -1);
-  for (int m : bolt.mainChannel) fromMain[size_t(m)] = 0;
-  for (size_t i = 1; i < n; ++i)
-    if (fromMain[i] < 0) fromMain[i] = fromMain[size_t(bolt.nodes[i].parent)] + 1;
-
-  auto vertex = [&](int node) {
-    const Node& nd = bolt.nodes[size_t(node)];
-    double u = 0.5, v = 0.5;
-    if (s.jitter > 0) jitterOf(s.jitterSeed, node, u, v);
-    Vertex out;
-    out.x = float(nd.cell.x + 0.5 + s.jitter * (u - 0.5));
-    out.y = float(nd.cell.y + 0.5 + s.jitter * (v - 0.5));
-    out.step = nd.step;
-    out.node = node;
-    out.intensity = fromMain[size_t(node)] == 0
-                        ? 1.0f
-                        : float(s.branchIntensity * std::exp(-(fromMain[size_t(node)] - 1) / s.branchFalloff));
-    return out;
-  };
+  const Tree tree = treeOf(bolt);
+  auto vertex = [&](int node) { return vertexOf(bolt, s, tree, node); };
 
   std::vector<Polyline> out;
   std::vector<uint8_t> onMain(n, 0);
@@ -59,29 +84,14 @@ std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& s) {
   out.push_back(std::move(main));
   // Branches: every child that is not the continuation of its parent's line starts one.
   // The continuation of a branch is its child with the deepest subtree (ties: earliest).
-  std::vector<int> stack;
   for (size_t i = 0; i < n; ++i) {
-    for (int c : children[i]) {
+    for (int c : tree.children[i]) {
       if (onMain[size_t(c)]) continue;
-      bool continuation = false;
-      if (!onMain[i]) {
-        int best = -1;
-        for (int d : children[i])
-          if (best < 0 || depth[size_t(d)] > depth[size_t(best)]) best = d;
-        continuation = best == c;
-      }
-      if (continuation) continue;
+      if (!onMain[i] && deepestChild(tree, i) == c) continue;
       Polyline b;
       b.width = float(s.branchWidth);
       b.vertices.push_back(vertex(int(i)));
-      for (int cur = c;;) {
-        b.vertices.push_back(vertex(cur));
-        int next = -1;
-        for (int d : children[size_t(cur)])
-          if (next < 0 || depth[size_t(d)] > depth[size_t(next)]) next = d;
-        if (next < 0) break;
-        cur = next;
-      }
+      for (int cur = c; cur >= 0; cur = deepestChild(tree, size_t(cur))) b.vertices.push_back(vertex(cur));
       out.push_back(std::move(b));
     }
   }
