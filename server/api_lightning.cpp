@@ -53,6 +53,53 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::stri
 
 lt::Cell cellOf(const json& j) { return {j[0].get<int>(), j[1].get<int>()}; }
 
+// "polylines": per line its channel, width, flat [x, y, ...] points, and per point the step and intensity.
+json polylinesJson(const std::vector<lt::Polyline>& polylines) {
+  json lines = json::array();
+  for (const auto& l : polylines) {
+    json xy = json::array(), step = json::array(), intensity = json::array();
+    for (const auto& v : l.vertices) {
+      xy.push_back(v.x);
+      xy.push_back(v.y);
+      step.push_back(v.step);
+      intensity.push_back(v.intensity);
+    }
+    lines.push_back({{"channel", l.main ? "main" : "branch"},
+                     {"width", l.width},
+                     {"points", std::move(xy)},
+                     {"step", std::move(step)},
+                     {"intensity", std::move(intensity)}});
+  }
+  return lines;
+}
+
+// "cells": the bolt's cells in growth order, flat [x, y, ...].
+json cellsJson(const lt::Bolt& bolt) {
+  json c = json::array();
+  for (const auto& n : bolt.nodes) {
+    c.push_back(n.cell.x);
+    c.push_back(n.cell.y);
+  }
+  return c;
+}
+
+// "tree": each node's parent and step, and the main channel's nodes.
+json treeJson(const lt::Bolt& bolt) {
+  json parent = json::array(), step = json::array();
+  for (const auto& n : bolt.nodes) {
+    parent.push_back(n.parent);
+    step.push_back(n.step);
+  }
+  return {{"parent", std::move(parent)}, {"step", std::move(step)}, {"mainChannel", bolt.mainChannel}};
+}
+
+// "guide": the A* waypoints, [[x, y], ...].
+json guideJson(const lt::Bolt& bolt) {
+  json g = json::array();
+  for (const auto& c : bolt.guide) g.push_back({c.x, c.y});
+  return g;
+}
+
 }  // namespace
 
 LightningRequest parseLightning(const json& body, const Config& config, const std::string& at) {
@@ -120,45 +167,10 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   out["cellCount"] = bolt.nodes.size();
   out["steps"] = bolt.nodes.back().step;
 
-  if (include.has("polylines")) {
-    json lines = json::array();
-    for (const auto& l : lt::polylines(bolt, request.shape)) {
-      json xy = json::array(), step = json::array(), intensity = json::array();
-      for (const auto& v : l.vertices) {
-        xy.push_back(v.x);
-        xy.push_back(v.y);
-        step.push_back(v.step);
-        intensity.push_back(v.intensity);
-      }
-      lines.push_back({{"channel", l.main ? "main" : "branch"},
-                       {"width", l.width},
-                       {"points", std::move(xy)},
-                       {"step", std::move(step)},
-                       {"intensity", std::move(intensity)}});
-    }
-    out["polylines"] = std::move(lines);
-  }
-  if (include.has("cells")) {
-    json c = json::array();
-    for (const auto& n : bolt.nodes) {
-      c.push_back(n.cell.x);
-      c.push_back(n.cell.y);
-    }
-    out["cells"] = std::move(c);
-  }
-  if (include.has("tree")) {
-    json parent = json::array(), step = json::array();
-    for (const auto& n : bolt.nodes) {
-      parent.push_back(n.parent);
-      step.push_back(n.step);
-    }
-    out["tree"] = {{"parent", std::move(parent)}, {"step", std::move(step)}, {"mainChannel", bolt.mainChannel}};
-  }
-  if (include.has("guide")) {
-    json g = json::array();
-    for (const auto& c : bolt.guide) g.push_back({c.x, c.y});
-    out["guide"] = std::move(g);
-  }
+  if (include.has("polylines")) out["polylines"] = polylinesJson(lt::polylines(bolt, request.shape));
+  if (include.has("cells")) out["cells"] = cellsJson(bolt);
+  if (include.has("tree")) out["tree"] = treeJson(bolt);
+  if (include.has("guide")) out["guide"] = guideJson(bolt);
   if (include.has("fractalDimension")) {
     std::vector<lt::Cell> cellsOnly;
     for (const auto& n : bolt.nodes) cellsOnly.push_back(n.cell);
