@@ -20,11 +20,9 @@
 
 namespace {
 
-// `effectd render scene.json -o out.png`: the same validation, scene building and renderer
-// as POST /v1/render, on this thread. Exit 0 written, 1 render failure, 2 bad input.
-int renderCommand(std::vector<std::string> args) {
-  std::string scenePath, outPath;
-  std::vector<std::string> flags;
+// `effectd render`'s arguments: the scene, -o/--output, and the rest as flags for parseConfig.
+void renderArgs(const std::vector<std::string>& args, std::string& scenePath, std::string& outPath,
+                std::vector<std::string>& flags) {
   for (size_t i = 0; i < args.size(); ++i) {
     if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size())
       outPath = args[++i];
@@ -35,35 +33,26 @@ int renderCommand(std::vector<std::string> args) {
     else
       flags.push_back(args[i]);
   }
-  if (scenePath.empty() || outPath.empty()) {
-    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n",
-               stderr);
-    return 2;
-  }
-  effectd::Config config;
-  bool help = false;
-  if (std::string err = effectd::parseConfig(flags, config, help); !err.empty()) {
-    std::fprintf(stderr, "effectd render: %s\n", err.c_str());
-    return 2;
-  }
+}
+
+// Reads the scene file as JSON; false, having said why, when it cannot.
+bool readScene(const std::string& scenePath, nlohmann::json& body) {
   std::ifstream in(scenePath, std::ios::binary);
   if (!in) {
     std::fprintf(stderr, "effectd render: cannot read %s\n", scenePath.c_str());
-    return 2;
+    return false;
   }
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  nlohmann::json body = nlohmann::json::parse(text, nullptr, false);
+  body = nlohmann::json::parse(text, nullptr, false);
   if (body.is_discarded()) {
     std::fprintf(stderr, "effectd render: %s is not valid JSON\n", scenePath.c_str());
-    return 2;
+    return false;
   }
-  effectd::Service service(config);  // for its schemas; it never listens
-  auto violations = service.schemas().validate("scene.json", body);
-  if (!violations.empty()) {
-    for (const auto& v : violations)
-      std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
-    return 2;
-  }
+  return true;
+}
+
+// Renders a schema-valid scene into the PNG file `outPath`; returns the exit status.
+int renderScene(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
   try {
     effects::render::Scene scene = effectd::buildScene(body, effectd::RequestContext{"render", config});
     auto renderer = effects::render::Renderer::create(config.eglPlatform);
@@ -86,6 +75,35 @@ int renderCommand(std::vector<std::string> args) {
     std::fprintf(stderr, "effectd render: %s\n", e.detail.c_str());
     return e.status >= 500 || e.status == 422 ? 1 : 2;
   }
+}
+
+// `effectd render scene.json -o out.png`: the same validation, scene building and renderer
+// as POST /v1/render, on this thread. Exit 0 written, 1 render failure, 2 bad input.
+int renderCommand(std::vector<std::string> args) {
+  std::string scenePath, outPath;
+  std::vector<std::string> flags;
+  renderArgs(args, scenePath, outPath, flags);
+  if (scenePath.empty() || outPath.empty()) {
+    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n",
+               stderr);
+    return 2;
+  }
+  effectd::Config config;
+  bool help = false;
+  if (std::string err = effectd::parseConfig(flags, config, help); !err.empty()) {
+    std::fprintf(stderr, "effectd render: %s\n", err.c_str());
+    return 2;
+  }
+  nlohmann::json body;
+  if (!readScene(scenePath, body)) return 2;
+  effectd::Service service(config);  // for its schemas; it never listens
+  auto violations = service.schemas().validate("scene.json", body);
+  if (!violations.empty()) {
+    for (const auto& v : violations)
+      std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
+    return 2;
+  }
+  return renderScene(body, config, outPath);
 }
 
 }  // namespace
