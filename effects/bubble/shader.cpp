@@ -25,15 +25,10 @@ std::string header(Glsl v, bool fragment) {
   return fragment ? "#version 300 es\nprecision highp float;\n" : "#version 300 es\n";
 }
 
-}  // namespace
-
-ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude,
-                    const std::string& fragmentFinish) {
-  ShaderSource out;
-  const bool env = f.reflection || f.refraction;
-  const bool needsView = env || f.rim || f.iridescence;
-
-  Builder vs{{}, &out.uniforms};
+// The vertex shader: position (wobbled, eqn 11), world position, normal, and the UV for the
+// texture flow. Its uniforms are appended to `uniforms`.
+std::string vertexShader(const Features& f, Glsl version, std::vector<std::string>& uniforms) {
+  Builder vs{{}, &uniforms};
   vs << header(version, false) << "layout(location = 0) in vec3 aPosition;\nlayout(location = 1) in vec3 aNormal;\n";
   if (f.textureFlow) vs << "layout(location = 2) in vec2 aUv;\n";
   vs.uniform("mat4", "uModel", "object -> world");
@@ -52,9 +47,17 @@ ShaderSource shader(const Features& f, Glsl version, const std::string& fragment
         "  vNormal = mat3(uModel) * aNormal;\n";
   if (f.textureFlow) vs << "  vUv = aUv;\n";
   vs << "  gl_Position = uViewProjection * world;\n}\n";
-  out.vertex = vs.src.str();
+  return vs.src.str();
+}
 
-  Builder fs{{}, &out.uniforms};
+// The fragment shader: the base colour, then each enabled feature's factor or term in turn,
+// with the caller's prelude (declarations) and finish (before the output). Its uniforms are
+// appended to `uniforms`.
+std::string fragmentShader(const Features& f, Glsl version, const std::string& fragmentPrelude,
+                           const std::string& fragmentFinish, std::vector<std::string>& uniforms) {
+  const bool env = f.reflection || f.refraction;
+  const bool needsView = env || f.rim || f.iridescence;
+  Builder fs{{}, &uniforms};
   fs << header(version, true) << "in vec3 vNormal;\nin vec3 vWorld;\n";
   if (f.textureFlow) fs << "in vec2 vUv;\n";
   fs << "out vec4 fragColor;\n";
@@ -94,7 +97,16 @@ ShaderSource shader(const Features& f, Glsl version, const std::string& fragment
   if (f.iridescence) fs << "  color.rgb += texture(uThinFilm, vec2(uThickness, abs(gammaOut))).rgb;\n";
   if (f.rim) fs << "  color.a *= clamp(pow(max(1.0 - gammaOut, 0.0), uRimPower), 0.0, 1.0);  // eqn 10\n";
   fs << fragmentFinish << "  fragColor = color;\n}\n";
-  out.fragment = fs.src.str();
+  return fs.src.str();
+}
+
+}  // namespace
+
+ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude,
+                    const std::string& fragmentFinish) {
+  ShaderSource out;
+  out.vertex = vertexShader(f, version, out.uniforms);
+  out.fragment = fragmentShader(f, version, fragmentPrelude, fragmentFinish, out.uniforms);
   return out;
 }
 
