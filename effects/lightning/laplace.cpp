@@ -179,6 +179,8 @@ void Laplace::smoothCoarse(Level& l, bool forward) {
 }
 
 // e_k approximately solves A_k e_k = r_k; k = 0 is the fine level (r_ -> z_).
+// Long because it is one V-cycle read top to bottom (smooth, residual, restrict, recurse,
+// prolong, smooth), each step on the same level geometry (fw, fh, fs, c).
 void Laplace::vcycle(size_t k) {
   const bool fine = k == 0;
   const bool coarsest = k + 1 == levels_.size();
