@@ -9,7 +9,10 @@ Measured = VmHWM after the request - VmRSS before it (the kernel's peak is reset
 /proc/PID/clear_refs). The estimate should be at or above the measurement (ratio >= 1): a
 budget built from estimates then bounds the real peak.
 """
-import http.client, json, os, subprocess, sys, time
+import http.client, json, os, sys, time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+import effectd_process  # noqa: E402
 
 BIN = sys.argv[1] if len(sys.argv) > 1 else "build/server/effectd"
 
@@ -58,10 +61,8 @@ def status_kb(pid, key):
 
 
 def start():
-    p = subprocess.Popen([BIN, "--port", "0", "--access-log", "0", "--threads", "2", "--response-cache-mb", "0",
-                          "--memory-budget-mb", "100000"], stderr=subprocess.PIPE, text=True)
-    port = json.loads(p.stderr.readline())["port"]
-    return p, port
+    return effectd_process.start(BIN, "--access-log", "0", "--threads", "2", "--response-cache-mb", "0",
+                                 "--memory-budget-mb", "100000")
 
 
 def post(port, path, body):

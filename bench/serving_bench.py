@@ -10,16 +10,17 @@ cheap requests while heavy ones run.
    default heavy-work slots (cores - 1) and, as the baseline in the same run, with
    --heavy-threads 8 (every bolt runs at once, as before the heavy slots existed).
 """
-import http.client, json, statistics, subprocess, sys, threading, time
+import http.client, json, os, statistics, sys, threading, time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+import effectd_process  # noqa: E402
 
 BIN = sys.argv[1] if len(sys.argv) > 1 else "build/server/effectd"
 SECONDS = float(sys.argv[2]) if len(sys.argv) > 2 else 5
 
 
 def start(*flags):
-    p = subprocess.Popen([BIN, "--port", "0", "--access-log", "0", "--threads", "16", *flags],
-                         stderr=subprocess.PIPE, text=True)
-    return p, json.loads(p.stderr.readline())["port"]
+    return effectd_process.start(BIN, "--access-log", "0", "--threads", "16", *flags)
 
 
 def pct(values, q):

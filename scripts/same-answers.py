@@ -7,21 +7,15 @@ computeMs and the like differ from run to run); PNG and glTF answers byte for by
 
   scripts/same-answers.py OLD_EFFECTD NEW_EFFECTD     exit 0 when every answer is the same
 """
-import base64, glob, http.client, json, math, os, re, subprocess, sys
+import base64, glob, http.client, json, math, os, sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 from answers import scrub  # noqa: E402
-
+import effectd_process  # noqa: E402
 
 
 def start(binary):
-    p = subprocess.Popen([binary, "--host", "127.0.0.1", "--port", "0", "--response-cache-mb", "0",
-                          "--heavy-threads", "2", "--admission-timeout-ms", "120000"],
-                         stderr=subprocess.PIPE, text=True)
-    for line in p.stderr:
-        m = re.search(r'"listening".*"port":(\d+)', line)
-        if m:
-            return p, int(m.group(1))
-    raise SystemExit(f"{binary} did not start")
+    return effectd_process.start(binary, "--host", "127.0.0.1", "--response-cache-mb", "0", "--heavy-threads", "2",
+                                 "--admission-timeout-ms", "120000")
 
 
 def post(port, path, body, ctype="application/json"):

@@ -4,8 +4,9 @@ peak RSS from /proc (VmHWM after clear_refs), answers as a client sees them.
 
     tests/memory_test.py build/server/effectd
 """
-import http.client, json, os, subprocess, sys, threading, time
+import http.client, json, os, sys, threading, time
 
+from effectd_process import start
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "bench"))
 from memory_estimates import grid_mesh  # noqa: E402
 
@@ -21,8 +22,7 @@ def check(ok, what):
 
 class Server:
     def __init__(self, *flags):
-        self.p = subprocess.Popen([BIN, "--port", "0", "--access-log", "0", *flags], stderr=subprocess.PIPE, text=True)
-        self.port = json.loads(self.p.stderr.readline())["port"]
+        self.p, self.port = start(BIN, "--access-log", "0", *flags)
 
     def kb(self, key):
         with open(f"/proc/{self.p.pid}/status") as f:

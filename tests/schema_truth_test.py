@@ -12,9 +12,10 @@ created when absent. Exceptions, each with its reason, are in ALLOWED.
 
     tests/schema_truth_test.py build/server/effectd
 """
-import copy, glob, http.client, json, os, subprocess, sys, time
+import copy, glob, http.client, json, os, sys, time
 
 from answers import scrub
+from effectd_process import start
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 BIN = sys.argv[1]
@@ -61,9 +62,7 @@ def properties(node, doc, pointer=""):
 
 class Server:
     def __init__(self):
-        self.p = subprocess.Popen([BIN, "--port", "0", "--access-log", "0", "--response-cache-mb", "0"],
-                                  stderr=subprocess.PIPE, text=True)
-        self.port = json.loads(self.p.stderr.readline())["port"]
+        self.p, self.port = start(BIN, "--access-log", "0", "--response-cache-mb", "0")
 
     def post(self, path, body):
         start = time.monotonic()
