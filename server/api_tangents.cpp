@@ -1,5 +1,6 @@
 // POST /v1/tangents — indexed triangle mesh (JSON) or binary glTF -> vertex tangents.
 #include <cstring>
+#include <map>
 
 #include <effects/tangents.h>
 
@@ -132,14 +133,30 @@ int accessorIndex(const json& value, const std::string& pointer) {
   return int(index);
 }
 
-// The mesh of one triangle primitive: its POSITION, TEXCOORD_0 and NORMAL (where given,
+// The texture coordinates a primitive's tangents follow: the set its material's normal texture
+// samples ("TEXCOORD_<texCoord>"), TEXCOORD_0 when it has none.
+std::string normalMapUvs(const json& gltf, const json& prim, const std::string& at) {
+  if (!prim.contains("material")) return "TEXCOORD_0";
+  uint64_t m = 0, set = 0;
+  check(glb::unsignedValue(prim["material"], at + "/material", INT32_MAX, m));
+  const json& materials = gltf.contains("materials") ? gltf["materials"] : json::array();
+  if (!materials.is_array() || m >= materials.size() || !materials[m].is_object())
+    throw gltfProblem(422, {at + "/material", "names no material"});
+  const json& material = materials[m];
+  if (material.contains("normalTexture") && material["normalTexture"].is_object())
+    check(glb::unsignedMember(material["normalTexture"], "texCoord",
+                              "/materials/" + std::to_string(m) + "/normalTexture/texCoord", 0, 31, set));
+  return "TEXCOORD_" + std::to_string(set);
+}
+
+// The mesh of one triangle primitive: its POSITION, `uvs` and NORMAL (where given,
 // `hadNormals`) accessors, and its indices (or the vertices in order when it has none).
-tg::Mesh readPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::string& at, size_t maxVertices,
-                       bool& hadNormals) {
+tg::Mesh readPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::string& uvs, const std::string& at,
+                       size_t maxVertices, bool& hadNormals) {
   tg::Mesh mesh;
   std::vector<float> pos, nrm, uv;
   check(glb::readFloats(asset, accessorIndex(attrs["POSITION"], at + "/attributes/POSITION"), 3, pos));
-  check(glb::readFloats(asset, accessorIndex(attrs["TEXCOORD_0"], at + "/attributes/TEXCOORD_0"), 2, uv));
+  check(glb::readFloats(asset, accessorIndex(attrs[uvs], at + "/attributes/" + uvs), 2, uv));
   hadNormals = attrs.contains("NORMAL");
   if (hadNormals) check(glb::readFloats(asset, accessorIndex(attrs["NORMAL"], at + "/attributes/NORMAL"), 3, nrm));
   const size_t n = pos.size() / 3;
@@ -168,9 +185,9 @@ tg::Mesh readPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::st
 }
 
 // A library error on a primitive's mesh, as a problem at the accessor it came from.
-[[noreturn]] void throwPrimitiveError(const effects::Error& e, const std::string& at) {
+[[noreturn]] void throwPrimitiveError(const effects::Error& e, const std::string& uvs, const std::string& at) {
   std::string attr = e.field.rfind("/positions", 0) == 0 ? "POSITION"
-                     : e.field.rfind("/uvs", 0) == 0     ? "TEXCOORD_0"
+                     : e.field.rfind("/uvs", 0) == 0     ? uvs
                      : e.field.rfind("/normals", 0) == 0 ? "NORMAL"
                                                          : "";
   std::string pointer = attr.empty() ? at + "/indices" : at + "/attributes/" + attr;
@@ -198,22 +215,46 @@ void remapPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::strin
   prim["indices"] = glb::addIndexAccessor(asset, out.indices);
 }
 
-// Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive.
-// Returns false when the primitive has no TEXCOORD_0 and so cannot have tangents.
-bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const RequestContext& ctx, double& ms) {
+// What became of each triangle primitive, for the X-Tangents header; and the primitives
+// already done, by what determines their tangents (attributes, indices, morph targets and UV
+// set): primitives sharing their accessors share the result instead of each getting a copy.
+struct GlbRun {
+  size_t generated = 0, kept = 0, shared = 0;
+  std::map<std::string, json> done;  // key -> the primitive's attributes, indices and targets after
+  double ms = 0;
+};
+
+// Adds TANGENT (and NORMAL where absent, flat as glTF prescribes) to one triangle primitive,
+// from the UV set its normal texture uses. A primitive that has TANGENT keeps it unless
+// `overwrite`; one without POSITION or that UV set cannot have tangents and is left alone.
+void processPrimitive(glb::Asset& asset, json& prim, const std::string& at, const RequestContext& ctx, bool overwrite,
+                      GlbRun& run) {
   const Config& config = ctx.config;
   json& attrs = prim["attributes"];
-  if (!attrs.is_object() || !attrs.contains("POSITION") || !attrs.contains("TEXCOORD_0")) return false;
+  if (!attrs.is_object()) return;
+  const std::string uvs = normalMapUvs(asset.gltf, prim, at);
+  if (!attrs.contains("POSITION") || !attrs.contains(uvs)) return;
+  if (attrs.contains("TANGENT") && !overwrite) {
+    ++run.kept;
+    return;
+  }
+  const std::string key = json{attrs, prim.value("indices", json()), prim.value("targets", json()), uvs}.dump();
+  if (auto it = run.done.find(key); it != run.done.end()) {
+    for (const char* part : {"attributes", "indices", "targets"})
+      if (it->second.contains(part)) prim[part] = it->second[part];
+    ++run.shared;
+    return;
+  }
   bool hadNormals = false;
-  const tg::Mesh mesh = readPrimitive(asset, prim, attrs, at, config.limits.maxMeshVertices, hadNormals);
+  const tg::Mesh mesh = readPrimitive(asset, prim, attrs, uvs, at, config.limits.maxMeshVertices, hadNormals);
   const size_t n = mesh.positions.size();
   tg::Options opt = options(ctx, tg::Mode::kMikkTSpace);
   opt.missingNormals = tg::NormalRule::kFlat;
   auto r = tg::generate(mesh, opt);
-  if (!r.ok()) throwPrimitiveError(r.error(), at);
+  if (!r.ok()) throwPrimitiveError(r.error(), uvs, at);
   tg::Output& out = r.value();
   flipW(out);  // glTF's UV origin is top-left
-  ms += out.stats.elapsedMs;
+  run.ms += out.stats.elapsedMs;
 
   std::vector<float> tangents;
   tangents.reserve(out.tangents.size() * 4);
@@ -226,7 +267,20 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
     attrs["NORMAL"] = glb::addFloatAccessor(asset, normals, 3, true);
   }
   attrs["TANGENT"] = glb::addFloatAccessor(asset, tangents, 4, true);
-  return true;
+  json& result = run.done[key];
+  for (const char* part : {"attributes", "indices", "targets"})
+    if (prim.contains(part)) result[part] = prim[part];
+  ++run.generated;
+}
+
+// ?overwrite=true|false (default false).
+bool overwriteOption(const RequestContext& ctx) {
+  for (const auto& [name, value] : ctx.query)
+    if (name != "overwrite") throw fieldError(400, "?" + name, "is not a parameter of a glTF body (overwrite is)");
+  auto it = ctx.query.find("overwrite");
+  if (it == ctx.query.end() || it->second == "false") return false;
+  if (it->second == "true") return true;
+  throw fieldError(400, "?overwrite", "must be true or false");
 }
 
 }  // namespace
@@ -234,9 +288,10 @@ bool processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
 BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
   glb::Asset asset;
   check(glb::parse(body, asset), 400);
+  const bool overwrite = overwriteOption(ctx);
   BinaryReply reply;
   reply.method = "mikktspace";
-  size_t done = 0;
+  GlbRun run;
   try {
     if (asset.gltf.contains("meshes"))
       for (size_t mi = 0; mi < asset.gltf["meshes"].size(); ++mi) {
@@ -247,15 +302,20 @@ BinaryReply handleGlb(const std::string& body, const RequestContext& ctx) {
           uint64_t mode = 4;
           check(glb::unsignedMember(prims[pi], "mode", at + "/mode", 4, 6, mode));
           if (mode != 4) continue;  // TRIANGLES only
-          done += processPrimitive(asset, prims[pi], at, ctx, reply.computeMs);
+          processPrimitive(asset, prims[pi], at, ctx, overwrite, run);
         }
       }
   } catch (const json::exception& e) {
     throw gltfProblem(422, {"", std::string("malformed glTF JSON: ") + e.what()});
   }
-  if (done == 0)
-    throw gltfProblem(422,
-                      {"/meshes", "no triangle primitive with POSITION and TEXCOORD_0: nothing can have tangents"});
+  if (run.generated + run.shared + run.kept == 0)
+    throw gltfProblem(422, {"/meshes",
+                            "no triangle primitive with POSITION and the texture coordinates its normal texture "
+                            "uses (TEXCOORD_0 without one): nothing can have tangents"});
+  glb::compact(asset);  // accessors the splits replaced, and their bytes, go
+  reply.computeMs = run.ms;
+  reply.headers["X-Tangents"] = "generated " + std::to_string(run.generated + run.shared) + ", kept " +
+                                std::to_string(run.kept) + (overwrite ? "" : " (?overwrite=true replaces them)");
   reply.body = glb::serialize(asset);
   reply.contentType = "model/gltf-binary";
   return reply;

@@ -84,14 +84,15 @@ Cost glbCost(const std::string& body, const Config&) {
 Cost bubbleCost(const json& body, const Config& config) {
   const Includes include(body, kBubbleIncludes);
   Cost c{kBase, false};
-  if (include.has("mesh")) {
+  const bool glb = body.value("format", "json") == "glb";  // the mesh, as a file
+  if (include.has("mesh") || glb) {
     const int level = std::min(body.value("mesh", json::object()).value("level", 3), 7);
     const size_t vertices = 10 * (size_t(1) << (2 * level)) + 2, triangles = 20 * (size_t(1) << (2 * level));
     const size_t perVertex = body.contains("camera") ? 16 : 12;  // + final vectors and rim
     c.bytes += vertices * (64 + perVertex * kAnswerNumber) + triangles * (16 + 3 * kAnswerNumber);
     c.heavy = level >= kHeavyLevel;
   }
-  if (include.has("thinFilm")) {
+  if (include.has("thinFilm") && !glb) {
     const json tf = body.value("thinFilm", json::object());
     const size_t texels =
         std::min(size_t(tf.value("width", 256)) * size_t(tf.value("height", 256)), config.limits.maxThinFilmTexels);

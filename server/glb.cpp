@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <set>
 
 namespace effectd::glb {
 namespace {
@@ -19,6 +20,8 @@ T load(const char* p) {
 }
 uint32_t u32(const std::string& s, size_t at) { return load<uint32_t>(s.data() + at); }
 void put32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+
+constexpr uint64_t kAny = SIZE_MAX / 4;  // sums of two stay representable
 
 int componentSize(int type) {
   switch (type) {
@@ -63,7 +66,6 @@ std::optional<FieldError> view(const Asset& a, int index, View& v) {
   v.accessor = &acc;
   if (acc.contains("sparse")) return FieldError{at + "/sparse", "sparse accessors are not supported"};
   uint64_t componentType = 0, count = 0, bvIndex = 0, buffer = 0, stride = 0, bvOffset = 0, bvLength = 0, accOffset = 0;
-  constexpr uint64_t kAny = SIZE_MAX / 4;  // sums of two stay representable
   if (auto p = unsignedMember(acc, "componentType", at + "/componentType", 0, 0xFFFF, componentType)) return p;
   v.componentType = int(componentType);
   v.components = componentCount(acc.contains("type") && acc["type"].is_string() ? acc["type"].get<std::string>() : "");
@@ -135,7 +137,8 @@ int pushAccessor(Asset& a, json accessor) {
 }  // namespace
 
 std::optional<FieldError> unsignedValue(const json& value, const std::string& pointer, uint64_t max, uint64_t& out) {
-  if (!value.is_number_unsigned() || value.get<uint64_t>() > max)
+  // JSON parsed from the body has unsigned integers; those this file writes may be signed.
+  if (!value.is_number_integer() || value.get<int64_t>() < 0 || value.get<uint64_t>() > max)
     return FieldError{pointer, "must be an integer from 0 to " + std::to_string(max)};
   out = value.get<uint64_t>();
   return std::nullopt;
@@ -186,6 +189,133 @@ std::optional<FieldError> parse(const std::string& b, Asset& out) {
         return FieldError{std::string("/") + key + "/" + std::to_string(i), "must be an object"};
   }
   return std::nullopt;
+}
+
+namespace {
+
+// Extensions whose JSON names no accessor and no buffer view: renumbering cannot miss them.
+bool onlySafeExtensions(const json& gltf) {
+  static const std::set<std::string> kSafe = {"KHR_materials_anisotropy",
+                                              "KHR_materials_clearcoat",
+                                              "KHR_materials_dispersion",
+                                              "KHR_materials_emissive_strength",
+                                              "KHR_materials_ior",
+                                              "KHR_materials_iridescence",
+                                              "KHR_materials_sheen",
+                                              "KHR_materials_specular",
+                                              "KHR_materials_transmission",
+                                              "KHR_materials_unlit",
+                                              "KHR_materials_variants",
+                                              "KHR_materials_volume",
+                                              "KHR_materials_pbrSpecularGlossiness",
+                                              "KHR_texture_transform",
+                                              "KHR_texture_basisu",
+                                              "KHR_lights_punctual",
+                                              "KHR_mesh_quantization",
+                                              "EXT_texture_webp"};
+  for (const auto& e : member(gltf, "extensionsUsed"))
+    if (!e.is_string() || !kSafe.count(e.get<std::string>())) return false;
+  return true;
+}
+
+// Every reference to an element of an array of `count`, or false if one is not a valid index.
+bool validRefs(const std::vector<json*>& refs, size_t count) {
+  for (const json* r : refs)
+    if (uint64_t index = 0; count == 0 || unsignedValue(*r, "", count - 1, index)) return false;
+  return true;
+}
+
+std::vector<json*> accessorRefs(json& g) {
+  std::vector<json*> refs;
+  auto add = [&](json& object, const char* key) {
+    if (object.is_object() && object.contains(key)) refs.push_back(&object[key]);
+  };
+  auto all = [&](json& object) {
+    if (object.is_object())
+      for (auto& [k, v] : object.items()) refs.push_back(&v);
+  };
+  if (g.contains("meshes") && g["meshes"].is_array())
+    for (auto& mesh : g["meshes"]) {
+      if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+      for (auto& p : mesh["primitives"]) {
+        if (!p.is_object()) continue;
+        if (p.contains("attributes")) all(p["attributes"]);
+        add(p, "indices");
+        if (p.contains("targets") && p["targets"].is_array())
+          for (auto& t : p["targets"]) all(t);
+      }
+    }
+  if (g.contains("skins") && g["skins"].is_array())
+    for (auto& s : g["skins"]) add(s, "inverseBindMatrices");
+  if (g.contains("animations") && g["animations"].is_array())
+    for (auto& an : g["animations"])
+      if (an.is_object() && an.contains("samplers") && an["samplers"].is_array())
+        for (auto& s : an["samplers"]) add(s, "input"), add(s, "output");
+  return refs;
+}
+
+std::vector<json*> bufferViewRefs(json& g) {
+  std::vector<json*> refs;
+  auto add = [&](json& object, const char* key) {
+    if (object.is_object() && object.contains(key)) refs.push_back(&object[key]);
+  };
+  for (auto& acc : g["accessors"]) {
+    add(acc, "bufferView");
+    if (acc.contains("sparse") && acc["sparse"].is_object()) {
+      json& sp = acc["sparse"];
+      if (sp.contains("indices")) add(sp["indices"], "bufferView");
+      if (sp.contains("values")) add(sp["values"], "bufferView");
+    }
+  }
+  if (g.contains("images") && g["images"].is_array())
+    for (auto& img : g["images"]) add(img, "bufferView");
+  return refs;
+}
+
+// Keeps only the items `refs` (valid indices into `items`) name, renumbering the references;
+// returns whether any item was dropped.
+bool keepUsed(json& items, const std::vector<json*>& refs) {
+  std::vector<int64_t> renumber(items.size(), -1);
+  for (const json* r : refs) renumber[r->get<size_t>()] = 0;
+  json kept = json::array();
+  for (size_t i = 0; i < items.size(); ++i)
+    if (renumber[i] == 0) {
+      renumber[i] = int64_t(kept.size());
+      kept.push_back(std::move(items[i]));
+    }
+  const bool dropped = kept.size() < items.size();
+  items = std::move(kept);
+  for (json* r : refs) *r = renumber[r->get<size_t>()];
+  return dropped;
+}
+
+}  // namespace
+
+void compact(Asset& a) {
+  json& g = a.gltf;
+  if (!onlySafeExtensions(g) || member(g, "buffers").size() > 1 || !g.contains("accessors")) return;
+  const std::vector<json*> accRefs = accessorRefs(g);
+  if (!validRefs(accRefs, g["accessors"].size())) return;
+  if (!keepUsed(g["accessors"], accRefs) || !g.contains("bufferViews")) return;  // nothing replaced
+  const std::vector<json*> viewRefs = bufferViewRefs(g);
+  if (!validRefs(viewRefs, g["bufferViews"].size())) return;
+  for (const json& bv : g["bufferViews"]) {  // every view must lie in the BIN chunk
+    uint64_t offset = 0, length = 0, buffer = 0;
+    if (!bv.contains("buffer") || unsignedMember(bv, "buffer", "", 0, 0, buffer) ||
+        unsignedMember(bv, "byteOffset", "", 0, kAny, offset) ||
+        unsignedMember(bv, "byteLength", "", 0, kAny, length) || offset > a.bin.size() ||
+        length > a.bin.size() - offset)
+      return;
+  }
+  if (!keepUsed(g["bufferViews"], viewRefs)) return;  // the bytes stay where they are
+  std::string bin;
+  for (json& bv : g["bufferViews"]) {  // in order, each at its old offset modulo 4 (alignment kept)
+    const size_t offset = bv.value("byteOffset", size_t(0)), length = bv.value("byteLength", size_t(0));
+    while (bin.size() % 4 != offset % 4) bin.push_back('\0');
+    bv["byteOffset"] = bin.size();
+    bin.append(a.bin, offset, length);
+  }
+  a.bin = std::move(bin);
 }
 
 std::string serialize(const Asset& a) {

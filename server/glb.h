@@ -34,6 +34,11 @@ std::optional<FieldError> unsignedValue(const nlohmann::json& value, const std::
 std::optional<FieldError> unsignedMember(const nlohmann::json& object, const char* key, const std::string& pointer,
                                          uint64_t fallback, uint64_t max, uint64_t& out);
 std::string serialize(const Asset& asset);
+// Drops accessors nothing references (after vertex splits replaced them) and the bytes only
+// they used, renumbering references. Leaves the asset untouched when it uses an extension that
+// may name accessors or buffer views itself, has more than one buffer, or a reference is
+// malformed: then nothing can be known unused.
+void compact(Asset& asset);
 
 // Accessor `index` as floats, `components` per element (normalized integers scaled to [0, 1]
 // or [-1, 1] as the spec has it). Fails for sparse accessors, other buffers, out-of-range views.

@@ -49,11 +49,9 @@ void writeProblem(httplib::Response& res, const ApiError& p, const std::string& 
                {"status", p.status},
                {"detail", p.detail},
                {"requestId", requestId}};
-  if (!p.errors.empty()) {
-    json list = json::array();
-    for (const auto& e : p.errors) list.push_back({{"pointer", e.pointer}, {"message", e.message}});
-    body["errors"] = std::move(list);
-  }
+  json list = json::array();  // always present: one shape for every problem
+  for (const auto& e : p.errors) list.push_back({{"pointer", e.pointer}, {"message", e.message}});
+  body["errors"] = std::move(list);
   res.status = p.status;
   for (const auto& [k, v] : p.headers) res.set_header(k, v);
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/problem+json");

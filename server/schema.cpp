@@ -181,6 +181,20 @@ void checkObject(const json& s, const json& v, const std::string& ptr, Errors& o
   }
 }
 
+// For alternatives that each only require one member ({"required": ["box"]}, ...): the members
+// as "box or sphere" ("color, gradient or image"); "" for any other kind of alternatives.
+std::string exclusiveMembers(const json& alternatives) {
+  std::vector<std::string> names;
+  for (const auto& branch : alternatives) {
+    if (!branch.is_object() || branch.size() != 1 || !branch.contains("required") || branch["required"].size() != 1)
+      return "";
+    names.push_back(branch["required"][0].get<std::string>());
+  }
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return out;
+}
+
 // "oneOf" and "anyOf". `tryBranch(schema)` checks the value at `ptr` against one alternative
 // on its own (a few errors at most) and returns what it found; the report names the
 // alternative the client most likely meant.
@@ -205,7 +219,8 @@ void checkAlternatives(const json& s, const std::string& ptr, Errors& out, const
     bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
     if (!ok) {
       if (matches > 1) {
-        out.add(ptr, "matches more than one alternative");
+        out.add(ptr, exclusiveMembers(*it).empty() ? "matches more than one alternative"
+                                                   : "give exactly one of " + exclusiveMembers(*it));
       } else if (missing.size() == it->size()) {  // none of the alternatives' members given
         std::string names;
         for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;

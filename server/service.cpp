@@ -31,7 +31,12 @@ constexpr size_t kMaxJsonDepth = 64;
 json parseBody(const std::string& body) {
   json::parser_callback_t limit = [](int depth, json::parse_event_t, json&) {
     if (depth > static_cast<int>(kMaxJsonDepth))
-      throw ApiError{400, "invalid-json", "Malformed JSON", "JSON nested deeper than 64 levels", {}, {}};
+      throw ApiError{400,
+                     "invalid-json",
+                     "Malformed JSON",
+                     "JSON nested deeper than 64 levels",
+                     {{"", "nested deeper than 64 levels"}},
+                     {}};
     return true;
   };
   try {
@@ -86,6 +91,7 @@ double answerBinary(const BinaryHandler& handler, const std::string& body, const
                     CachedAnswer& answer) {
   BinaryReply reply = handler(body, ctx);
   if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
+  answer.headers.insert(reply.headers.begin(), reply.headers.end());
   answer.body = std::move(reply.body);
   answer.contentType = reply.contentType;
   return reply.computeMs;
@@ -264,14 +270,18 @@ void Service::addReadinessInfo(const std::string& name, std::function<std::strin
 
 void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_, compute_.get()};
+  for (const auto& [k, v] : req.params) ctx.query[k] = v;
   const std::string type = mediaType(req.get_header_value("Content-Type"));
+  std::string query;  // part of what determines a binary answer
+  for (const auto& [k, v] : ctx.query) query += k + "=" + v + "&";
   const Coding coding = negotiate(tl.acceptEncoding);
   const std::string inm = req.get_header_value("If-None-Match");
   tl.encoded = true;
   // The exact request bytes find a cached answer before any parsing.
-  const std::string requestKey = req.body.size() <= ResponseCache::kMaxAliasKeyBytes
-                                     ? route.path + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
-                                     : std::string();
+  const std::string requestKey =
+      req.body.size() <= ResponseCache::kMaxAliasKeyBytes
+          ? route.path + "?" + query + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
+          : std::string();
   try {
     if (auto hit = cache_.byRequest(requestKey)) {
       res.set_header("Server-Timing", "cache;desc=\"hit\"");
@@ -281,7 +291,7 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
     json body;
     // What determines the answer; "" = not cacheable.
     const std::string canonical = binary != route.binary.end()
-                                      ? type + "\n" + req.body
+                                      ? type + "\n" + query + "\n" + req.body
                                       : parseJsonRequest(req.body, *schemas_, route.schema, body);
     // Deterministic answers: a strong validator per representation (request and coding).
     std::string tag;

@@ -65,6 +65,8 @@ struct RequestContext {
   // The JSON pointer, within the request body, of the object the handler reads: "" for an
   // endpoint's own body, "/fog" for the fog part of a /v1/scene. Problems name fields under it.
   std::string at = "";
+  // The query string's parameters (binary bodies take their options there; JSON bodies have none).
+  std::map<std::string, std::string> query = {};
 };
 
 using JsonHandler = std::function<JsonReply(const nlohmann::json& body, const RequestContext& ctx)>;
@@ -74,6 +76,7 @@ struct BinaryReply {
   std::string contentType;
   double computeMs = 0;
   std::string method;
+  std::map<std::string, std::string> headers;  // part of the answer (cached with it)
 };
 using BinaryHandler = std::function<BinaryReply(const std::string& body, const RequestContext& ctx)>;
 using BinaryEstimator = std::function<Cost(const std::string& body, const Config& config)>;

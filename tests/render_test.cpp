@@ -367,7 +367,7 @@ TEST(Render, BadScenesNameTheField) {
   problem({{"lightning", {{"grid", {{"width", 8}, {"height", 8}}}, {"start", {9, 0}}, {"targets", {{1, 7}}}}}}, 400,
           "/lightning/start");
   problem({{"fog", {{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 1}}}}}}, 400, "/fog/fog/end");
-  problem({{"bubble", {{"mesh", {{"level", 9}}}}}}, 413, "/bubble/mesh/level");
+  problem({{"bubble", {{"mesh", {{"level", 9}}}}}}, 400, "/bubble/mesh/level");
   problem({{"quads", {{{"center", {0, 0, 0}}, {"size", {1, 1}}, {"normal", {0, 0, 0}}}}}}, 400, "/quads/0/normal");
 
   // A PNG larger than the pixel limit is refused from its header, before decoding.

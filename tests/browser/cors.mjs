@@ -9,16 +9,11 @@
 //   - POST /v1/render: a PNG that decodes to the requested size and is not one flat colour;
 //   - a page on an origin not in the list cannot read anything (fetch rejects).
 // Usage: node cors.mjs EFFECTD_BINARY [CHROMIUM]
-import { spawn } from 'node:child_process';
 import http from 'node:http';
 import puppeteer from 'puppeteer-core';
+import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
-let failures = 0;
-function check(ok, what, detail) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}${ok || detail === undefined ? '' : ': ' + JSON.stringify(detail)}`);
-  if (!ok) failures++;
-}
 
 // The page's origin: a static server for an empty page.
 const pages = http.createServer((req, res) => {
@@ -31,18 +26,7 @@ const allowedOrigin = `http://localhost:${pagePort}`;  // same page, a different
 const refusedOrigin = `http://127.0.0.1:${pagePort}`;
 
 // effectd, allowing only the page's origin.
-const server = spawn(binary, ['--host', '127.0.0.1', '--port', '0', '--cors-origins', allowedOrigin],
-                     { stdio: ['ignore', 'ignore', 'pipe'] });
-const api = await new Promise((resolve, reject) => {
-  let log = '';
-  server.stderr.on('data', (d) => {
-    log += d;
-    const m = log.match(/"listening"[^\n]*"port":(\d+)/) || log.match(/"port":(\d+)[^\n]*"listening"/);
-    if (m) resolve(`http://127.0.0.1:${m[1]}`);
-  });
-  server.on('exit', (code) => reject(new Error(`effectd exited (${code}): ${log}`)));
-  setTimeout(() => reject(new Error(`effectd did not start: ${log}`)), 10000);
-});
+const { url: api, process: server } = await startEffectd(binary, ['--cors-origins', allowedOrigin]);
 
 const browser = await puppeteer.launch({
   executablePath: chromium,
@@ -127,5 +111,5 @@ try {
   server.kill('SIGTERM');
   pages.close();
 }
-console.log(failures ? `${failures} check(s) failed` : 'all browser checks passed');
-process.exit(failures ? 1 : 0);
+console.log(results.failures ? `${results.failures} check(s) failed` : 'all browser checks passed');
+process.exit(results.failures ? 1 : 0);

@@ -1,0 +1,76 @@
+#include "bubble_glb.h"
+
+#include <algorithm>
+
+#include "glb.h"
+
+namespace effectd {
+
+using nlohmann::json;
+
+namespace {
+
+template <int N, class V>
+std::vector<float> flatFloats(const std::vector<V>& v) {
+  std::vector<float> out;
+  out.reserve(v.size() * N);
+  for (const V& x : v)
+    for (int c = 0; c < N; ++c) out.push_back(float(x[c]));
+  return out;
+}
+
+// KHR_materials_transmission + ior make the film see-through with the right refraction;
+// KHR_materials_iridescence (when the feature is on) gives it thin-film colour.
+json material(const effects::bubble::Params& p, const effects::bubble::Features& f, double tMin, double tMax) {
+  json extensions = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
+                     {"KHR_materials_ior", {{"ior", p.n2}}}};
+  if (f.iridescence)
+    extensions["KHR_materials_iridescence"] = {{"iridescenceFactor", 1.0},
+                                               {"iridescenceIor", p.n2},
+                                               {"iridescenceThicknessMinimum", tMin},
+                                               {"iridescenceThicknessMaximum", tMax}};
+  return {{"name", "soap film"},
+          {"doubleSided", true},
+          {"pbrMetallicRoughness",
+           {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.05}}},
+          {"extensions", extensions}};
+}
+
+}  // namespace
+
+std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params,
+                      const effects::bubble::Features& features, double thicknessMinNm, double thicknessMaxNm) {
+  glb::Asset a;
+  a.gltf = {{"asset", {{"version", "2.0"}, {"generator", "effectd /v1/bubble"}}},
+            {"scene", 0},
+            {"scenes", {{{"nodes", {0}}}}},
+            {"nodes", {{{"mesh", 0}, {"name", "bubble"}}}},
+            {"accessors", json::array()},
+            {"bufferViews", json::array()}};
+  std::vector<float> tangents = flatFloats<4>(mesh.tangents);
+  for (size_t i = 3; i < tangents.size(); i += 4) tangents[i] = -tangents[i];  // glTF: UV origin top left
+  const int position = glb::addFloatAccessor(a, flatFloats<3>(mesh.positions), 3, true);
+  json lo = json::array(), hi = json::array();
+  for (int c = 0; c < 3; ++c) {
+    auto [mn, mx] = std::minmax_element(mesh.positions.begin(), mesh.positions.end(),
+                                        [c](const auto& x, const auto& y) { return x[c] < y[c]; });
+    lo.push_back((*mn)[c]);
+    hi.push_back((*mx)[c]);
+  }
+  a.gltf["accessors"][position]["min"] = lo;  // glTF requires POSITION bounds
+  a.gltf["accessors"][position]["max"] = hi;
+  json attributes = {{"POSITION", position},
+                     {"NORMAL", glb::addFloatAccessor(a, flatFloats<3>(mesh.normals), 3, true)},
+                     {"TEXCOORD_0", glb::addFloatAccessor(a, flatFloats<2>(mesh.uvs), 2, true)},
+                     {"TANGENT", glb::addFloatAccessor(a, tangents, 4, true)}};
+  const int indices = glb::addIndexAccessor(a, mesh.indices);
+  a.gltf["meshes"] = {
+      {{"name", "bubble"}, {"primitives", {{{"attributes", attributes}, {"indices", indices}, {"material", 0}}}}}};
+  a.gltf["materials"] = {material(params, features, thicknessMinNm, thicknessMaxNm)};
+  json used = {"KHR_materials_transmission", "KHR_materials_ior"};
+  if (features.iridescence) used.push_back("KHR_materials_iridescence");
+  a.gltf["extensionsUsed"] = used;
+  return glb::serialize(a);
+}
+
+}  // namespace effectd
