@@ -41,12 +41,15 @@ json material(const effects::bubble::Params& p, const effects::bubble::Features&
 std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params,
                       const effects::bubble::Features& features, double thicknessMinNm, double thicknessMaxNm) {
   glb::Asset a;
-  a.gltf = {{"asset", {{"version", "2.0"}, {"generator", "effectd /v1/bubble"}}},
-            {"scene", 0},
-            {"scenes", {{{"nodes", {0}}}}},
-            {"nodes", {{{"mesh", 0}, {"name", "bubble"}}}},
-            {"accessors", json::array()},
-            {"bufferViews", json::array()}};
+  // Arrays of one element spelled json::array(...): a braced single element may collapse to
+  // the element itself depending on the compiler (nlohmann::json's initializer lists).
+  a.gltf = json::object();
+  a.gltf["asset"] = {{"version", "2.0"}, {"generator", "effectd /v1/bubble"}};
+  a.gltf["scene"] = 0;
+  a.gltf["scenes"] = json::array({json{{"nodes", json::array({0})}}});
+  a.gltf["nodes"] = json::array({json{{"mesh", 0}, {"name", "bubble"}}});
+  a.gltf["accessors"] = json::array();
+  a.gltf["bufferViews"] = json::array();
   std::vector<float> tangents = flatFloats<4>(mesh.tangents);
   for (size_t i = 3; i < tangents.size(); i += 4) tangents[i] = -tangents[i];  // glTF: UV origin top left
   const int position = glb::addFloatAccessor(a, flatFloats<3>(mesh.positions), 3, true);
@@ -64,9 +67,9 @@ std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::
                      {"TEXCOORD_0", glb::addFloatAccessor(a, flatFloats<2>(mesh.uvs), 2, true)},
                      {"TANGENT", glb::addFloatAccessor(a, tangents, 4, true)}};
   const int indices = glb::addIndexAccessor(a, mesh.indices);
-  a.gltf["meshes"] = {
-      {{"name", "bubble"}, {"primitives", {{{"attributes", attributes}, {"indices", indices}, {"material", 0}}}}}};
-  a.gltf["materials"] = {material(params, features, thicknessMinNm, thicknessMaxNm)};
+  const json primitive = {{"attributes", attributes}, {"indices", indices}, {"material", 0}};
+  a.gltf["meshes"] = json::array({json{{"name", "bubble"}, {"primitives", json::array({primitive})}}});
+  a.gltf["materials"] = json::array({material(params, features, thicknessMinNm, thicknessMaxNm)});
   json used = {"KHR_materials_transmission", "KHR_materials_ior"};
   if (features.iridescence) used.push_back("KHR_materials_iridescence");
   a.gltf["extensionsUsed"] = used;

@@ -1,0 +1,123 @@
+// How far the fast method's bolts are from DBM's, in the statistics a player sees: box-counting
+// dimension D, cells, branch tips (cells nothing grew from). Start top-centre, target
+// bottom-centre of an N x N grid, no obstacles; every row is over `--seeds` bolts (DBM:
+// `--dbm-seeds`). For the fast method each `--axis` value (eqn 8's base per cell) and each
+// `--lifetime` is a row, so a scan shows which setting meets DBM at each grid and eta.
+//
+//   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
+//                         [--seeds S] [--dbm-seeds S]
+// Output: a markdown table, one row per (grid, eta, method, setting): mean +- sd of D,
+// medians of cells and tips, and the mean milliseconds per bolt.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <effects/lightning.h>
+
+namespace lt = effects::lightning;
+
+namespace {
+
+struct Sample {
+  double d = 0, cells = 0, tips = 0, ms = 0;
+};
+
+Sample measure(const lt::Params& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto r = lt::grow(p);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (!r.ok()) {
+    std::fprintf(stderr, "grow failed: %s\n", r.error().message.c_str());
+    std::exit(1);
+  }
+  const lt::Bolt& b = r.value();
+  std::vector<char> hasChild(b.nodes.size(), 0);
+  std::vector<lt::Cell> cells;
+  for (const auto& n : b.nodes) {
+    if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
+    cells.push_back(n.cell);
+  }
+  return {lt::fractalDimension(cells, p.width, p.height), double(b.nodes.size()),
+          double(std::count(hasChild.begin(), hasChild.end(), 0)), ms};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+void row(int n, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
+  std::vector<double> d, cells, tips;
+  double ms = 0;
+  for (int s = 1; s <= seeds; ++s) {
+    lt::Params p = base;
+    p.seed = uint64_t(s);
+    const Sample x = measure(p);
+    d.push_back(x.d);
+    cells.push_back(x.cells);
+    tips.push_back(x.tips);
+    ms += x.ms;
+  }
+  double mean = 0, var = 0;
+  for (double v : d) mean += v / double(d.size());
+  for (double v : d) var += (v - mean) * (v - mean) / std::max<double>(1, double(d.size()) - 1);
+  std::printf("| %d | %g | %s | %s | %.3f ± %.3f | %.0f | %.0f | %.2f |\n", n, eta, method, setting.c_str(), mean,
+              std::sqrt(var), median(cells), median(tips), ms / seeds);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> grids;
+  std::vector<double> etas, axes;
+  std::vector<int> lifetimes;
+  int seeds = 20, dbmSeeds = 10;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    const char* v = argv[i + 1];
+    if (flag == "--grid") grids.push_back(std::atoi(v));
+    else if (flag == "--eta") etas.push_back(std::atof(v));
+    else if (flag == "--axis") axes.push_back(std::atof(v));
+    else if (flag == "--lifetime") lifetimes.push_back(std::atoi(v));
+    else if (flag == "--seeds") seeds = std::atoi(v);
+    else if (flag == "--dbm-seeds") dbmSeeds = std::atoi(v);
+    else {
+      std::fprintf(stderr, "unknown flag %s\n", argv[i]);
+      return 2;
+    }
+  }
+  if (grids.empty()) grids = {64, 128};
+  if (etas.empty()) etas = {1, 2, 3};
+  if (axes.empty()) axes = {lt::Params{}.axisGrowth};
+  if (lifetimes.empty()) lifetimes = {lt::Params{}.lifetime};
+  std::printf("| grid | eta | method | setting | D | cells (median) | tips (median) | ms/bolt |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (int n : grids)
+    for (double eta : etas) {
+      lt::Params base;
+      base.width = base.height = n;
+      base.start = {n / 2, 0};
+      base.targets = {{n / 2, n - 1}};
+      base.eta = eta;
+      if (dbmSeeds > 0) {
+        lt::Params p = base;
+        p.method = lt::Method::kDbm;
+        row(n, eta, "dbm", "mgpcg", p, dbmSeeds);
+      }
+      for (double a : axes)
+        for (int l : lifetimes) {
+          lt::Params p = base;
+          p.axisGrowth = a;
+          p.lifetime = l;
+          char setting[64];
+          std::snprintf(setting, sizeof setting, "axis %g, lifetime %d", a, l);
+          row(n, eta, "fast", setting, p, seeds);
+        }
+    }
+}
