@@ -5,7 +5,9 @@
 // `--lifetime` is a row, so a scan shows which setting meets DBM at each grid and eta.
 //
 //   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
-//                         [--seeds S] [--dbm-seeds S]
+//                         [--seeds S] [--dbm-seeds S] [--fit]
+// --fit: instead of the --axis rows, the base per cell at which the fast method's median
+// cells meet DBM's (bisection), and the statistics it gives.
 // Output: a markdown table, one row per (grid, eta, method, setting): mean +- sd of D,
 // medians of cells and tips, and the mean milliseconds per bolt.
 #include <algorithm>
@@ -51,7 +53,8 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-void row(int n, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
+// Prints one table row over `seeds` bolts; returns their median cells.
+double row(int n, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
   std::vector<double> d, cells, tips;
   double ms = 0;
   for (int s = 1; s <= seeds; ++s) {
@@ -69,6 +72,29 @@ void row(int n, double eta, const char* method, const std::string& setting, cons
   std::printf("| %d | %g | %s | %s | %.3f ± %.3f | %.0f | %.0f | %.2f |\n", n, eta, method, setting.c_str(), mean,
               std::sqrt(var), median(cells), median(tips), ms / seeds);
   std::fflush(stdout);
+  return median(cells);
+}
+
+// Median cells of `seeds` fast bolts with eqn 8's base `axis`.
+double medianCells(lt::Params p, double axis, int seeds) {
+  std::vector<double> cells;
+  p.axisGrowth = axis;
+  for (int s = 1; s <= seeds; ++s) {
+    p.seed = uint64_t(1000 + s);  // other seeds than the rows print
+    cells.push_back(measure(p).cells);
+  }
+  return median(cells);
+}
+
+// The base per cell at which the fast method's median cells meet DBM's: bisection on
+// ln(axis) in [0, ln 2] (cells fall as the base grows).
+double fitAxis(const lt::Params& base, double dbmCells, int seeds) {
+  double lo = 0, hi = std::log(2.0);
+  for (int i = 0; i < 10; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (medianCells(base, std::exp(mid), seeds) > dbmCells ? lo : hi) = mid;
+  }
+  return std::exp(0.5 * (lo + hi));
 }
 
 }  // namespace
@@ -78,8 +104,15 @@ int main(int argc, char** argv) {
   std::vector<double> etas, axes;
   std::vector<int> lifetimes;
   int seeds = 20, dbmSeeds = 10;
-  for (int i = 1; i + 1 < argc; i += 2) {
+  bool fit = false;
+  for (int i = 1; i < argc; i += 2) {
     const std::string flag = argv[i];
+    if (flag == "--fit") {
+      fit = true;
+      --i;
+      continue;
+    }
+    if (i + 1 >= argc) break;
     const char* v = argv[i + 1];
     if (flag == "--grid") grids.push_back(std::atoi(v));
     else if (flag == "--eta") etas.push_back(std::atof(v));
@@ -108,7 +141,18 @@ int main(int argc, char** argv) {
       if (dbmSeeds > 0) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;
-        row(n, eta, "dbm", "mgpcg", p, dbmSeeds);
+        const double dbmCells = row(n, eta, "dbm", "mgpcg", p, dbmSeeds);
+        if (fit) {
+          lt::Params f = base;
+          f.lifetime = lifetimes.front();
+          const double axis = fitAxis(f, dbmCells, seeds);
+          f.axisGrowth = axis;
+          char setting[96];
+          std::snprintf(setting, sizeof setting, "fitted axis %.4f (ln %.4f), lifetime %d", axis, std::log(axis),
+                        f.lifetime);
+          row(n, eta, "fast", setting, f, seeds);
+          continue;
+        }
       }
       for (double a : axes)
         for (int l : lifetimes) {
