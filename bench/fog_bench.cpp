@@ -10,7 +10,6 @@ namespace {
 
 using namespace effects::fog;
 
-
 void BM_FogTable(benchmark::State& state) {
   Fog f = fixtures::fogOf(static_cast<FogType>(state.range(0)));
   TableOptions o;

@@ -88,11 +88,12 @@ void fractal() {
     const char* name;
     Method method;
     double axisGrowth;
+    int lifetime;
   };
-  const Row rows[] = {{"fast", Method::kFast, 2.0},
-                      {"fast, axisGrowth 1.1", Method::kFast, 1.1},
-                      {"charges", Method::kCharges, 2.0},
-                      {"dbm", Method::kDbm, 2.0}};
+  const Row rows[] = {{"fast (calibrated default)", Method::kFast, Params{}.axisGrowth, Params{}.lifetime},
+                      {"fast (paper)", Method::kFast, kPaperAxisGrowth, kPaperLifetime},
+                      {"charges", Method::kCharges, 2.0, 0},
+                      {"dbm", Method::kDbm, 2.0, 0}};
   for (double eta : {1.0, 2.0}) {
     for (const Row& row : rows) {
       double sum = 0, sum2 = 0;
@@ -100,6 +101,7 @@ void fractal() {
         Params p = lightningLayout(128, row.method, seed);
         p.eta = eta;
         p.axisGrowth = row.axisGrowth;
+        p.lifetime = row.lifetime;
         auto b = grow(p);
         std::vector<Cell> cells;
         for (const auto& n : b.value().nodes) cells.push_back(n.cell);

@@ -114,12 +114,18 @@ int main(int argc, char** argv) {
     }
     if (i + 1 >= argc) break;
     const char* v = argv[i + 1];
-    if (flag == "--grid") grids.push_back(std::atoi(v));
-    else if (flag == "--eta") etas.push_back(std::atof(v));
-    else if (flag == "--axis") axes.push_back(std::atof(v));
-    else if (flag == "--lifetime") lifetimes.push_back(std::atoi(v));
-    else if (flag == "--seeds") seeds = std::atoi(v);
-    else if (flag == "--dbm-seeds") dbmSeeds = std::atoi(v);
+    if (flag == "--grid")
+      grids.push_back(std::atoi(v));
+    else if (flag == "--eta")
+      etas.push_back(std::atof(v));
+    else if (flag == "--axis")
+      axes.push_back(std::atof(v));
+    else if (flag == "--lifetime")
+      lifetimes.push_back(std::atoi(v));
+    else if (flag == "--seeds")
+      seeds = std::atoi(v);
+    else if (flag == "--dbm-seeds")
+      dbmSeeds = std::atoi(v);
     else {
       std::fprintf(stderr, "unknown flag %s\n", argv[i]);
       return 2;

@@ -125,6 +125,10 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
                          " (--max-solver-grid-cells); the fast method takes up to " +
                          std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
+  if (body.value("variant", "calibrated") == "paper") {
+    p.lifetime = lt::kPaperLifetime;
+    p.axisGrowth = lt::kPaperAxisGrowth;
+  }
   p.lifetime = body.value("lifetime", p.lifetime);
   p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
   p.solver = body.value("solver", "mgpcg") == "cg" ? lt::Solver::kCg : lt::Solver::kMgpcg;

@@ -1,4 +1,5 @@
 // effects/lightning: growth methods, guide, stiff and extreme cases, shape, quality metrics.
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -12,6 +13,55 @@ namespace effects::lightning {
 namespace {
 
 Params basic(int n, Method m = Method::kFast, uint64_t seed = 1) { return fixtures::lightningLayout(n, m, seed); }
+
+// Box-counting D (mean), cells and branch tips (medians) over seeds 1..n.
+struct BoltStats {
+  double d = 0, cells = 0, tips = 0;
+};
+BoltStats statsOver(Params p, int seeds) {
+  std::vector<double> d, cells, tips;
+  for (int s = 1; s <= seeds; ++s) {
+    p.seed = uint64_t(s);
+    auto r = grow(p);
+    EXPECT_TRUE(r.ok());
+    if (!r.ok()) return {};
+    std::vector<char> hasChild(r.value().nodes.size(), 0);
+    std::vector<Cell> cs;
+    for (const Node& n : r.value().nodes) {
+      if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
+      cs.push_back(n.cell);
+    }
+    d.push_back(fractalDimension(cs, p.width, p.height));
+    cells.push_back(double(cs.size()));
+    tips.push_back(double(std::count(hasChild.begin(), hasChild.end(), 0)));
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  double mean = 0;
+  for (double v : d) mean += v / double(d.size());
+  return {mean, median(cells), median(tips)};
+}
+
+// The default fast method is calibrated to DBM (docs/lightning-calibration.md: D within
+// -0.01..+0.05 over 10-60 seeds); with 4 DBM and 16 fast seeds here the bounds are looser.
+// The paper's literal constants are measurably further from DBM.
+TEST(Fast, DefaultMeetsDbmStatistics) {
+  for (double eta : {1.0, 2.0, 3.0}) {
+    Params fast = basic(64);
+    fast.eta = eta;
+    Params dbm = fast, paper = fast;
+    dbm.method = Method::kDbm;
+    paper.axisGrowth = kPaperAxisGrowth;
+    paper.lifetime = kPaperLifetime;
+    const BoltStats f = statsOver(fast, 16), r = statsOver(dbm, 4), q = statsOver(paper, 16);
+    EXPECT_NEAR(f.d, r.d, 0.08) << "eta " << eta;
+    EXPECT_NEAR(f.cells / r.cells, 1.0, 0.4) << "eta " << eta << ": " << f.cells << " vs " << r.cells;
+    EXPECT_NEAR(f.tips / r.tips, 1.0, 0.5) << "eta " << eta << ": " << f.tips << " vs " << r.tips;
+    EXPECT_LT(std::fabs(f.d - r.d), std::fabs(q.d - r.d)) << "eta " << eta;
+  }
+}
 
 // The bolt is a tree of 8-connected cells, free of obstacles, from start to every target.
 void expectWellFormed(const Params& p, const Bolt& b) {

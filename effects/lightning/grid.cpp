@@ -64,10 +64,14 @@ BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obst
       }
     levels_.push_back(std::move(c));
   }
+  if (size_t(width) * size_t(height) <= kMemoCells) {
+    memoCells_ = size_t(width) * size_t(height);
+    memo_.reset(new std::atomic<float>[memoCells_]());
+  }
 }
 
 size_t BoundaryMap::bytes() const {
-  size_t b = quads_.size();
+  size_t b = quads_.size() + memoCells_ * sizeof(float);
   for (const Level& l : levels_) b += l.count.size() * 3 * sizeof(float);
   return b;
 }
@@ -105,8 +109,16 @@ double BoundaryMap::visit(int level, int bx, int by, double px, double py) const
 }
 
 double BoundaryMap::potential(int x, int y) const {
+  const size_t i = size_t(y) * size_t(dw_ - 2) + size_t(x);
+  if (memo_)
+    if (float v = memo_[i].load(std::memory_order_relaxed); v != 0.0f) return v;
   double px = x + 1.5, py = y + 1.5;  // domain coordinates of the cell centre
-  return visit(int(levels_.size()) + 1, 0, 0, px, py);
+  const double v = visit(int(levels_.size()) + 1, 0, 0, px, py);
+  if (memo_) {
+    memo_[i].store(float(v), std::memory_order_relaxed);
+    return float(v);  // the same value whether it came from the memo or not
+  }
+  return v;
 }
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,

@@ -1,6 +1,9 @@
 // Private to effects/lightning: the obstacle grid, its boundary map, A* and line of sight.
 #pragma once
 
+#include <atomic>
+#include <memory>
+
 #include <memory>
 #include <vector>
 
@@ -31,7 +34,11 @@ constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 class BoundaryMap {
  public:
   BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles);
+  // Thread-safe; on grids up to kMemoCells the value of each cell is kept once computed, so
+  // every request on a cached map shares the work (stores are of the same value: races are
+  // benign, the atomics make them defined).
   double potential(int x, int y) const;
+  static constexpr size_t kMemoCells = size_t(1) << 20;
   size_t bytes() const;
 
  private:
@@ -48,6 +55,8 @@ class BoundaryMap {
   int qw_, qh_;  // 2x2 blocks per side
   std::vector<uint8_t> quads_;
   std::vector<Level> levels_;  // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2
+  size_t memoCells_ = 0;
+  std::unique_ptr<std::atomic<float>[]> memo_;  // 0 = not computed yet (a potential is > 0)
 };
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,

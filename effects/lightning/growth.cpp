@@ -6,6 +6,7 @@
 
 #include "grid.h"
 #include "laplace.h"
+#include "weight_tree.h"
 
 namespace effects::lightning {
 
@@ -46,6 +47,10 @@ struct Candidate {
   int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8
   int parent;      // node it attaches to if chosen: its newest bolt neighbour
   double charge;   // kCharges: sum over bolt cells of 1/r
+  // kFast: log(2^G / (B * P)), fixed while the segment's axis stands, and Phi^eta relative
+  // to the grower's weight reference (kept per candidate: only cells that gain a neighbour
+  // change, so a step costs one pass of additions, not a logarithm and a power per candidate).
+  double logStatic = 0, weight = 0;
 };
 
 bool adjacent(Cell a, Cell b) { return std::abs(a.x - b.x) <= 1 && std::abs(a.y - b.y) <= 1; }
@@ -75,6 +80,14 @@ class Grower {
   void removeCandidate(size_t slot);
   void expireCandidates();
   void logWeights(std::vector<double>& out);
+  double fastLogStatic(Cell c);
+  void refreshFastWeight(Candidate& c);
+  void restartFastWeights();
+  size_t sampleFast();
+  void syncWeightTree();
+  void markWeight(size_t slot) {
+    if (p_.method == Method::kFast) dirty_.push_back(slot);
+  }
   double boundary(Cell c);
   std::optional<Error> growSegment(size_t k);
   std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
@@ -95,7 +108,12 @@ class Grower {
   std::unique_ptr<detail::Laplace> laplace_, reference_;
   Rng rng_{p_.seed};
   int step_ = 0;
-  Cell anchor_, attractor_;  // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
+  Cell anchor_, attractor_;    // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
+  double weightRef_ = 0;       // kFast: weights are exp(eta * log Phi - weightRef_)
+  bool rescale_ = true;        // kFast: a weight left the safe range; recompute the reference
+  detail::WeightTree tree_;    // kFast: the candidates' weights, by slot
+  std::vector<size_t> dirty_;  // kFast: slots whose weight changed since the tree last saw them
+  size_t treeUpdates_ = 0;     // since the last rebuild (which also clears rounding drift)
   double solverIterations_ = 0, lastResidual_ = 0, errorSum_ = 0;
   int errorSteps_ = 0;
   size_t candidatesMax_ = 0;
@@ -120,6 +138,8 @@ void Grower::removeCandidate(size_t slot) {
     cands_[slot] = cands_.back();
     candidateOf_[g_.index(cands_[slot].cell)] = int32_t(slot);
   }
+  markWeight(slot);
+  markWeight(cands_.size() - 1);
   cands_.pop_back();
 }
 
@@ -134,6 +154,8 @@ void Grower::addCandidatesAround(int node) {
       cand.neighbours = std::min(cand.neighbours + 1, 8);
       cand.born = step_;
       cand.parent = node;
+      if (p_.method == Method::kFast) refreshFastWeight(cand);
+      markWeight(size_t(candidateOf_[i]));
       continue;
     }
     Candidate cand{{x, y}, step_, 0, node, 0.0};
@@ -143,8 +165,13 @@ void Grower::addCandidatesAround(int node) {
     }
     if (p_.method == Method::kCharges)
       for (const Node& n : bolt_.nodes) cand.charge += 1.0 / std::hypot(double(x - n.cell.x), double(y - n.cell.y));
+    if (p_.method == Method::kFast) {
+      cand.logStatic = fastLogStatic(cand.cell);
+      refreshFastWeight(cand);
+    }
     candidateOf_[i] = int32_t(cands_.size());
     cands_.push_back(cand);
+    markWeight(cands_.size() - 1);
   }
   candidatesMax_ = std::max(candidatesMax_, cands_.size());
 }
@@ -166,31 +193,9 @@ double Grower::boundary(Cell c) {
 void Grower::logWeights(std::vector<double>& out) {
   out.resize(cands_.size());
   switch (p_.method) {
-    case Method::kFast: {
-      // Seed 002 eqn 8: P_i = 2^G / (B * N * P), the base 2 being Params::axisGrowth. B (eqn 4)
-      // is the border/obstacle charge
-      // potential (large near them: Phi small), N (eqn 6) the adjacent bolt cells, P (eqn 5)
-      // the distance to the positive charge, G the candidate's step along anchor -> attractor.
-      const double lnGrowth = std::log(p_.axisGrowth);  // the paper: ln 2
-      double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
-      double len = std::hypot(ax, ay);
-      if (len > 0) {
-        ax /= len;
-        ay /= len;
-      }
-      for (size_t i = 0; i < cands_.size(); ++i) {
-        const Candidate& c = cands_[i];
-        // G counts steps towards the attractor and, past it, back: folded at the attractor's
-        // distance. Unfolded, 2^G kept rewarding cells beyond the target, and a bolt that
-        // overshot in a tall grid ran on to the far wall (128 x 32767: 2 M steps, minutes).
-        const double along = (c.cell.x - anchor_.x) * ax + (c.cell.y - anchor_.y) * ay;
-        double G = std::floor(along <= len ? along : 2 * len - along);
-        double P = std::hypot(double(c.cell.x - attractor_.x), double(c.cell.y - attractor_.y));
-        out[i] =
-            G * lnGrowth - std::log(boundary(c.cell)) - std::log(double(c.neighbours)) - std::log(std::max(P, 0.5));
-      }
+    case Method::kFast:
+      for (size_t i = 0; i < cands_.size(); ++i) out[i] = cands_[i].logStatic - std::log(double(cands_[i].neighbours));
       break;
-    }
     case Method::kDbm:
       for (size_t i = 0; i < cands_.size(); ++i) {
         double phi = laplace_->phi(cands_[i].cell.x, cands_[i].cell.y);
@@ -214,6 +219,84 @@ void Grower::logWeights(std::vector<double>& out) {
       break;
     }
   }
+}
+
+// Seed 002 eqn 8 without N: log(2^G / (B * P)), the base 2 being Params::axisGrowth. B (eqn 4)
+// is the border/obstacle charge potential (large near them: Phi small), P (eqn 5) the
+// distance to the positive charge, G the candidate's step along anchor -> attractor. N (eqn 6,
+// the adjacent bolt cells) changes as the bolt grows and is applied in refreshFastWeight().
+double Grower::fastLogStatic(Cell c) {
+  const double lnGrowth = std::log(p_.axisGrowth);
+  double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
+  const double len = std::hypot(ax, ay);
+  if (len > 0) {
+    ax /= len;
+    ay /= len;
+  }
+  // G counts steps towards the attractor and, past it, back: folded at the attractor's
+  // distance. Unfolded, 2^G kept rewarding cells beyond the target, and a bolt that
+  // overshot in a tall grid ran on to the far wall (128 x 32767: 2 M steps, minutes).
+  const double along = (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
+  const double G = std::floor(along <= len ? along : 2 * len - along);
+  const double P = std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
+  return G * lnGrowth - std::log(boundary(c)) - std::log(std::max(P, 0.5));
+}
+
+// Phi^eta of one candidate against the current reference (eta = 0: every weight 1).
+void Grower::refreshFastWeight(Candidate& c) {
+  if (p_.eta == 0.0) {
+    c.weight = 1.0;
+    return;
+  }
+  c.weight = std::exp(p_.eta * (c.logStatic - std::log(double(c.neighbours))) - weightRef_);
+  if (!(c.weight <= 1e250)) rescale_ = true;
+}
+
+// A new axis (segment start, next waypoint): every candidate's G and P change.
+void Grower::restartFastWeights() {
+  for (Candidate& c : cands_) c.logStatic = fastLogStatic(c.cell);
+  rescale_ = true;
+}
+
+// Brings the weight tree up to date: the changed slots one by one, or a rebuild (O(n)) after a
+// new reference, when slots were added beyond it, or every n updates against rounding drift.
+void Grower::syncWeightTree() {
+  if (rescale_) {
+    double top = kNegInf;
+    for (const Candidate& c : cands_) top = std::max(top, p_.eta * (c.logStatic - std::log(double(c.neighbours))));
+    weightRef_ = std::isfinite(top) ? top : 0.0;
+    rescale_ = false;
+    for (Candidate& c : cands_) refreshFastWeight(c);
+  }
+  bool rebuild = tree_.size() != cands_.size() && dirty_.empty();
+  for (size_t slot : dirty_) rebuild = rebuild || slot >= tree_.size();
+  treeUpdates_ += dirty_.size();
+  if (rebuild || rescale_ || treeUpdates_ > std::max<size_t>(64, cands_.size()) || tree_.size() < cands_.size()) {
+    tree_.rebuild(cands_.size(), [&](size_t i) { return cands_[i].weight; });
+    treeUpdates_ = 0;
+  } else {
+    for (size_t slot : dirty_) tree_.set(slot, slot < cands_.size() ? cands_[slot].weight : 0.0);
+  }
+  dirty_.clear();
+}
+
+// Samples a candidate with probability Phi_i^eta / sum Phi^eta from the kept weights (one
+// uniform draw per step). The reference is reset to the largest eta log Phi whenever a weight
+// would overflow or every weight has underflowed; the distribution is candidateWeights()'.
+size_t Grower::sampleFast() {
+  const double r = rng_.uniform();
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    syncWeightTree();
+    const double total = tree_.total();
+    if (total > 0 && std::isfinite(total)) {
+      const size_t i = tree_.find(r * total);
+      if (i < cands_.size() && cands_[i].weight > 0) return i;
+    }
+    rescale_ = true;  // drift or underflow: exact sums from a fresh reference
+  }
+  for (size_t i = cands_.size(); i-- > 0;)  // every Phi = 0: uniform
+    if (cands_[i].weight > 0) return i;
+  return size_t(r * double(cands_.size())) % cands_.size();
 }
 
 // Unnormalised p_i = Phi_i^eta (seed 002 eqn 2) from log Phi, scaled by the largest so that
@@ -340,6 +423,16 @@ void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, si
          (adjacent(newest, waypoints[wp]) || detail::lineOfSight(g_, newest, waypoints[wp + 1]))) {
     anchor_ = newest;
     attractor_ = waypoints[++wp];
+    if (p_.method == Method::kFast) {
+      // A new leg of the guide: without a lifetime the frontier left behind (the room before
+      // a gap in a wall) would keep candidates that the new axis rewards through the wall.
+      // The leg grows from the cells added lately (the paper's lifetime), as DBM's screened
+      // field would have it.
+      if (p_.lifetime == 0)
+        for (size_t i = cands_.size(); i-- > 0;)
+          if (step_ - cands_[i].born > kPaperLifetime) removeCandidate(i);
+      restartFastWeights();
+    }
   }
 }
 
@@ -365,6 +458,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
 
   // Chain lightning: the new segment grows from the previous target only.
   for (size_t i = cands_.size(); i-- > 0;) removeCandidate(i);
+  rescale_ = true;
   int last = from;
   std::vector<double> logPhi, scratch;
   size_t segmentFirstNode = bolt_.nodes.size();
@@ -378,8 +472,14 @@ std::optional<Error> Grower::growSegment(size_t k) {
       reviveFrontier(from, segmentFirstNode);
       if (cands_.empty()) return unsatisfiable(field, "the bolt enclosed itself before reaching the target");
     }
-    weighCandidates(logPhi);
-    size_t pick = sample(logPhi, p_.eta, rng_, scratch);
+    size_t pick = 0;
+    if (p_.method == Method::kFast) {
+      if (reference_) weighCandidates(logPhi);  // only the error needs every log Phi
+      pick = sampleFast();
+    } else {
+      weighCandidates(logPhi);
+      pick = sample(logPhi, p_.eta, rng_, scratch);
+    }
     Candidate chosen = cands_[pick];
     last = addNode(chosen.cell, chosen.parent);
     addCandidatesAround(last);

@@ -11,7 +11,9 @@
 // Several targets make chain lightning: each later segment grows from the previous target.
 //
 // Methods (how Phi is obtained):
-//   kFast    seed 002 eqns 4-8: Phi_i = 2^G / (B * N * P), candidates live `lifetime` steps.
+//   kFast    seed 002 eqns 4-8: Phi_i = a^G / (B * N * P), candidates live `lifetime` steps.
+//            Defaults calibrated to DBM (docs/lightning-calibration.md): a = 1.2 per cell,
+//            candidates never expire; the paper's literal a = 2, lifetime 4 are kPaper*.
 //   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
 //            Phi = 1), warm-started; solver kMgpcg (multigrid-preconditioned CG) or kCg
 //            (plain CG, the baseline of Kim & Lin 2004 and of seed 002's comparison).
@@ -44,6 +46,10 @@ enum class Method { kFast, kDbm, kCharges };
 enum class Solver { kMgpcg, kCg };
 enum class Guide { kAuto, kAstar, kNone };
 
+// Seed 002's literal eqn 8 and lifetime (the `paper` variant): bolts thinner than DBM's.
+inline constexpr double kPaperAxisGrowth = 2.0;
+inline constexpr int kPaperLifetime = 4;
+
 const char* toString(Method m);
 const char* toString(Solver s);
 
@@ -54,9 +60,9 @@ struct Params {
   std::vector<Cell> targets{{64, 127}};
   Method method = Method::kFast;
   double eta = 2.0;         // [0, 50]; seed 002: 2..3 looks like lightning
-  int lifetime = 4;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
-  double axisGrowth = 2.0;  // kFast: base of eqn 8's 2^G, in [1, 64]; the paper's 2 gives
-                            // thinner bolts than DBM, ~1.1 matches DBM's D at eta 2
+  int lifetime = 0;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
+  double axisGrowth = 1.2;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]; 1.2 with
+                            // lifetime 0 meets DBM's D, cells and tips (64^2-256^2, eta 0.5-4)
   Guide guide = Guide::kAuto;
   Solver solver = Solver::kMgpcg;  // kDbm
   double tolerance = 1e-6;         // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
