@@ -150,6 +150,29 @@ json thinFilmJson(const json& body, const bb::Params& params, const json& tf, co
   return j;
 }
 
+// `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks.
+void addShaderParts(const json& body, const Includes& include, const bb::Params& params, const bb::Features& features,
+                    double t, json& out) {
+  // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
+  const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
+  bb::ShaderSource s;
+  if (include.has("uniforms") || include.has("shader"))
+    s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
+  if (include.has("uniforms")) out["uniforms"] = uniforms(params, s.uniforms, t);
+  if (include.has("uniforms") && features.textureFlow) {  // eqn 9, for clients that offset on the CPU
+    const glm::dvec2 off = bb::flowOffset(params, t);
+    out["flowOffset"] = {off.x, off.y};
+  }
+  if (include.has("shader")) {
+    out["shader"] = {
+        {"language", es ? "glsl-es-300" : "glsl-330"},
+        {"vertex", s.vertex},
+        {"fragment", s.fragment},
+        {"uniforms", s.uniforms},
+        {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
+  }
+}
+
 }  // namespace
 
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
@@ -181,24 +204,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
     out["position"] = {c.x, c.y, c.z};
   }
-  // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
-  const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
-  bb::ShaderSource s;
-  if (include.has("uniforms") || include.has("shader"))
-    s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
-  if (include.has("uniforms")) out["uniforms"] = uniforms(params, s.uniforms, t);
-  if (include.has("uniforms") && features.textureFlow) {  // eqn 9, for clients that offset on the CPU
-    const glm::dvec2 off = bb::flowOffset(params, t);
-    out["flowOffset"] = {off.x, off.y};
-  }
-  if (include.has("shader")) {
-    out["shader"] = {
-        {"language", es ? "glsl-es-300" : "glsl-330"},
-        {"vertex", s.vertex},
-        {"fragment", s.fragment},
-        {"uniforms", s.uniforms},
-        {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
-  }
+  addShaderParts(body, include, params, features, t, out);
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
     bb::Mesh mesh = buildMesh(body, params, features, t, ctx);

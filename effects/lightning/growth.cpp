@@ -1,5 +1,8 @@
 // Laplacian growth: the three ways of getting Phi (fast, dbm, charges), candidate sampling,
 // the A* guide, chain targets, and the per-step error against the converged Laplace solution.
+// Over 500 lines because it is one class, the Grower, whose steps share the growth state
+// (bolt, candidates, their weights, the axis); its pure parts live beside it (grid.h,
+// laplace.h, astar, weight_tree.h).
 #include <algorithm>
 #include <cmath>
 #include <limits>
