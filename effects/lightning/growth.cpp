@@ -84,6 +84,7 @@ class Grower {
   void expireCandidates();
   void logWeights(std::vector<double>& out);
   double fastLogStatic(Cell c);
+  static double fastLogPhi(const Candidate& c) { return c.logStatic - std::log(double(c.neighbours)); }
   void refreshFastWeight(Candidate& c);
   void restartFastWeights();
   size_t sampleFast();
@@ -197,7 +198,7 @@ void Grower::logWeights(std::vector<double>& out) {
   out.resize(cands_.size());
   switch (p_.method) {
     case Method::kFast:
-      for (size_t i = 0; i < cands_.size(); ++i) out[i] = cands_[i].logStatic - std::log(double(cands_[i].neighbours));
+      for (size_t i = 0; i < cands_.size(); ++i) out[i] = fastLogPhi(cands_[i]);
       break;
     case Method::kDbm:
       for (size_t i = 0; i < cands_.size(); ++i) {
@@ -251,7 +252,7 @@ void Grower::refreshFastWeight(Candidate& c) {
     c.weight = 1.0;
     return;
   }
-  c.weight = std::exp(p_.eta * (c.logStatic - std::log(double(c.neighbours))) - weightRef_);
+  c.weight = std::exp(p_.eta * fastLogPhi(c) - weightRef_);
   if (!(c.weight <= 1e250)) rescale_ = true;
 }
 
@@ -262,23 +263,28 @@ void Grower::restartFastWeights() {
 }
 
 // Brings the weight tree up to date: the changed slots one by one, or a rebuild (O(n)) after a
-// new reference, when slots were added beyond it, or every n updates against rounding drift.
+// new reference (every weight changed), when a slot lies beyond the tree, or every n updates
+// against rounding drift. The tree is built with room for twice the candidates (zero weights
+// past the end), so a growing frontier rebuilds it O(log n) times, not at every step.
 void Grower::syncWeightTree() {
-  if (rescale_) {
+  const bool rescaled = rescale_;
+  if (rescaled) {
     double top = kNegInf;
-    for (const Candidate& c : cands_) top = std::max(top, p_.eta * (c.logStatic - std::log(double(c.neighbours))));
+    for (const Candidate& c : cands_) top = std::max(top, p_.eta * fastLogPhi(c));
     weightRef_ = std::isfinite(top) ? top : 0.0;
     rescale_ = false;
     for (Candidate& c : cands_) refreshFastWeight(c);
   }
-  bool rebuild = tree_.size() != cands_.size() && dirty_.empty();
+  bool rebuild =
+      rescaled || cands_.size() > tree_.size() || treeUpdates_ + dirty_.size() > std::max<size_t>(64, cands_.size());
   for (size_t slot : dirty_) rebuild = rebuild || slot >= tree_.size();
-  treeUpdates_ += dirty_.size();
-  if (rebuild || rescale_ || treeUpdates_ > std::max<size_t>(64, cands_.size()) || tree_.size() < cands_.size()) {
-    tree_.rebuild(cands_.size(), [&](size_t i) { return cands_[i].weight; });
+  if (rebuild) {
+    tree_.rebuild(std::max<size_t>(16, 2 * cands_.size()),
+                  [&](size_t i) { return i < cands_.size() ? cands_[i].weight : 0.0; });
     treeUpdates_ = 0;
   } else {
     for (size_t slot : dirty_) tree_.set(slot, slot < cands_.size() ? cands_[slot].weight : 0.0);
+    treeUpdates_ += dirty_.size();
   }
   dirty_.clear();
 }
