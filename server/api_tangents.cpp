@@ -256,17 +256,10 @@ void processPrimitive(glb::Asset& asset, json& prim, const std::string& at, cons
   flipW(out);  // glTF's UV origin is top-left
   run.ms += out.stats.elapsedMs;
 
-  std::vector<float> tangents;
-  tangents.reserve(out.tangents.size() * 4);
-  for (const auto& t : out.tangents) tangents.insert(tangents.end(), {t.x, t.y, t.z, t.w});
   const bool identity = out.remap.size() == n;
   if (!identity) remapPrimitive(asset, prim, attrs, at, out, hadNormals);  // every attribute follows the split
-  if (!hadNormals) {
-    std::vector<float> normals;
-    for (const auto& v : out.normals) normals.insert(normals.end(), {v.x, v.y, v.z});
-    attrs["NORMAL"] = glb::addFloatAccessor(asset, normals, 3, true);
-  }
-  attrs["TANGENT"] = glb::addFloatAccessor(asset, tangents, 4, true);
+  if (!hadNormals) attrs["NORMAL"] = glb::addFloatAccessor(asset, glb::floats<3>(out.normals), 3, true);
+  attrs["TANGENT"] = glb::addFloatAccessor(asset, glb::floats<4>(out.tangents), 4, true);
   json& result = run.done[key];
   for (const char* part : {"attributes", "indices", "targets"})
     if (prim.contains(part)) result[part] = prim[part];

@@ -10,15 +10,6 @@ using nlohmann::json;
 
 namespace {
 
-template <int N, class V>
-std::vector<float> flatFloats(const std::vector<V>& v) {
-  std::vector<float> out;
-  out.reserve(v.size() * N);
-  for (const V& x : v)
-    for (int c = 0; c < N; ++c) out.push_back(float(x[c]));
-  return out;
-}
-
 // KHR_materials_transmission + ior make the film see-through with the right refraction;
 // KHR_materials_iridescence (when the feature is on) gives it thin-film colour.
 json material(const effects::bubble::Params& p, const effects::bubble::Features& f, double tMin, double tMax) {
@@ -50,9 +41,9 @@ std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::
   a.gltf["nodes"] = json::array({json{{"mesh", 0}, {"name", "bubble"}}});
   a.gltf["accessors"] = json::array();
   a.gltf["bufferViews"] = json::array();
-  std::vector<float> tangents = flatFloats<4>(mesh.tangents);
+  std::vector<float> tangents = glb::floats<4>(mesh.tangents);
   for (size_t i = 3; i < tangents.size(); i += 4) tangents[i] = -tangents[i];  // glTF: UV origin top left
-  const int position = glb::addFloatAccessor(a, flatFloats<3>(mesh.positions), 3, true);
+  const int position = glb::addFloatAccessor(a, glb::floats<3>(mesh.positions), 3, true);
   json lo = json::array(), hi = json::array();
   for (int c = 0; c < 3; ++c) {
     auto [mn, mx] = std::minmax_element(mesh.positions.begin(), mesh.positions.end(),
@@ -63,8 +54,8 @@ std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::
   a.gltf["accessors"][position]["min"] = lo;  // glTF requires POSITION bounds
   a.gltf["accessors"][position]["max"] = hi;
   json attributes = {{"POSITION", position},
-                     {"NORMAL", glb::addFloatAccessor(a, flatFloats<3>(mesh.normals), 3, true)},
-                     {"TEXCOORD_0", glb::addFloatAccessor(a, flatFloats<2>(mesh.uvs), 2, true)},
+                     {"NORMAL", glb::addFloatAccessor(a, glb::floats<3>(mesh.normals), 3, true)},
+                     {"TEXCOORD_0", glb::addFloatAccessor(a, glb::floats<2>(mesh.uvs), 2, true)},
                      {"TANGENT", glb::addFloatAccessor(a, tangents, 4, true)}};
   const int indices = glb::addIndexAccessor(a, mesh.indices);
   const json primitive = {{"attributes", attributes}, {"indices", indices}, {"material", 0}};

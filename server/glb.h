@@ -45,6 +45,16 @@ void compact(Asset& asset);
 std::optional<FieldError> readFloats(const Asset& asset, int index, int components, std::vector<float>& out);
 std::optional<FieldError> readIndices(const Asset& asset, int index, std::vector<uint32_t>& out);
 
+// glm vectors as one flat float array (x0, y0, z0, x1, ...), as accessors hold them.
+template <int N, class V>
+std::vector<float> floats(const std::vector<V>& v) {
+  std::vector<float> out;
+  out.reserve(v.size() * N);
+  for (const V& x : v)
+    for (int c = 0; c < N; ++c) out.push_back(float(x[c]));
+  return out;
+}
+
 // New accessors over data appended to the BIN chunk (tightly packed, 4-byte aligned rows).
 int addFloatAccessor(Asset& asset, const std::vector<float>& data, int components, bool vertexAttribute);
 int addIndexAccessor(Asset& asset, const std::vector<uint32_t>& indices);

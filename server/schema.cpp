@@ -219,8 +219,8 @@ void checkAlternatives(const json& s, const std::string& ptr, Errors& out, const
     bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
     if (!ok) {
       if (matches > 1) {
-        out.add(ptr, exclusiveMembers(*it).empty() ? "matches more than one alternative"
-                                                   : "give exactly one of " + exclusiveMembers(*it));
+        const std::string members = exclusiveMembers(*it);
+        out.add(ptr, members.empty() ? "matches more than one alternative" : "give exactly one of " + members);
       } else if (missing.size() == it->size()) {  // none of the alternatives' members given
         std::string names;
         for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;

@@ -19,7 +19,7 @@ import yaml from 'js-yaml';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const proto = process.env.EFFECTD_PROTO_DIR || path.join(root, 'proto');
+const proto = path.join(root, 'proto');
 const [binary] = process.argv.slice(2);
 
 // ---- the contract ------------------------------------------------------------------------

@@ -13,14 +13,9 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { generateTangents } from 'mikktspace';
 import validator from 'gltf-validator';
+import { check, results } from '../node/effectd.mjs';
 
 const base = process.argv[2];
-let failures = 0;
-function check(ok, what, detail) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}${ok || detail === undefined ? '' : ': ' + JSON.stringify(detail)}`);
-  if (!ok) failures++;
-  return ok;
-}
 
 // ---- GLB in and out ---------------------------------------------------------------------------
 function parseGlb(bytes) {
@@ -246,5 +241,5 @@ for (const iridescence of [true, false]) {
   check(same === m.vertexCount, `bubble mesh (uvOrigin top-left): tangent w as /v1/tangents gives it on ${same}/${m.vertexCount} vertices`);
 }
 
-console.log(failures ? `${failures} glTF check(s) failed` : 'glTF checks passed');
-process.exit(failures ? 1 : 0);
+console.log(results.failures ? `${results.failures} glTF check(s) failed` : 'glTF checks passed');
+process.exit(results.failures ? 1 : 0);
