@@ -272,8 +272,8 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
   RequestContext ctx{tl.requestId, config_, compute_.get()};
   for (const auto& [k, v] : req.params) ctx.query[k] = v;
   const std::string type = mediaType(req.get_header_value("Content-Type"));
-  std::string query;  // part of what determines a binary answer
-  for (const auto& [k, v] : ctx.query) query += k + "=" + v + "&";
+  // Part of what determines a binary answer; as JSON, so that no two queries read the same.
+  const std::string query = ctx.query.empty() ? std::string() : json(ctx.query).dump();
   const Coding coding = negotiate(tl.acceptEncoding);
   const std::string inm = req.get_header_value("If-None-Match");
   tl.encoded = true;
