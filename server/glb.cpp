@@ -225,11 +225,14 @@ bool validRefs(const std::vector<json*>& refs, size_t count) {
   return true;
 }
 
+// object[key] as a reference to renumber, when there is one.
+void addRef(std::vector<json*>& refs, json& object, const char* key) {
+  if (object.is_object() && object.contains(key)) refs.push_back(&object[key]);
+}
+
 std::vector<json*> accessorRefs(json& g) {
   std::vector<json*> refs;
-  auto add = [&](json& object, const char* key) {
-    if (object.is_object() && object.contains(key)) refs.push_back(&object[key]);
-  };
+  auto add = [&](json& object, const char* key) { addRef(refs, object, key); };
   auto all = [&](json& object) {
     if (object.is_object())
       for (auto& [k, v] : object.items()) refs.push_back(&v);
@@ -256,9 +259,7 @@ std::vector<json*> accessorRefs(json& g) {
 
 std::vector<json*> bufferViewRefs(json& g) {
   std::vector<json*> refs;
-  auto add = [&](json& object, const char* key) {
-    if (object.is_object() && object.contains(key)) refs.push_back(&object[key]);
-  };
+  auto add = [&](json& object, const char* key) { addRef(refs, object, key); };
   for (auto& acc : g["accessors"]) {
     add(acc, "bufferView");
     if (acc.contains("sparse") && acc["sparse"].is_object()) {
