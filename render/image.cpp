@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "render/render.h"
@@ -23,6 +24,72 @@ Result<std::string> encodePng(const Image& image, int bitDepth) {
   if (!out->open("frame.png", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !out->close())
     return unsatisfiable("/image", "PNG encoding failed: " + out->geterror());
   return std::string(bytes.begin(), bytes.end());
+}
+
+struct GifEncoder::Impl {
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy{bytes};
+  std::unique_ptr<OIIO::ImageOutput> out;
+  std::vector<OIIO::ImageSpec> specs;
+  std::vector<unsigned char> pixels;
+  int added = 0;
+  std::string error;
+};
+
+GifEncoder::GifEncoder(int width, int height, int count, double fps) : impl_(std::make_unique<Impl>()) {
+  OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
+  // GIF delays are in hundredths of a second; OpenImageIO takes the rate as a rational.
+  const int rate[2] = {int(std::lround(fps * 100)), 100};
+  spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
+  spec.attribute("gif:LoopCount", 0);  // forever
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  impl_->specs.assign(size_t(std::max(1, count)), spec);
+  impl_->out = OIIO::ImageOutput::create("frames.gif", &impl_->proxy);
+  if (!impl_->out)
+    impl_->error = "OpenImageIO has no GIF writer";
+  else if (!impl_->out->open("frames.gif", int(impl_->specs.size()), impl_->specs.data()))
+    impl_->error = impl_->out->geterror();
+}
+
+GifEncoder::~GifEncoder() = default;
+
+std::optional<Error> GifEncoder::add(const Image& frame) {
+  Impl& g = *impl_;
+  if (!g.error.empty()) return unsatisfiable("/frames", "GIF encoding failed: " + g.error);
+  if (g.added >= int(g.specs.size())) return invalid("/frames", "more frames than announced");
+  if (g.added > 0 && !g.out->open("frames.gif", g.specs[size_t(g.added)], OIIO::ImageOutput::AppendSubimage))
+    return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
+  // OpenImageIO's GIF writer takes 8-bit pixels; round as encodePng does.
+  g.pixels.resize(frame.rgba.size());
+  for (size_t i = 0; i < frame.rgba.size(); ++i)
+    g.pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(frame.rgba[i], 0.0f, 1.0f) * 255.0f));
+  if (!g.out->write_image(OIIO::TypeDesc::UINT8, g.pixels.data()))
+    return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
+  ++g.added;
+  return std::nullopt;
+}
+
+Result<std::string> GifEncoder::finish() {
+  Impl& g = *impl_;
+  if (!g.error.empty()) return unsatisfiable("/frames", "GIF encoding failed: " + g.error);
+  if (g.added != int(g.specs.size())) return invalid("/frames", "fewer frames than announced");
+  if (!g.out->close()) return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
+  return std::string(g.bytes.begin(), g.bytes.end());
+}
+
+Flipbook::Flipbook(int width, int height, int count) : frameWidth(width), frameHeight(height) {
+  columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+  rows = (count + columns - 1) / columns;
+  sheet.width = columns * width;
+  sheet.height = rows * height;
+  sheet.rgba.assign(size_t(sheet.width) * size_t(sheet.height) * 4, 0.0f);
+}
+
+void Flipbook::put(const Image& frame, int index) {
+  const int cx = index % columns, cy = index / columns;
+  for (int y = 0; y < std::min(frame.height, frameHeight); ++y)
+    std::copy_n(&frame.rgba[size_t(y) * size_t(frame.width) * 4], size_t(std::min(frame.width, frameWidth)) * 4,
+                &sheet.rgba[((size_t(cy) * frameHeight + size_t(y)) * size_t(sheet.width) + size_t(cx) * frameWidth) * 4]);
 }
 
 Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {

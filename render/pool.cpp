@@ -31,6 +31,10 @@ std::string RenderPool::description() {
 }
 
 std::optional<std::future<Result<Frame>>> RenderPool::submit(Scene scene) {
+  return submit(std::move(scene), Sequence{0, {}, {}});
+}
+
+std::optional<std::future<Result<Frame>>> RenderPool::submit(Scene scene, Sequence sequence) {
   if (!start().empty()) {
     std::promise<Result<Frame>> failed;
     failed.set_value(unsatisfiable("/renderer", startError_));
@@ -40,7 +44,8 @@ std::optional<std::future<Result<Frame>>> RenderPool::submit(Scene scene) {
   // Jobs beyond the idle workers wait; at most `queue` of them.
   const int idle = options_.threads - busy_.load();
   if (int(jobs_.size()) >= options_.queue + std::max(0, idle)) return std::nullopt;
-  jobs_.push_back(Job{std::move(scene), {}});
+  jobs_.push_back(Job{std::move(scene), std::nullopt, {}});
+  if (sequence.count > 0) jobs_.back().sequence = std::move(sequence);
   auto future = jobs_.back().done.get_future();
   wake_.notify_one();
   return future;
@@ -69,8 +74,12 @@ void RenderPool::worker(int) {
       }
     }
     try {
-      job.done.set_value(renderer.ok() ? renderer.value()->render(job.scene)
-                                       : Result<Frame>(unsatisfiable("/renderer", renderer.error().message)));
+      if (!renderer.ok())
+        job.done.set_value(unsatisfiable("/renderer", renderer.error().message));
+      else if (job.sequence)
+        job.done.set_value(renderer.value()->render(job.scene, *job.sequence));
+      else
+        job.done.set_value(renderer.value()->render(job.scene));
     } catch (const std::exception& e) {
       job.done.set_value(unsatisfiable("/renderer", std::string("render failed: ") + e.what()));
     }

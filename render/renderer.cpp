@@ -143,6 +143,22 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const std::string& platform) 
 }
 
 Result<Frame> Renderer::render(const Scene& scene) { return impl_->render(scene); }
+
+Result<Frame> Renderer::render(Scene& scene, const Sequence& sequence) {
+  Frame total;
+  for (int i = 0; i < sequence.count; ++i) {
+    if (sequence.prepare) sequence.prepare(scene, i);
+    auto frame = impl_->render(scene);
+    if (!frame.ok()) return frame.error();
+    total.ms += frame.value().ms;
+    total.variantsCompiled += frame.value().variantsCompiled;
+    total.variantsCached = frame.value().variantsCached;
+    total.passes = frame.value().passes;
+    if (sequence.consume)
+      if (auto e = sequence.consume(frame.value(), i)) return *e;
+  }
+  return total;
+}
 const std::string& Renderer::description() const { return impl_->gpu.description; }
 
 }  // namespace effects::render

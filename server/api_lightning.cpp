@@ -100,6 +100,46 @@ json guideJson(const lt::Bolt& bolt) {
   return g;
 }
 
+// "timeline": when each polyline vertex lights, the strokes, and the channels' keyframes.
+json timelineJson(const lt::Timeline& tl) {
+  json lines = json::array();
+  for (size_t i = 0; i < tl.leader.size(); ++i) lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
+  json strokes = json::array();
+  for (const auto& s : tl.strokes) strokes.push_back({{"t", s.t}, {"peak", s.peak}});
+  json t = json::array(), leader = json::array(), main = json::array(), branches = json::array();
+  for (const auto& k : tl.keyframes) {
+    t.push_back(k.t);
+    leader.push_back(k.leader);
+    main.push_back(k.main);
+    branches.push_back(k.branches);
+  }
+  return {{"connect", tl.connect},
+          {"duration", tl.duration},
+          {"strokes", std::move(strokes)},
+          {"keyframes", {{"t", std::move(t)}, {"leader", std::move(leader)}, {"main", std::move(main)}, {"branches", std::move(branches)}}},
+          {"polylines", std::move(lines)}};
+}
+
+// The strike's physics: top-level animationSeed (default: seed) and timeScale, "timeline".
+lt::TimelineParams parseTimeline(const json& body, uint64_t seed, const std::string& at) {
+  lt::TimelineParams t;
+  t.seed = body.value("animationSeed", seed);
+  t.timeScale = body.value("timeScale", t.timeScale);
+  const json o = body.value("timeline", json::object());
+  t.cellSize = o.value("cellSize", t.cellSize);
+  t.leaderStep = o.value("leaderStep", t.leaderStep);
+  if (o.contains("leaderPause")) t.pauseMinUs = o["leaderPause"][0], t.pauseMaxUs = o["leaderPause"][1];
+  t.returnStrokeSpeed = o.value("returnStrokeSpeed", t.returnStrokeSpeed);
+  t.strokes = o.value("strokes", t.strokes);
+  if (o.contains("strokeInterval")) t.intervalMinMs = o["strokeInterval"][0], t.intervalMaxMs = o["strokeInterval"][1];
+  t.flashMs = o.value("flashDecay", t.flashMs);
+  t.glowMs = o.value("glowDecay", t.glowMs);
+  t.leaderBrightness = o.value("leaderBrightness", t.leaderBrightness);
+  t.flicker = o.value("flicker", t.flicker);
+  if (auto e = lt::validate(t)) throwError(*e, at);
+  return t;
+}
+
 }  // namespace
 
 LightningRequest parseLightning(const json& body, const Config& config, const std::string& at) {
@@ -144,6 +184,7 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   shape.branchWidth = s.value("branchWidth", shape.branchWidth);
   shape.branchIntensity = s.value("branchIntensity", shape.branchIntensity);
   shape.branchFalloff = s.value("branchFalloff", shape.branchFalloff);
+  r.timeline = parseTimeline(body, p.seed, at);
   return r;
 }
 
@@ -167,11 +208,16 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;
   json out = {{"method", bolt.stats.method}, {"grid", {p.width, p.height}}};
+  if (p.method == lt::Method::kFast) out["variant"] = body.value("variant", "calibrated");
   out["mainChannelLength"] = bolt.mainChannel.size();
   out["cellCount"] = bolt.nodes.size();
   out["steps"] = bolt.nodes.back().step;
 
-  if (include.has("polylines")) out["polylines"] = polylinesJson(lt::polylines(bolt, request.shape));
+  if (include.has("polylines") || include.has("timeline")) {
+    const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
+    if (include.has("polylines")) out["polylines"] = polylinesJson(lines);
+    if (include.has("timeline")) out["timeline"] = timelineJson(lt::timeline(bolt, lines, request.timeline));
+  }
   if (include.has("cells")) out["cells"] = cellsJson(bolt);
   if (include.has("tree")) out["tree"] = treeJson(bolt);
   if (include.has("guide")) out["guide"] = guideJson(bolt);

@@ -17,6 +17,7 @@ JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx)
 struct LightningRequest {
   effects::lightning::Params params;
   effects::lightning::ShapeParams shape;
+  effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
 };
 // The request at JSON pointer `at` ("" for the endpoint's body); problems name fields under it.
 LightningRequest parseLightning(const nlohmann::json& body, const Config& config, const std::string& at);

@@ -129,12 +129,18 @@ rd::Fog parseSceneFog(const json& f) {
   return fog;
 }
 
-// The bolt grown by the lightning endpoint's own parser and method, in the scene's style.
-rd::Lightning sceneLightning(const json& body, const Config& config) {
+// The bolt grown by the lightning endpoint's own parser and method, in the scene's style;
+// for an animated render, its strike timeline.
+rd::Lightning sceneLightning(const json& body, const Config& config, Animation* animation) {
   const LightningRequest r = parseLightning(body["lightning"], config, "/lightning");
   const effects::lightning::Bolt bolt = growBolt(r.params, "/lightning");
   rd::Lightning l;
   l.polylines = effects::lightning::polylines(bolt, r.shape);
+  if (animation && animation->frames.count > 0) {
+    animation->bolt = l.polylines;
+    animation->strike = effects::lightning::timeline(bolt, l.polylines, r.timeline);
+    animation->strikeTime = body.value("lightningStyle", json::object()).value("strikeTime", animation->time);
+  }
   l.gridWidth = r.params.width;
   l.gridHeight = r.params.height;
   const json st = body.value("lightningStyle", json::object());
@@ -190,9 +196,24 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
   return b;
 }
 
+// "frames": how many, how fast, and into what; frames x pixels within --max-render-pixels.
+Frames parseFrames(const json& f, const rd::Scene& s, const Config& config) {
+  Frames out;
+  out.count = f["count"];
+  out.fps = f.value("fps", out.fps);
+  out.flipbook = f.value("format", "gif") == "flipbook";
+  const size_t pixels = size_t(out.count) * size_t(s.width) * size_t(s.height);
+  if (pixels > config.limits.maxRenderPixels)
+    throw fieldError(413, "/frames/count",
+                     std::to_string(out.count) + " frames of " + std::to_string(s.width) + "x" +
+                         std::to_string(s.height) + " are " + std::to_string(pixels) + " pixels, over the limit of " +
+                         std::to_string(config.limits.maxRenderPixels) + " (--max-render-pixels)");
+  return out;
+}
+
 }  // namespace
 
-rd::Scene buildScene(const json& body, const RequestContext& ctx, double* computeMs) {
+rd::Scene buildScene(const json& body, const RequestContext& ctx, double* computeMs, Animation* animation) {
   const Config& config = ctx.config;
   effects::Stopwatch watch;
   rd::Scene s;
@@ -204,6 +225,11 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
                          std::to_string(config.limits.maxRenderPixels) + " pixels (--max-render-pixels)");
   s.bitDepth = body.value("bitDepth", 8);
   s.time = body.value("time", 0.0);
+  if (animation) {
+    animation->time = s.time;
+    if (body.contains("frames")) animation->frames = parseFrames(body["frames"], s, config);
+    if (body.contains("bubble") && body["bubble"].contains("time")) animation->bubbleTime = body["bubble"]["time"].get<double>();
+  }
   parseCamera(body, s);
   if (body.contains("background")) parseBackground(body["background"], config, s);
   if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"]);
@@ -211,7 +237,7 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
     s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
   if (body.contains("quads")) parseQuads(body["quads"], s);
   if (body.contains("fog")) s.fog = parseSceneFog(body["fog"]);
-  if (body.contains("lightning")) s.lightning = sceneLightning(body, config);
+  if (body.contains("lightning")) s.lightning = sceneLightning(body, config, animation);
   if (body.contains("bubble")) s.bubble = sceneBubble(body, ctx, s.time);
   if (computeMs) *computeMs = watch.ms();
   return s;
@@ -253,9 +279,12 @@ void addRenderEndpoints(Service& service) {
       [pool, metrics](const json& body, const RequestContext& ctx) {
         JsonReply reply;
         reply.method = "render";
-        rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+        Animation animation;
+        rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
         const int bitDepth = scene.bitDepth;
-        auto job = pool->submit(std::move(scene));
+        std::optional<MovieWriter> movie;
+        if (animation.frames.count > 0) movie.emplace(animation, scene.width, scene.height, bitDepth);
+        auto job = movie ? pool->submit(std::move(scene), movie->sequence()) : pool->submit(std::move(scene));
         if (!job)
           throw ApiError{503,
                          "render-queue-full",
@@ -267,14 +296,22 @@ void addRenderEndpoints(Service& service) {
         if (!frame.ok()) throwError(frame.error());
         const rd::Frame& f = frame.value();
         effects::Stopwatch encode;
-        auto png = rd::encodePng(f.image, bitDepth);
-        if (!png.ok()) throwError(png.error());
+        reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
+        if (movie) {
+          auto m = movie->finish();
+          if (!m.ok()) throwError(m.error());
+          reply.binary = std::move(m.value().bytes);
+          reply.contentType = m.value().contentType;
+          for (auto& [name, value] : m.value().headers) reply.headers[name] = std::move(value);
+        } else {
+          auto png = rd::encodePng(f.image, bitDepth);
+          if (!png.ok()) throwError(png.error());
+          reply.binary = std::move(png.value());
+          reply.contentType = "image/png";
+        }
         for (const auto& p : f.passes) metrics->count("render_passes", p);
         metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
         reply.computeMs += f.ms + encode.ms();
-        reply.binary = std::move(png.value());
-        reply.contentType = "image/png";
-        reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
         reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
                             {"X-Render-Ms", std::to_string(f.ms)}};
         return reply;

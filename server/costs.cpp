@@ -116,6 +116,12 @@ Cost renderCost(const json& body, const Config& config) {
   // Render targets and read-back (RGBA float), the converted 8/16-bit image, the PNG; a
   // decoded background image.
   c.bytes += pixels * 96;
+  // Frames: a flipbook sheet (RGBA float, then 8/16-bit and PNG) of count x pixels; a GIF
+  // holds one frame at a time plus its output (under a byte per pixel per frame).
+  if (body.contains("frames")) {
+    const size_t count = std::max<size_t>(1, body["frames"].value("count", 1));
+    c.bytes += std::min(count * pixels, config.limits.maxRenderPixels) * 28;
+  }
   if (body.contains("background") && body["background"].contains("image"))
     c.bytes += config.limits.maxRenderPixels * 16;
   c.heavy = c.heavy || pixels >= (2048u * 2048u);

@@ -51,25 +51,45 @@ bool readScene(const std::string& scenePath, nlohmann::json& body) {
   return true;
 }
 
-// Renders a schema-valid scene into the PNG file `outPath`; returns the exit status.
+// Renders a schema-valid scene into `outPath` (a PNG; with "frames" a GIF or a flipbook PNG);
+// returns the exit status. What it rendered goes to stderr as one JSON line.
 int renderScene(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
   try {
-    effects::render::Scene scene = effectd::buildScene(body, effectd::RequestContext{"render", config});
+    effectd::Animation animation;
+    effects::render::Scene scene =
+        effectd::buildScene(body, effectd::RequestContext{"render", config}, nullptr, &animation);
     auto renderer = effects::render::Renderer::create(config.eglPlatform);
     if (!renderer.ok()) throw effectd::toApiError(renderer.error());
-    auto frame = renderer.value()->render(scene);
-    if (!frame.ok()) throw effectd::toApiError(frame.error());
-    auto png = effects::render::encodePng(frame.value().image, scene.bitDepth);
-    if (!png.ok()) throw effectd::toApiError(png.error());
+    nlohmann::json said = {{"renderer", renderer.value()->description()}};
+    std::string bytes;
+    if (animation.frames.count > 0) {
+      effectd::MovieWriter writer(animation, scene.width, scene.height, scene.bitDepth);
+      auto frames = renderer.value()->render(scene, writer.sequence());
+      if (!frames.ok()) throw effectd::toApiError(frames.error());
+      auto movie = writer.finish();
+      if (!movie.ok()) throw effectd::toApiError(movie.error());
+      bytes = std::move(movie.value().bytes);
+      said["passes"] = frames.value().passList();
+      said["renderMs"] = frames.value().ms;
+      said["contentType"] = movie.value().contentType;
+      for (const auto& [name, value] : movie.value().headers) said[name] = value;
+    } else {
+      auto frame = renderer.value()->render(scene);
+      if (!frame.ok()) throw effectd::toApiError(frame.error());
+      auto png = effects::render::encodePng(frame.value().image, scene.bitDepth);
+      if (!png.ok()) throw effectd::toApiError(png.error());
+      bytes = std::move(png.value());
+      said["passes"] = frame.value().passList();
+      said["renderMs"] = frame.value().ms;
+    }
     std::ofstream out(outPath, std::ios::binary);
-    out << png.value();
+    out << bytes;
     if (!out.flush()) {
       std::fprintf(stderr, "effectd render: cannot write %s\n", outPath.c_str());
       return 1;
     }
-    const std::string passes = frame.value().passList();
-    std::fprintf(stderr, "{\"renderer\":\"%s\",\"passes\":\"%s\",\"renderMs\":%.2f,\"bytes\":%zu}\n",
-                 renderer.value()->description().c_str(), passes.c_str(), frame.value().ms, png.value().size());
+    said["bytes"] = bytes.size();
+    std::fprintf(stderr, "%s\n", said.dump().c_str());
     return 0;
   } catch (const effectd::ApiError& e) {
     std::fprintf(stderr, "effectd render: %s\n", e.detail.c_str());
@@ -84,7 +104,7 @@ int renderCommand(std::vector<std::string> args) {
   std::vector<std::string> flags;
   renderArgs(args, scenePath, outPath, flags);
   if (scenePath.empty() || outPath.empty()) {
-    std::fputs("usage: effectd render SCENE.json -o OUT.png [--egl-platform=auto|device|surfaceless] [--max-*=N]\n",
+    std::fputs("usage: effectd render SCENE.json -o OUT.png|OUT.gif [--egl-platform=auto|device|surfaceless] [--max-*=N]\n",
                stderr);
     return 2;
   }

@@ -55,6 +55,39 @@ TEST(LightningApi, SameSeedSameBytesOtherJitterSeedSameCells) {
   EXPECT_NE(c["polylines"], ja["polylines"]);
 }
 
+TEST(LightningApi, TimelineParallelToPolylinesAndItsOwnSeed) {
+  TestServer s;
+  json req = request(64);
+  req["include"] = {"polylines", "timeline"};
+  auto r = s.postJson("/v1/lightning", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json a = json::parse(r->body);
+  EXPECT_EQ(a["variant"], "calibrated");
+  const json& tl = a["timeline"];
+  ASSERT_EQ(tl["polylines"].size(), a["polylines"].size());
+  for (size_t i = 0; i < a["polylines"].size(); ++i) {
+    EXPECT_EQ(tl["polylines"][i]["leader"].size(), a["polylines"][i]["step"].size());
+    EXPECT_EQ(tl["polylines"][i]["strokeDelay"].size(), a["polylines"][i]["step"].size());
+  }
+  const size_t keyframes = tl["keyframes"]["t"].size();
+  for (const char* c : {"leader", "main", "branches"}) EXPECT_EQ(tl["keyframes"][c].size(), keyframes) << c;
+  EXPECT_GT(tl["duration"].get<double>(), tl["connect"].get<double>());
+
+  // Another animation seed: the same bolt, another strike; timeScale stretches it.
+  req["animationSeed"] = 99;
+  req["timeScale"] = 4;
+  json b = json::parse(s.postJson("/v1/lightning", req)->body);
+  EXPECT_EQ(b["polylines"], a["polylines"]);
+  EXPECT_NE(b["timeline"]["strokes"], a["timeline"]["strokes"]);
+  EXPECT_GT(b["timeline"]["connect"].get<double>(), 2 * a["timeline"]["connect"].get<double>());
+
+  req["variant"] = "paper";
+  EXPECT_EQ(json::parse(s.postJson("/v1/lightning", req)->body)["variant"], "paper");
+  req["timeline"] = {{"leaderPause", {50, 20}}};
+  json p = expectProblem(s.postJson("/v1/lightning", req), 400);
+  EXPECT_TRUE(hasPointer(p, "/timeline/leaderPause")) << p.dump();
+}
+
 TEST(LightningApi, LargeGridWithBitmapObstacles) {
   TestServer s;
   const int n = 1024;

@@ -3,12 +3,15 @@
 // polylines, only-needed passes, concurrency and saturation, bad input.
 //
 // Golden images are the PNGs in examples/. EFFECTD_UPDATE_GOLDEN=1 rewrites them.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <future>
 
+#include <OpenImageIO/imageio.h>
 #include <render/render.h>
 #include <glm/geometric.hpp>
 
@@ -36,6 +39,32 @@ glm::vec4 pixel(const rd::Image& img, int x, int y) {
 
 httplib::Result render(const TestServer& s, const json& scene) { return s.postJson("/v1/render", scene); }
 
+// Frames of an animated GIF, decoded by OpenImageIO's reader (giflib), as straight RGBA.
+std::vector<rd::Image> decodeGif(const std::string& bytes) {
+  std::vector<rd::Image> frames;
+  // OpenImageIO's GIF reader reads files only.
+  const fs::path path = fs::temp_directory_path() / ("effectd-test-" + std::to_string(::getpid()) + ".gif");
+  std::ofstream(path, std::ios::binary) << bytes;
+  auto in = OIIO::ImageInput::open(path.string());
+  fs::remove(path);
+  if (!in) return frames;
+  for (int i = 0; in->seek_subimage(i, 0); ++i) {
+    const OIIO::ImageSpec& s = in->spec();
+    rd::Image f{s.width, s.height, std::vector<float>(size_t(s.width) * s.height * 4, 1.0f)};
+    if (!in->read_image(i, 0, 0, std::min(4, s.nchannels), OIIO::TypeDesc::FLOAT, f.rgba.data(), 4 * sizeof(float)))
+      break;
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+double meanBrightness(const rd::Image& img) {
+  double sum = 0;
+  for (size_t i = 0; i < img.rgba.size(); ++i)
+    if (i % 4 < 3) sum += img.rgba[i];
+  return sum / double(img.rgba.size() * 3 / 4);
+}
+
 TEST(Render, ExampleScenesMatchTheirGoldenImages) {
   TestServer s;
   const bool update = std::getenv("EFFECTD_UPDATE_GOLDEN") != nullptr;
@@ -47,27 +76,35 @@ TEST(Render, ExampleScenesMatchTheirGoldenImages) {
     auto r = s.postJson("/v1/render", slurp(entry.path()));
     ASSERT_TRUE(r);
     ASSERT_EQ(r->status, 200) << r->body;
-    EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+    const bool animated = r->get_header_value("Content-Type") == "image/gif";
+    EXPECT_TRUE(animated || r->get_header_value("Content-Type") == "image/png");
     EXPECT_FALSE(r->get_header_value("X-Renderer").empty());
-    const fs::path golden = fs::path(entry.path()).replace_extension(".png");
+    const fs::path golden = fs::path(entry.path()).replace_extension(animated ? ".gif" : ".png");
     if (update) {
       std::ofstream(golden, std::ios::binary) << r->body;
       continue;
     }
     ASSERT_TRUE(fs::exists(golden)) << golden << " is missing: run with EFFECTD_UPDATE_GOLDEN=1";
-    rd::Image got = decode(r->body), want = decode(slurp(golden));
-    ASSERT_EQ(got.width, want.width);
-    ASSERT_EQ(got.height, want.height);
-    // Tolerance: llvmpipe builds and GPUs may differ by rounding at edges, not in content.
-    double sum = 0;
-    size_t far = 0;
-    for (size_t i = 0; i < got.rgba.size(); ++i) {
-      double d = std::abs(got.rgba[i] - want.rgba[i]);
-      sum += d;
-      far += d > 8.0 / 255;
+    const auto frames = [&](const std::string& bytes) {
+      return animated ? decodeGif(bytes) : std::vector<rd::Image>{decode(bytes)};
+    };
+    const std::vector<rd::Image> got = frames(r->body), want = frames(slurp(golden));
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t f = 0; f < got.size(); ++f) {
+      SCOPED_TRACE("frame " + std::to_string(f));
+      ASSERT_EQ(got[f].width, want[f].width);
+      ASSERT_EQ(got[f].height, want[f].height);
+      // Tolerance: llvmpipe builds and GPUs may differ by rounding at edges, not in content.
+      double sum = 0;
+      size_t far = 0;
+      for (size_t i = 0; i < got[f].rgba.size(); ++i) {
+        double d = std::abs(got[f].rgba[i] - want[f].rgba[i]);
+        sum += d;
+        far += d > 8.0 / 255;
+      }
+      EXPECT_LT(sum / double(got[f].rgba.size()), 1.0 / 255) << "mean difference";
+      EXPECT_LT(double(far) / double(got[f].rgba.size()), 0.005) << "share of channels off by more than 8/255";
     }
-    EXPECT_LT(sum / double(got.rgba.size()), 1.0 / 255) << "mean difference";
-    EXPECT_LT(double(far) / double(got.rgba.size()), 0.005) << "share of channels off by more than 8/255";
   }
   EXPECT_GE(scenes, 4);
 }
@@ -375,6 +412,74 @@ TEST(Render, BadScenesNameTheField) {
   auto png = rd::encodePng(big, 8);
   ASSERT_TRUE(png.ok());
   problem({{"background", {{"image", base64Encode(png.value())}}}}, 413, "/background/image");
+}
+
+json strikeScene(int frames, const char* format) {
+  return {{"width", 96},
+          {"height", 96},
+          {"frames", {{"count", frames}, {"fps", 20}, {"format", format}}},
+          {"lightning",
+           {{"grid", {{"width", 48}, {"height", 48}}}, {"start", {24, 0}}, {"targets", {{24, 47}}}, {"timeScale", 4}}}};
+}
+
+TEST(Render, StrikeAsAnimatedGif) {
+  TestServer s;
+  auto r = render(s, strikeScene(30, "gif"));
+  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
+  EXPECT_EQ(r->get_header_value("Content-Type"), "image/gif");
+  EXPECT_EQ(r->get_header_value("X-Frame-Count"), "30");
+  const std::vector<rd::Image> g = decodeGif(r->body);
+  ASSERT_EQ(g.size(), 30u);
+  EXPECT_EQ(g[0].width, 96);
+  EXPECT_EQ(g[0].height, 96);
+  // The strike lights the first frames, strokes re-light it, the last frames are dark again.
+  std::vector<double> brightness;
+  for (const auto& f : g) brightness.push_back(meanBrightness(f));
+  EXPECT_GT(brightness[0], brightness.back() + 0.01);
+  EXPECT_LT(std::abs(brightness[29] - brightness[28]), 1e-3);
+  int relit = 0;
+  for (size_t i = 1; i < brightness.size(); ++i) relit += brightness[i] > brightness[i - 1] + 0.002;
+  EXPECT_GE(relit, 2) << "re-strikes";
+  // The same scene, the same bytes; another animation seed, another movie of the same bolt.
+  EXPECT_EQ(render(s, strikeScene(30, "gif"))->body, r->body);
+  json other = strikeScene(30, "gif");
+  other["lightning"]["animationSeed"] = 9;
+  EXPECT_NE(render(s, other)->body, r->body);
+}
+
+TEST(Render, FlipbookHoldsTheFramesInAGrid) {
+  TestServer s;
+  auto r = render(s, strikeScene(10, "flipbook"));
+  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
+  EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+  EXPECT_EQ(r->get_header_value("X-Flipbook-Columns"), "4");
+  EXPECT_EQ(r->get_header_value("X-Flipbook-Rows"), "3");
+  const rd::Image sheet = decode(r->body);
+  EXPECT_EQ(sheet.width, 4 * 96);
+  EXPECT_EQ(sheet.height, 3 * 96);
+  EXPECT_EQ(pixel(sheet, 3 * 96 + 50, 2 * 96 + 50).a, 0.0f);  // after the last frame: empty
+  EXPECT_EQ(pixel(sheet, 50, 50).a, 1.0f);
+
+  // A wobbling bubble: frames differ.
+  json bubble = {{"width", 64}, {"height", 64}, {"frames", {{"count", 4}, {"fps", 4}, {"format", "flipbook"}}}, {"bubble", json::object()}};
+  r = render(s, bubble);
+  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
+  const rd::Image b = decode(r->body);
+  double diff = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) diff += glm::length(pixel(b, x, y) - pixel(b, 64 + x, y));
+  EXPECT_GT(diff, 1.0);
+}
+
+TEST(Render, FramesAreBoundedByThePixelLimit) {
+  Config c = TestServer::quietConfig();
+  c.limits.maxRenderPixels = 96 * 96 * 20;
+  TestServer s(c);
+  json p = expectProblem(render(s, strikeScene(21, "gif")), 413);
+  EXPECT_TRUE(hasPointer(p, "/frames/count")) << p.dump();
+  EXPECT_EQ(render(s, strikeScene(20, "gif"))->status, 200);
+  p = expectProblem(render(s, {{"frames", {{"count", 0}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/frames/count")) << p.dump();
 }
 
 TEST(Render, BackgroundImageFillsTheFrame) {

@@ -140,3 +140,73 @@ struct Polyline {
 std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& shape);
 
 }  // namespace effects::lightning
+
+namespace effects::lightning {
+
+// ---- Strike timeline: when each vertex lights and how bright the channels are -------------
+// A cloud-to-ground flash in physical units (Uman, "The Lightning Discharge"; Rakov & Uman,
+// "Lightning: Physics and Effects"): a stepped leader advances from the start in steps of
+// ~50 m separated by 20-50 us pauses, along every branch at once; when it touches the target
+// the leader stops (branch tips it had not reached stay dark) and a return stroke runs back up
+// the main channel at ~1/3 c, flashing the branches once; 3-4 strokes 40-60 ms apart re-light
+// the main channel (each dart leader follows the old channel); the channel flickers between
+// strokes and its glow fades over ~100 ms. Deterministic from `seed`; the bolt's shape is not
+// touched, so the same bolt can be animated many ways. Times are game seconds = physical
+// seconds * timeScale. Docs: docs/effects.md section 1 ("Strike timeline").
+struct TimelineParams {
+  uint64_t seed = 1;                 // the animation seed (pauses, stroke count and spacing, flicker)
+  double timeScale = 1;              // game seconds per physical second, (0, 1e6]
+  double cellSize = 25;              // metres per grid cell
+  double leaderStep = 50;            // metres per leader step
+  double pauseMinUs = 20, pauseMaxUs = 50;
+  double returnStrokeSpeed = 1e8;    // m/s (~c/3)
+  int strokes = 0;                   // return strokes; 0 = 3 or 4 at random
+  double intervalMinMs = 40, intervalMaxMs = 60;
+  double flashMs = 8;                // decay time of each stroke's flash
+  double glowMs = 35;                // decay time of the channel's glow (gone after ~100 ms)
+  double leaderBrightness = 0.3;     // the leader's glow relative to the first stroke's peak
+  double flicker = 0.25;             // relative brightness noise of the glow between strokes
+};
+
+std::optional<Error> validate(const TimelineParams& p);
+
+// Brightness of the three channel classes over time; clients interpolate linearly.
+struct Keyframe {
+  double t = 0;
+  float leader = 0;    // vertices the leader has reached and no stroke has yet
+  float main = 0;      // the main channel after the first stroke reached the vertex
+  float branches = 0;  // branch vertices after the first stroke reached them (first stroke only)
+};
+
+struct Stroke {
+  double t = 0;     // when the return stroke starts at the target
+  float peak = 1;   // its peak brightness (the first: 1)
+};
+
+struct Timeline {
+  // Per polyline, per vertex (parallel to polylines()): when the leader reaches the vertex,
+  // and how long after a stroke starts that stroke reaches it. Along a polyline both grow
+  // monotonically in the leader's direction.
+  std::vector<std::vector<double>> leader, strokeDelay;
+  double connect = 0;   // the leader touches the target: it stops, the first stroke starts
+  double duration = 0;  // every channel dark from here
+  std::vector<Stroke> strokes;
+  std::vector<Keyframe> keyframes;
+};
+
+// `lines` must be polylines(bolt, ...) of the same bolt.
+Timeline timeline(const Bolt& bolt, const std::vector<Polyline>& lines, const TimelineParams& params);
+
+// The keyframe channels at time t (linear between keyframes, 0 outside).
+Keyframe channelsAt(const Timeline& tl, double t);
+
+// A vertex's brightness at time t (0 before the leader reaches it or if it never does,
+// multiplied by its intensity), as a client would compute it from the answer.
+double vertexBrightness(const Timeline& tl, const std::vector<Polyline>& lines, size_t line, size_t vertex, double t);
+
+// The bolt as an eye sees it over one frame [t0, t1]: each polyline cut to the vertices the
+// leader has reached by t1, each vertex's intensity the highest brightness it had during the
+// frame (a flash shorter than a frame is not lost between frames); unlit polylines left out.
+std::vector<Polyline> exposure(const Timeline& tl, const std::vector<Polyline>& lines, double t0, double t1);
+
+}  // namespace effects::lightning

@@ -20,6 +20,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -140,6 +141,14 @@ struct Frame {
   std::string passList() const;     // "background,quads,...": the passes, comma-separated
 };
 
+// Renders several frames of one scene in one job: before frame i, prepare(scene, i) moves the
+// scene on (time, animated parts); after it, consume(frame, i) takes the pixels.
+struct Sequence {
+  int count = 1;
+  std::function<void(Scene&, int)> prepare;
+  std::function<std::optional<Error>(const Frame&, int)> consume;
+};
+
 // Which EGL platform to use: "auto" (device, then surfaceless), "device" or "surfaceless".
 // Empty = the EFFECTD_EGL_PLATFORM environment variable, else "auto".
 class Renderer {
@@ -151,6 +160,7 @@ class Renderer {
 
   // Call on the creating thread only.
   Result<Frame> render(const Scene& scene);
+  Result<Frame> render(Scene& scene, const Sequence& sequence);
   // e.g. "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless"
   const std::string& description() const;
 
@@ -162,6 +172,33 @@ class Renderer {
 
 // PNG bytes of `frame` (8 or 16 bits per channel, straight alpha) via OpenImageIO.
 Result<std::string> encodePng(const Image& image, int bitDepth);
+
+// An animated GIF written frame by frame through OpenImageIO's GIF writer (256 colours per
+// frame, looping forever), so a sequence never holds more than one frame.
+class GifEncoder {
+ public:
+  GifEncoder(int width, int height, int count, double fps);
+  ~GifEncoder();
+  GifEncoder(const GifEncoder&) = delete;
+  GifEncoder& operator=(const GifEncoder&) = delete;
+  std::optional<Error> add(const Image& frame);
+  Result<std::string> finish();  // after `count` frames
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A flipbook (sprite sheet): `count` frames in a grid, left to right, top to bottom, as the
+// texture-sheet animations of engines play them (Unity's Texture Sheet Animation, Unreal's
+// SubUV). columns = ceil(sqrt(count)), rows = ceil(count / columns); unused cells transparent.
+struct Flipbook {
+  int columns = 0, rows = 0, frameWidth = 0, frameHeight = 0;
+  Image sheet;
+  Flipbook(int width, int height, int count);
+  void put(const Image& frame, int index);
+};
+
 // Decodes PNG/JPEG/anything OpenImageIO reads from memory into straight-alpha RGBA float.
 // Images with more than maxPixels pixels are refused before their pixels are decoded.
 Result<Image> decodeImage(const std::string& bytes, size_t maxPixels);
@@ -182,6 +219,9 @@ class RenderPool {
 
   // nullopt when the queue is full (the caller answers 503 + Retry-After).
   std::optional<std::future<Result<Frame>>> submit(Scene scene);
+  // A frame sequence as one job; the Frame returned has no pixels (consume took them), the
+  // last frame's passes, and the compile counts and times summed over the frames.
+  std::optional<std::future<Result<Frame>>> submit(Scene scene, Sequence sequence);
   // Starts the threads if they are not running and waits for the first context; "" when
   // every context could be created, otherwise why not.
   std::string start();
@@ -192,6 +232,7 @@ class RenderPool {
   void worker(int index);
   struct Job {
     Scene scene;
+    std::optional<Sequence> sequence;
     std::promise<Result<Frame>> done;
   };
   PoolOptions options_;

@@ -1,0 +1,60 @@
+// Animated renders: each frame's scene from the animation, frames into a GIF or a flipbook.
+#include "scene.h"
+
+namespace effectd {
+
+namespace rd = effects::render;
+
+MovieWriter::MovieWriter(const Animation& animation, int width, int height, int bitDepth)
+    : animation_(animation), bitDepth_(bitDepth) {
+  if (animation.frames.flipbook)
+    book_.emplace(width, height, animation.frames.count);
+  else
+    gif_.emplace(width, height, animation.frames.count, animation.frames.fps);
+}
+
+rd::Sequence MovieWriter::sequence() {
+  rd::Sequence s;
+  s.count = animation_.frames.count;
+  s.prepare = [this](rd::Scene& scene, int i) {
+    const Animation& a = animation_;
+    const double dt = 1.0 / a.frames.fps, offset = i * dt;
+    scene.time = a.time + offset;
+    if (scene.bubble) scene.bubble->time = a.bubbleTime.value_or(a.time) + offset;
+    if (scene.lightning && a.strike) {
+      // The strike as an eye sees it: each vertex at its brightest moment in the frame.
+      const double t = scene.time - a.strikeTime;
+      scene.lightning->polylines = effects::lightning::exposure(*a.strike, a.bolt, t, t + dt);
+    }
+  };
+  s.consume = [this](const rd::Frame& frame, int i) -> std::optional<effects::Error> {
+    if (book_) {
+      book_->put(frame.image, i);
+      return std::nullopt;
+    }
+    return gif_->add(frame.image);
+  };
+  return s;
+}
+
+effects::Result<Movie> MovieWriter::finish() {
+  Movie m;
+  const Frames& f = animation_.frames;
+  m.headers = {{"X-Frame-Count", std::to_string(f.count)}, {"X-Frame-Rate", nlohmann::json(f.fps).dump()}};
+  if (book_) {
+    auto png = rd::encodePng(book_->sheet, bitDepth_);
+    if (!png.ok()) return png.error();
+    m.bytes = std::move(png.value());
+    m.contentType = "image/png";
+    m.headers.push_back({"X-Flipbook-Columns", std::to_string(book_->columns)});
+    m.headers.push_back({"X-Flipbook-Rows", std::to_string(book_->rows)});
+    return m;
+  }
+  auto gif = gif_->finish();
+  if (!gif.ok()) return gif.error();
+  m.bytes = std::move(gif.value());
+  m.contentType = "image/gif";
+  return m;
+}
+
+}  // namespace effectd
