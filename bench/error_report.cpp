@@ -88,6 +88,108 @@ double dimensionOf(const lt::Bolt& b, int n) {
   return lt::fractalDimension(cells, n, n);
 }
 
+// Mean and sample standard deviation.
+std::pair<double, double> meanSd(const std::vector<double>& v) {
+  double mean = 0, var = 0;
+  for (double x : v) mean += x / double(v.size());
+  for (double x : v) var += (x - mean) * (x - mean) / double(std::max<size_t>(1, v.size() - 1));
+  return {mean, std::sqrt(var)};
+}
+
+// The settings of one grid and neighbourhood: the calibrated default, the paper's constants
+// and the curves through them (lifetime, eqn 8's base), charges, DBM's solver tolerances.
+std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood) {
+  auto layout = [&] {
+    lt::Params p = fixtures::lightningLayout(n);
+    p.neighbourhood = hood;
+    p.axisGrowth = lt::calibratedAxisGrowth(p);
+    return p;
+  };
+  std::vector<LightningSetting> settings;
+  settings.push_back({"fast calibrated", "default: axisGrowth " + fmt(layout().axisGrowth, 3) + ", lifetime inf", layout()});
+  for (int life : {2, 4, 8, 0}) {  // the paper's base 2; lifetime 4 is the paper variant
+    lt::Params p = layout();
+    p.axisGrowth = lt::kPaperAxisGrowth;
+    p.lifetime = life;
+    settings.push_back({"fast paper", (life == 4 ? "variant paper: lifetime 4" : "lifetime " + (life ? std::to_string(life) : std::string("inf"))), p});
+  }
+  for (double growth : {1.5, 1.25, 1.1, 1.0}) {  // eqn 8's base, candidates never expiring
+    lt::Params p = layout();
+    p.axisGrowth = growth;
+    settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3), p});
+  }
+  if (n <= 128 || hood == 8) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2
+    lt::Params c = layout();
+    c.method = lt::Method::kCharges;
+    settings.push_back({"charges", "charges", c});
+  }
+  std::vector<double> tolerances;
+  if (quick)
+    tolerances = {1e-2, 1e-4, 1e-6};
+  else if (n <= 128)
+    tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
+  else
+    tolerances = {1e-2, 1e-4};
+  for (lt::Solver solver : {lt::Solver::kMgpcg, lt::Solver::kCg}) {
+    if (solver == lt::Solver::kCg && (quick || n > 64)) continue;
+    for (double tol : tolerances) {
+      lt::Params p = layout();
+      p.method = lt::Method::kDbm;
+      p.solver = solver;
+      p.tolerance = tol;
+      settings.push_back({std::string("dbm-") + lt::toString(solver), "tol " + fmt(tol, 1), p});
+    }
+  }
+  return settings;
+}
+
+// Every setting over 10 seeds (3 in the quick run): D against DBM's (tolerance 1e-8, the
+// same neighbourhood, 10 seeds) and, up to 128^2, the mean per-step total-variation distance
+// (its reference solve every step costs seconds per 256^2 bolt).
+void lightningRows(bool quick, int n, int hood, Section& tv, Section& fd) {
+  const int seeds = quick ? 3 : 10;
+  const std::string grid = std::to_string(n) + "², " + std::to_string(hood) + "-nbhd";
+  std::vector<double> refD;
+  {
+    lt::Params p = fixtures::lightningLayout(n);
+    p.neighbourhood = hood;
+    p.method = lt::Method::kDbm;
+    p.tolerance = 1e-8;
+    for (int s = 1; s <= seeds; ++s) {
+      p.seed = uint64_t(s);
+      auto b = lt::grow(p);
+      if (b.ok()) refD.push_back(dimensionOf(b.value(), n));
+    }
+  }
+  const auto [dRef, dRefSd] = meanSd(refD);
+  for (const auto& s : lightningSettings(quick, n, hood)) {
+    std::vector<double> times, dims, tvs;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      lt::Params p = s.params;
+      p.seed = uint64_t(seed);
+      auto b = lt::grow(p);
+      if (!b.ok()) continue;
+      times.push_back(b.value().stats.elapsedMs);
+      dims.push_back(dimensionOf(b.value(), n));
+      if (n > 128) continue;
+      p.measureError = true;
+      auto e = lt::grow(p);
+      if (e.ok()) tvs.push_back(e.value().stats.error.value_or(0));
+    }
+    const auto [mean, sd] = meanSd(dims);
+    // One curve per method, grid and neighbourhood; the setting varies along it.
+    const std::string series = s.series + " " + grid;
+    fd.points.push_back({series, s.setting, median(times), std::abs(mean - dRef),
+                         fmt(mean, 3) + " ± " + fmt(sd, 2) + " (" + std::to_string(dims.size()) + " seeds)"});
+    if (tvs.empty()) continue;
+    const auto [tvMean, tvSd] = meanSd(tvs);
+    tv.points.push_back({series, s.setting, median(times), tvMean,
+                         "± " + fmt(tvSd, 2) + " (" + std::to_string(tvs.size()) + " seeds)"});
+  }
+  fd.points.push_back({"dbm reference " + grid, "D_ref", 0, 0,
+                       fmt(dRef, 3) + " ± " + fmt(dRefSd, 2) + " (" + std::to_string(refD.size()) + " seeds)"});
+}
+
 void lightning(bool quick, Section& tv, Section& fd) {
   tv = {
       "lightning-tv",
@@ -96,7 +198,7 @@ void lightning(bool quick, Section& tv, Section& fd) {
       "mean total-variation distance per step",
       "ms per bolt (median)",
       "setting",
-      "seeds (time / error)",
+      "sd over seeds",
       {},
       {}};
   fd = {"lightning-fd",
@@ -109,108 +211,8 @@ void lightning(bool quick, Section& tv, Section& fd) {
         {},
         {}};
   const std::vector<int> sizes = quick ? std::vector<int>{32} : std::vector<int>{64, 128, 256};
-  for (int n : sizes) {
-    std::vector<LightningSetting> settings;
-    settings.push_back({"fast calibrated", "default: axisGrowth 1.2, lifetime inf", fixtures::lightningLayout(n)});
-    for (int life : {2, 4, 8, 0}) {  // the paper's base 2
-      lt::Params p = fixtures::lightningLayout(n);
-      p.axisGrowth = lt::kPaperAxisGrowth;
-      p.lifetime = life;
-      settings.push_back({"fast paper", "lifetime " + (life ? std::to_string(life) : std::string("inf")), p});
-    }
-    for (double growth : {1.5, 1.25, 1.1, 1.0}) {  // eqn 8's base at the paper's lifetime
-      lt::Params p = fixtures::lightningLayout(n);
-      p.lifetime = lt::kPaperLifetime;
-      p.axisGrowth = growth;
-      settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3), p});
-    }
-    lt::Params c = fixtures::lightningLayout(n);
-    c.method = lt::Method::kCharges;
-    settings.push_back({"charges", "charges", c});
-    std::vector<double> tolerances;
-    if (quick)
-      tolerances = {1e-2, 1e-4, 1e-6};
-    else if (n == 64)
-      tolerances = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
-    else if (n == 128)
-      tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
-    else
-      tolerances = {1e-2, 1e-4};
-    for (lt::Solver solver : {lt::Solver::kMgpcg, lt::Solver::kCg}) {
-      if (solver == lt::Solver::kCg && (quick || n > 128)) continue;
-      for (double tol : tolerances) {
-        lt::Params p = fixtures::lightningLayout(n);
-        p.method = lt::Method::kDbm;
-        p.solver = solver;
-        p.tolerance = tol;
-        settings.push_back({std::string("dbm-") + lt::toString(solver), "tol " + fmt(tol, 1), p});
-      }
-    }
-    // Seeds: 20 for the fast methods; fewer where one bolt takes seconds (stated per row).
-    auto seedsFor = [&](const LightningSetting& s) {
-      if (quick) return 3;
-      if (s.params.method == lt::Method::kDbm) return n == 64 ? 5 : n == 128 ? 3 : 1;
-      if (s.params.method == lt::Method::kCharges) return n == 256 ? 3 : 20;
-      return n == 256 ? 5 : 20;
-    };
-    auto errorSeedsFor = [&](const LightningSetting& s) {
-      if (n == 256)
-        return s.params.method == lt::Method::kFast && s.params.lifetime == 4 && s.params.axisGrowth == 2 ? 1 : 0;
-      if (n == 128 && s.params.method == lt::Method::kDbm && s.params.tolerance > 1e-3 &&
-          s.params.solver == lt::Solver::kCg)
-        return 0;  // a loose CG solve grows ~10^4 cells: tens of seconds of reference solves
-      return quick || n == 128 ? 1 : 2;
-    };
-    // Reference dimension: DBM at tolerance 1e-8 (MGPCG).
-    std::vector<double> refD;
-    {
-      lt::Params p = fixtures::lightningLayout(n);
-      p.method = lt::Method::kDbm;
-      p.tolerance = 1e-8;
-      const int seeds = quick ? 3 : n == 64 ? 10 : n == 128 ? 5 : 1;
-      for (int s = 1; s <= seeds; ++s) {
-        p.seed = uint64_t(s);
-        auto b = lt::grow(p);
-        if (b.ok()) refD.push_back(dimensionOf(b.value(), n));
-      }
-    }
-    double dRef = 0;
-    for (double d : refD) dRef += d / double(refD.size());
-    for (const auto& s : settings) {
-      std::vector<double> times, dims;
-      const int seeds = seedsFor(s);
-      for (int seed = 1; seed <= seeds; ++seed) {
-        lt::Params p = s.params;
-        p.seed = uint64_t(seed);
-        auto b = lt::grow(p);
-        if (!b.ok()) continue;
-        times.push_back(b.value().stats.elapsedMs);
-        dims.push_back(dimensionOf(b.value(), n));
-      }
-      double mean = 0, var = 0;
-      for (double d : dims) mean += d / double(dims.size());
-      for (double d : dims) var += (d - mean) * (d - mean) / double(std::max<size_t>(1, dims.size() - 1));
-      // One curve per method and grid size; the setting varies along it.
-      const std::string series = s.series + " " + std::to_string(n) + "²", label = s.setting;
-      fd.points.push_back(
-          {series, label, median(times), std::abs(mean - dRef), fmt(mean, 3) + " ± " + fmt(std::sqrt(var), 2)});
-      const int errSeeds = errorSeedsFor(s);
-      if (errSeeds == 0) continue;
-      double tvSum = 0;
-      for (int seed = 1; seed <= errSeeds; ++seed) {
-        lt::Params p = s.params;
-        p.seed = uint64_t(seed);
-        p.measureError = true;
-        auto b = lt::grow(p);
-        if (b.ok()) tvSum += b.value().stats.error.value_or(0);
-      }
-      tv.points.push_back(
-          {series, label, median(times), tvSum / errSeeds, std::to_string(seeds) + " / " + std::to_string(errSeeds)});
-    }
-    fd.points.push_back(
-        {"dbm reference " + std::to_string(n) + "²", "D_ref", 0, 0,
-         fmt(dRef, 3) + " (" + std::to_string(refD.size()) + (refD.size() == 1 ? " seed)" : " seeds)")});
-  }
+  for (int n : sizes)
+    for (int hood : {8, 4}) lightningRows(quick, n, hood, tv, fd);
 }
 
 // ---- fog --------------------------------------------------------------------------------------
@@ -379,6 +381,15 @@ void conclude(std::vector<Section>& sections) {
       for (const auto& p : s.points)
         if (p.ms > 0 && p.series.rfind("dbm", 0) != 0 && (!best || p.error < best->error)) best = &p;
       if (best) c << "Closest to DBM's dimension without a linear solve: " << show(*best) << ".";
+      c << " The calibrated default against DBM in its neighbourhood (|D − D_ref|; the paper variant):";
+      for (const auto& p : s.points) {
+        if (p.series.rfind("fast calibrated", 0) != 0) continue;
+        const std::string grid = p.series.substr(std::string("fast calibrated ").size());
+        c << " " << grid << " " << fmt(p.error, 2);
+        for (const auto& q : s.points)
+          if (q.series == "fast paper " + grid && q.setting.rfind("variant paper", 0) == 0) c << " (" << fmt(q.error, 2) << ")";
+        c << ";";
+      }
       // Per DBM curve: the loosest tolerance from which |D - D_ref| stays within 0.03.
       std::map<std::string, std::string> settles;
       for (const auto& p : s.points) {
@@ -500,7 +511,8 @@ void write(const std::vector<Section>& sections, const fs::path& out, bool quick
       pts.push_back({{"series", p.series},
                      {"setting", p.setting},
                      {"ms", p.ms},
-                     {"error", std::isfinite(p.error) ? json(p.error) : json()}});
+                     {"error", std::isfinite(p.error) ? json(p.error) : json()},
+                     {"note", p.note}});
     }
     md << "\n**Conclusion.** " << s.conclusion << "\n\n";
     j[s.id] = {{"title", s.title},

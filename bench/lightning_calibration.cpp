@@ -5,7 +5,10 @@
 // `--lifetime` is a row, so a scan shows which setting meets DBM at each grid and eta.
 //
 //   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
-//                         [--seeds S] [--dbm-seeds S] [--fit]
+//                         [--seeds S] [--dbm-seeds S] [--neighbourhood 4|8] [--fit]
+//                         [--charges-eta E]...
+// --charges-eta: rows for the charges method (Kim et al. 2007) at these eta, beside DBM's
+// row at each --eta: which charges eta gives DBM's statistics.
 // --fit: instead of the --axis rows, the base per cell at which the fast method's median
 // cells meet DBM's (bisection), and the statistics it gives.
 // Output: a markdown table, one row per (grid, eta, method, setting): mean +- sd of D,
@@ -101,9 +104,9 @@ double fitAxis(const lt::Params& base, double dbmCells, int seeds) {
 
 int main(int argc, char** argv) {
   std::vector<int> grids;
-  std::vector<double> etas, axes;
+  std::vector<double> etas, axes, chargesEtas;
   std::vector<int> lifetimes;
-  int seeds = 20, dbmSeeds = 10;
+  int seeds = 20, dbmSeeds = 10, neighbourhood = 8;
   bool fit = false;
   for (int i = 1; i < argc; i += 2) {
     const std::string flag = argv[i];
@@ -126,6 +129,10 @@ int main(int argc, char** argv) {
       seeds = std::atoi(v);
     else if (flag == "--dbm-seeds")
       dbmSeeds = std::atoi(v);
+    else if (flag == "--charges-eta")
+      chargesEtas.push_back(std::atof(v));
+    else if (flag == "--neighbourhood")
+      neighbourhood = std::atoi(v);
     else {
       std::fprintf(stderr, "unknown flag %s\n", argv[i]);
       return 2;
@@ -133,7 +140,7 @@ int main(int argc, char** argv) {
   }
   if (grids.empty()) grids = {64, 128};
   if (etas.empty()) etas = {1, 2, 3};
-  if (axes.empty()) axes = {lt::Params{}.axisGrowth};
+  const bool calibrated = axes.empty();  // each row at calibratedAxisGrowth() of its grid and eta
   if (lifetimes.empty()) lifetimes = {lt::Params{}.lifetime};
   std::printf("| grid | eta | method | setting | D | cells (median) | tips (median) | ms/bolt |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
@@ -144,6 +151,7 @@ int main(int argc, char** argv) {
       base.start = {n / 2, 0};
       base.targets = {{n / 2, n - 1}};
       base.eta = eta;
+      base.neighbourhood = neighbourhood;
       if (dbmSeeds > 0) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;
@@ -160,6 +168,16 @@ int main(int argc, char** argv) {
           continue;
         }
       }
+      for (double ce : chargesEtas) {
+        lt::Params p = base;
+        p.method = lt::Method::kCharges;
+        p.eta = ce;
+        char setting[64];
+        std::snprintf(setting, sizeof setting, "charges eta %g", ce);
+        row(n, eta, "charges", setting, p, seeds);
+      }
+      if (!chargesEtas.empty()) continue;
+      if (calibrated) axes = {lt::calibratedAxisGrowth(base)};
       for (double a : axes)
         for (int l : lifetimes) {
           lt::Params p = base;

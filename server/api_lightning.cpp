@@ -165,6 +165,8 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
                          " (--max-solver-grid-cells); the fast method takes up to " +
                          std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
+  p.neighbourhood = body.value("neighbourhood", p.neighbourhood);
+  p.axisGrowth = lt::calibratedAxisGrowth(p);
   if (body.value("variant", "calibrated") == "paper") {
     p.lifetime = lt::kPaperLifetime;
     p.axisGrowth = lt::kPaperAxisGrowth;

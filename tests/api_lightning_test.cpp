@@ -88,6 +88,31 @@ TEST(LightningApi, TimelineParallelToPolylinesAndItsOwnSeed) {
   EXPECT_TRUE(hasPointer(p, "/timeline/leaderPause")) << p.dump();
 }
 
+TEST(LightningApi, FourNeighbourhoodGrowsFourConnectedTrees) {
+  TestServer s;
+  for (const char* method : {"fast", "dbm", "charges"}) {
+    json req = request(32);
+    req["neighbourhood"] = 4;
+    req["method"] = method;
+    req["include"] = {"cells", "tree"};
+    auto r = s.postJson("/v1/lightning", req);
+    ASSERT_EQ(r->status, 200) << r->body;
+    json a = json::parse(r->body);
+    const json &cells = a["cells"], &parent = a["tree"]["parent"];
+    for (size_t i = 1; i < parent.size(); ++i) {
+      const size_t q = parent[i].get<size_t>();
+      EXPECT_EQ(std::abs(cells[2 * i].get<int>() - cells[2 * q].get<int>()) +
+                    std::abs(cells[2 * i + 1].get<int>() - cells[2 * q + 1].get<int>()),
+                1)
+          << method << " cell " << i;
+    }
+  }
+  json req = request(32);
+  req["neighbourhood"] = 6;
+  json p = expectProblem(s.postJson("/v1/lightning", req), 400);
+  EXPECT_TRUE(hasPointer(p, "/neighbourhood")) << p.dump();
+}
+
 TEST(LightningApi, LargeGridWithBitmapObstacles) {
   TestServer s;
   const int n = 1024;

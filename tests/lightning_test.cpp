@@ -63,7 +63,7 @@ TEST(Fast, DefaultMeetsDbmStatistics) {
   }
 }
 
-// The bolt is a tree of 8-connected cells, free of obstacles, from start to every target.
+// The bolt is a tree of 8-connected (or 4-connected) cells, free of obstacles, from start to every target.
 void expectWellFormed(const Params& p, const Bolt& b) {
   ASSERT_FALSE(b.nodes.empty());
   EXPECT_EQ(b.nodes[0].cell, p.start);
@@ -80,6 +80,7 @@ void expectWellFormed(const Params& p, const Bolt& b) {
     const Cell& q = b.nodes[size_t(n.parent)].cell;
     EXPECT_LE(std::abs(q.x - n.cell.x), 1);
     EXPECT_LE(std::abs(q.y - n.cell.y), 1);
+    if (p.neighbourhood == 4) EXPECT_EQ(std::abs(q.x - n.cell.x) + std::abs(q.y - n.cell.y), 1);
   }
   ASSERT_FALSE(b.mainChannel.empty());
   EXPECT_EQ(b.nodes[size_t(b.mainChannel.front())].cell, p.start);
@@ -185,6 +186,57 @@ TEST(Lightning, MazeCorridorWithGuide) {
     auto b = grow(p);
     ASSERT_TRUE(b.ok()) << toString(m) << " " << b.error().message;
     expectWellFormed(p, b.value());
+  }
+}
+
+// The 4-neighbourhood: every method grows 4-connected trees, the guide walks 4-connected
+// paths (through a maze, and not through a diagonal gap: 422, not a hang), and the calibrated
+// fast method stays near 4-neighbourhood DBM.
+TEST(Lightning, FourNeighbourhood) {
+  const int n = 33;
+  Params maze = basic(n);
+  maze.neighbourhood = 4;
+  maze.obstacles.assign(size_t(n) * n, 0);
+  for (int y = 1; y < n - 1; y += 2)
+    for (int x = 0; x < n; ++x) maze.obstacles[size_t(y) * n + x] = (y / 2) % 2 == 0 ? (x != n - 1) : (x != 0);
+  maze.start = {0, 0};
+  maze.targets = {{n - 1, n - 1}};
+  for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
+    Params p = basic(48, m);
+    p.neighbourhood = 4;
+    auto b = grow(p);
+    ASSERT_TRUE(b.ok()) << toString(m) << " " << b.error().message;
+    expectWellFormed(p, b.value());
+    maze.method = m;
+    auto mb = grow(maze);
+    ASSERT_TRUE(mb.ok()) << toString(m) << " " << mb.error().message;
+    expectWellFormed(maze, mb.value());
+  }
+  // A wall whose only gap is diagonal: open to 8-neighbour bolts, closed to 4-neighbour ones.
+  Params gap = basic(16);
+  gap.obstacles.assign(16 * 16, 0);
+  for (int x = 0; x < 16; ++x) gap.obstacles[size_t(8) * 16 + x] = x != 7, gap.obstacles[size_t(7) * 16 + x] = x != 8;
+  gap.start = {8, 0};
+  gap.targets = {{8, 15}};
+  EXPECT_TRUE(grow(gap).ok());
+  gap.neighbourhood = 4;
+  auto closed = grow(gap);
+  ASSERT_FALSE(closed.ok());
+  EXPECT_EQ(closed.error().kind, ErrorKind::kUnsatisfiable);
+  EXPECT_EQ(closed.error().field, "/targets/0");
+  gap.neighbourhood = 6;
+  EXPECT_EQ(grow(gap).error().field, "/neighbourhood");
+
+  for (double eta : {1.0, 2.0}) {
+    Params fast = basic(64);
+    fast.eta = eta;
+    fast.neighbourhood = 4;
+    fast.axisGrowth = calibratedAxisGrowth(fast);
+    Params dbm = fast;
+    dbm.method = Method::kDbm;
+    const BoltStats f = statsOver(fast, 16), r = statsOver(dbm, 4);
+    EXPECT_NEAR(f.d, r.d, 0.1) << "eta " << eta;
+    EXPECT_NEAR(f.cells / r.cells, 1.0, 0.4) << "eta " << eta << ": " << f.cells << " vs " << r.cells;
   }
 }
 

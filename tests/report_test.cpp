@@ -49,8 +49,16 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
       EXPECT_TRUE(fs::exists(out / "error-vs-time" / (std::string(id) + ".png")));
     }
   }
-  // DBM: tighter solver tolerance -> closer to the converged distribution.
-  expectShrinks(errorsOf(r["lightning-tv"], "dbm-mgpcg 32²"), "dbm TV over tolerance 1e-2, 1e-4, 1e-6");
+  // DBM: tighter solver tolerance -> closer to the converged distribution, in either
+  // neighbourhood; every lightning row says its seeds.
+  for (const char* hood : {"8", "4"}) {
+    const std::string grid = std::string("32², ") + hood + "-nbhd";
+    expectShrinks(errorsOf(r["lightning-tv"], "dbm-mgpcg " + grid), "dbm TV over tolerance 1e-2, 1e-4, 1e-6 " + grid);
+    EXPECT_EQ(errorsOf(r["lightning-fd"], "fast calibrated " + grid).size(), 1u) << grid;
+    EXPECT_EQ(errorsOf(r["lightning-fd"], "fast paper " + grid, "variant paper").size(), 1u) << grid;
+  }
+  for (const char* id : {"lightning-tv", "lightning-fd"})
+    for (const auto& p : r[id]["points"]) EXPECT_NE(p["note"].get<std::string>().find("(3 seeds)"), std::string::npos) << p;
   // Fog tables: more entries -> smaller interpolation error, for every type.
   for (const char* type :
        {"EXPONENTIAL", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2", "DISTANCE_GAUSSIAN", "GL_LINEAR", "HEIGHT"})

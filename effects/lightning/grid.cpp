@@ -193,13 +193,16 @@ std::vector<Cell> turningPoints(const std::vector<Cell>& path) {
 
 }  // namespace detail
 
-std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to) {
+std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
+                        int neighbourhood) {
   detail::Grid g{width, height, &obstacles};
+  const detail::Stencil st = detail::stencil(neighbourhood);
   const size_t n = size_t(width) * size_t(height);
   std::vector<float> cost(n, INFINITY);
   std::vector<int32_t> parent(n, -1);
   auto h = [&](int x, int y) {
     double dx = std::abs(x - to.x), dy = std::abs(y - to.y);
+    if (st.size == 4) return dx + dy;                                        // Manhattan
     return std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy);  // octile
   };
   using Item = std::pair<double, int32_t>;  // f, index (ties: smaller index first: deterministic)
@@ -213,11 +216,11 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
     int x = i % width, y = i / width;
     if (f > cost[size_t(i)] + h(x, y) + 1e-6) continue;  // stale entry
     if (size_t(i) == t) break;
-    for (int k = 0; k < 8; ++k) {
-      int nx = x + detail::kDx[k], ny = y + detail::kDy[k];
+    for (int k = 0; k < st.size; ++k) {
+      int nx = x + st.dx[k], ny = y + st.dy[k];
       if (!g.inside(nx, ny) || g.blocked(nx, ny)) continue;
       size_t j = size_t(ny) * width + nx;
-      float c = cost[size_t(i)] + ((detail::kDx[k] && detail::kDy[k]) ? float(std::sqrt(2.0)) : 1.0f);
+      float c = cost[size_t(i)] + ((st.dx[k] && st.dy[k]) ? float(std::sqrt(2.0)) : 1.0f);
       if (c < cost[j]) {
         cost[j] = c;
         parent[j] = i;

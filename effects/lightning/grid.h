@@ -2,8 +2,7 @@
 #pragma once
 
 #include <atomic>
-#include <memory>
-
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -23,6 +22,23 @@ struct Grid {
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+constexpr int kDx4[4] = {0, -1, 1, 0};
+constexpr int kDy4[4] = {-1, 0, 0, 1};
+
+// The neighbour offsets of a 4- or 8-neighbourhood (Params::neighbourhood).
+struct Stencil {
+  const int* dx;
+  const int* dy;
+  int size;
+};
+inline Stencil stencil(int neighbourhood) {
+  return neighbourhood == 4 ? Stencil{kDx4, kDy4, 4} : Stencil{kDx, kDy, 8};
+}
+// a and b are the same cell or neighbours in the neighbourhood.
+inline bool touching(Cell a, Cell b, int neighbourhood) {
+  const int dx = std::abs(a.x - b.x), dy = std::abs(a.y - b.y);
+  return neighbourhood == 4 ? dx + dy <= 1 : dx <= 1 && dy <= 1;
+}
 
 // Seed 002 eqn 4: potential of the negative charges on the grid border (a ring of cells just
 // outside the grid) and on obstacle cells, sum of 1/r. A pyramid of charge counts and

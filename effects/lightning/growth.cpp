@@ -33,21 +33,26 @@ std::optional<Error> validate(const Params& p) {
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
+  if (p.neighbourhood != 4 && p.neighbourhood != 8) return invalid("/neighbourhood", "must be 4 or 8");
   return std::nullopt;
+}
+
+double calibratedAxisGrowth(const Params& p) {
+  if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
+  const double longer = std::max(3, std::max(p.width, p.height));
+  return std::exp((0.2 + 0.025 * std::min(p.eta, 8.0)) * std::pow(128.0 / longer, 0.35));
 }
 
 namespace {
 
 using detail::Grid;
-using detail::kDx;
-using detail::kDy;
 
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 
 struct Candidate {
   Cell cell;
   int born;        // step at which it last gained a bolt neighbour
-  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8
+  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8 (1..4 in a 4-neighbourhood)
   int parent;      // node it attaches to if chosen: its newest bolt neighbour
   double charge;   // kCharges: sum over bolt cells of 1/r
   // kFast: log(2^G / (B * P)), fixed while the segment's axis stands, and Phi^eta relative
@@ -56,11 +61,10 @@ struct Candidate {
   double logStatic = 0, weight = 0;
 };
 
-bool adjacent(Cell a, Cell b) { return std::abs(a.x - b.x) <= 1 && std::abs(a.y - b.y) <= 1; }
-
 class Grower {
  public:
-  Grower(const Params& p, Bolt& bolt) : p_(p), g_{p.width, p.height, &p.obstacles}, bolt_(bolt) {
+  Grower(const Params& p, Bolt& bolt)
+      : p_(p), g_{p.width, p.height, &p.obstacles}, stencil_(detail::stencil(p.neighbourhood)), bolt_(bolt) {
     nodeOf_.assign(size_t(p.width) * size_t(p.height), -1);
     candidateOf_.assign(nodeOf_.size(), -1);
     reserved_.assign(nodeOf_.size(), 0);
@@ -101,8 +105,11 @@ class Grower {
   void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
   double stepError(const std::vector<double>& logPhi);
 
+  bool touching(Cell a, Cell b) const { return detail::touching(a, b, p_.neighbourhood); }
+
   const Params& p_;
   Grid g_;
+  detail::Stencil stencil_;
   Bolt& bolt_;
   std::vector<int32_t> nodeOf_, candidateOf_;
   std::vector<uint8_t> reserved_;
@@ -149,13 +156,13 @@ void Grower::removeCandidate(size_t slot) {
 
 void Grower::addCandidatesAround(int node) {
   Cell c = bolt_.nodes[size_t(node)].cell;
-  for (int k = 0; k < 8; ++k) {
-    int x = c.x + kDx[k], y = c.y + kDy[k];
+  for (int k = 0; k < stencil_.size; ++k) {
+    int x = c.x + stencil_.dx[k], y = c.y + stencil_.dy[k];
     if (!free(x, y)) continue;
     size_t i = g_.index({x, y});
     if (candidateOf_[i] >= 0) {
       Candidate& cand = cands_[size_t(candidateOf_[i])];
-      cand.neighbours = std::min(cand.neighbours + 1, 8);
+      cand.neighbours = std::min(cand.neighbours + 1, stencil_.size);
       cand.born = step_;
       cand.parent = node;
       if (p_.method == Method::kFast) refreshFastWeight(cand);
@@ -163,8 +170,8 @@ void Grower::addCandidatesAround(int node) {
       continue;
     }
     Candidate cand{{x, y}, step_, 0, node, 0.0};
-    for (int j = 0; j < 8; ++j) {
-      int nx = x + kDx[j], ny = y + kDy[j];
+    for (int j = 0; j < stencil_.size; ++j) {
+      int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j];
       if (g_.inside(nx, ny) && nodeOf_[g_.index({nx, ny})] >= 0) ++cand.neighbours;
     }
     if (p_.method == Method::kCharges)
@@ -345,8 +352,8 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   // Reference support: every free cell next to a bolt cell.
   std::vector<size_t> cells;
   for (const Node& n : bolt_.nodes)
-    for (int k = 0; k < 8; ++k) {
-      int x = n.cell.x + kDx[k], y = n.cell.y + kDy[k];
+    for (int k = 0; k < stencil_.size; ++k) {
+      int x = n.cell.x + stencil_.dx[k], y = n.cell.y + stencil_.dy[k];
       if (free(x, y)) cells.push_back(g_.index({x, y}));
     }
   std::sort(cells.begin(), cells.end());
@@ -386,7 +393,7 @@ std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
     blocked[g_.index(fromCell)] = 0;
   }
   Stopwatch guideWatch;
-  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target);
+  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
   return path;
 }
@@ -429,7 +436,7 @@ void Grower::weighCandidates(std::vector<double>& logPhi) {
 // to the current one or sees the next one.
 void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp) {
   while (wp + 1 < waypoints.size() &&
-         (adjacent(newest, waypoints[wp]) || detail::lineOfSight(g_, newest, waypoints[wp + 1]))) {
+         (touching(newest, waypoints[wp]) || detail::lineOfSight(g_, newest, waypoints[wp + 1]))) {
     anchor_ = newest;
     attractor_ = waypoints[++wp];
     if (p_.method == Method::kFast) {
@@ -472,7 +479,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
   std::vector<double> logPhi, scratch;
   size_t segmentFirstNode = bolt_.nodes.size();
   addCandidatesAround(from);
-  while (!adjacent(bolt_.nodes[size_t(last)].cell, target)) {
+  while (!touching(bolt_.nodes[size_t(last)].cell, target)) {
     if (size_t(step_) >= p_.maxSteps)
       return overLimit("/maxSteps", "growth step budget of " + std::to_string(p_.maxSteps) + " cells exhausted");
     ++step_;

@@ -5,9 +5,10 @@
 // (point charges). Digest: docs/effects.md section 1.
 //
 // Grid: width x height cells, cell (x, y) covers [x, x+1] x [y, y+1]; x right, y down.
-// 8-neighbourhood. The bolt grows one cell per step from `start`; candidate i is picked with
+// 8-neighbourhood by default, 4 on request (classic DBM). The bolt grows one cell per step
+// from `start`; candidate i is picked with
 // probability p_i = Phi_i^eta / sum_j Phi_j^eta (seed 002 eqn 2), computed in log space.
-// A segment ends when the bolt touches (8-adjacent) its target; the target joins the bolt.
+// A segment ends when the bolt touches (is a neighbour of) its target; the target joins the bolt.
 // Several targets make chain lightning: each later segment grows from the previous target.
 //
 // Methods (how Phi is obtained):
@@ -49,6 +50,13 @@ enum class Guide { kAuto, kAstar, kNone };
 // Seed 002's literal eqn 8 and lifetime (the `paper` variant): bolts thinner than DBM's.
 inline constexpr double kPaperAxisGrowth = 2.0;
 inline constexpr int kPaperLifetime = 4;
+// The base per cell (lifetime 0) that meets DBM's statistics (docs/lightning-calibration.md):
+// 1.2 in the 8-neighbourhood for every grid and eta measured (64^2-256^2, eta 0.5-4); in the
+// 4-neighbourhood the fitted base falls with the grid and rises with eta, as
+// ln a = (0.2 + 0.025 eta) (128 / L)^0.35, L = the grid's longer side.
+inline constexpr double kCalibratedAxisGrowth8 = 1.2;
+struct Params;
+double calibratedAxisGrowth(const Params& p);
 
 const char* toString(Method m);
 const char* toString(Solver s);
@@ -61,8 +69,11 @@ struct Params {
   Method method = Method::kFast;
   double eta = 2.0;         // [0, 50]; seed 002: 2..3 looks like lightning
   int lifetime = 0;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
-  double axisGrowth = 1.2;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]; 1.2 with
-                            // lifetime 0 meets DBM's D, cells and tips (64^2-256^2, eta 0.5-4)
+  double axisGrowth = kCalibratedAxisGrowth8;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]
+                                               // (calibratedAxisGrowth() with lifetime 0 meets
+                                               // DBM's D, cells and tips)
+  int neighbourhood = 8;    // 8 (diagonals too) or 4: which cells are candidates, which
+                            // touch a target, how the A* guide moves, N's range (eqn 6)
   Guide guide = Guide::kAuto;
   Solver solver = Solver::kMgpcg;  // kDbm
   double tolerance = 1e-6;         // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
@@ -106,8 +117,10 @@ std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_
 // Normalisation (division by a constant) cancels in p_i and is not applied.
 double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c);
 
-// 8-connected A* (octile heuristic); empty if unreachable.
-std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to);
+// A* over the 8-neighbourhood (octile heuristic) or the 4-neighbourhood (Manhattan); empty if
+// unreachable.
+std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
+                        int neighbourhood = 8);
 
 }  // namespace effects::lightning
 
