@@ -82,10 +82,11 @@ Flipbook::Flipbook(int width, int height, int count) : frameWidth(width), frameH
   rows = (count + columns - 1) / columns;
   sheet.width = columns * width;
   sheet.height = rows * height;
-  sheet.rgba.assign(size_t(sheet.width) * size_t(sheet.height) * 4, 0.0f);
 }
 
 void Flipbook::put(const Image& frame, int index) {
+  // Allocated with the first frame, on the render thread: a queued request holds no sheet.
+  if (sheet.rgba.empty()) sheet.rgba.assign(size_t(sheet.width) * size_t(sheet.height) * 4, 0.0f);
   const int cx = index % columns, cy = index / columns;
   for (int y = 0; y < std::min(frame.height, frameHeight); ++y)
     std::copy_n(&frame.rgba[size_t(y) * size_t(frame.width) * 4], size_t(std::min(frame.width, frameWidth)) * 4,

@@ -61,6 +61,12 @@ TEST(Fast, DefaultMeetsDbmStatistics) {
     EXPECT_NEAR(f.tips / r.tips, 1.0, 0.5) << "eta " << eta << ": " << f.tips << " vs " << r.tips;
     EXPECT_LT(std::fabs(f.d - r.d), std::fabs(q.d - r.d)) << "eta " << eta;
   }
+  // And on a 128^2 grid (eta 2; DBM's bolts take ~0.2 s each there).
+  Params fast = basic(128), dbm = basic(128, Method::kDbm);
+  const BoltStats f = statsOver(fast, 12), r = statsOver(dbm, 3);
+  EXPECT_NEAR(f.d, r.d, 0.08);
+  EXPECT_NEAR(f.cells / r.cells, 1.0, 0.4) << f.cells << " vs " << r.cells;
+  EXPECT_NEAR(f.tips / r.tips, 1.0, 0.5) << f.tips << " vs " << r.tips;
 }
 
 // The bolt is a tree of 8-connected (or 4-connected) cells, free of obstacles, from start to every target.

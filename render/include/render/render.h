@@ -192,6 +192,7 @@ class GifEncoder {
 // A flipbook (sprite sheet): `count` frames in a grid, left to right, top to bottom, as the
 // texture-sheet animations of engines play them (Unity's Texture Sheet Animation, Unreal's
 // SubUV). columns = ceil(sqrt(count)), rows = ceil(count / columns); unused cells transparent.
+// The sheet's pixels are allocated by the first put().
 struct Flipbook {
   int columns = 0, rows = 0, frameWidth = 0, frameHeight = 0;
   Image sheet;
