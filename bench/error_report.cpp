@@ -467,10 +467,15 @@ void plot(const Section& s, const fs::path& dir) {
   }
   d.close();
   std::ofstream g(script);
-  g << "set terminal pngcairo noenhanced size 800,520 font 'sans,10'\n"
+  // Many curves: the key goes below the plot in three columns and the picture grows to hold it.
+  const bool many = series.size() > 16;
+  const int height = many ? 560 + 15 * int((series.size() + 2) / 3) : 520;
+  g << "set terminal pngcairo noenhanced size " << (many ? 1000 : 800) << "," << height << " font 'sans,10'\n"
     << "set output '" << (dir / (s.id + ".png")).string() << "'\n"
     << "set title \"" << s.title << "\"\n"
-    << "set logscale xy\nset grid\nset key outside right top\n"
+    << "set logscale xy\nset grid\n"
+    << (many ? "set key outside below maxcols 3 maxrows " + std::to_string((series.size() + 2) / 3) + "\n"
+             : std::string("set key outside right top\n"))
     << "set xlabel \"" << s.timeName << "\"\nset ylabel \"" << s.errorName << "\"\n"
     << "set format y '%.0e'\n"
     << "plot ";

@@ -16,6 +16,7 @@ PACKAGES=(
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
   json-schema-test-suite  # the official JSON-Schema tests run against server/schema.cpp
+  python3-jsonschema # tests/sweep_test.py checks answers against proto/schemas/*-answer.json
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node
 # (e.g. from NodeSource) keep it; otherwise Debian's.

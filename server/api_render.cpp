@@ -175,6 +175,8 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
     effects::Error e = mesh.error();
     throwError(e, e.field == "/level" || e.field == "/radius" ? "/bubble/mesh" : "/bubble");
   }
+  if (b.features.wobble)  // the shader wobbles what icosphere() left still
+    if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, "/bubble/mesh");
   b.mesh = std::move(mesh.value());
   if (b.features.iridescence) {
     bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, "/bubble");

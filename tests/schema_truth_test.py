@@ -12,12 +12,12 @@ created when absent. Exceptions, each with its reason, are in ALLOWED.
 
     tests/schema_truth_test.py build/server/effectd
 """
-import copy, glob, http.client, json, os, sys, time
+import glob, http.client, json, os, sys, time
 
 from answers import scrub
 from effectd_process import start
+from schema_walk import ROOT, SCHEMAS as schemas, properties, resolve, with_value
 
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 BIN = sys.argv[1]
 ENDPOINTS = {"fog.json": "/v1/fog", "lightning.json": "/v1/lightning", "bubble.json": "/v1/bubble",
              "tangents.json": "/v1/tangents", "scene.json": "/v1/scene"}
@@ -33,31 +33,7 @@ ALLOWED = {
         "KHR_materials_iridescence's own 100-400 nm unless a range is given (api_bubble.cpp)",
 }
 
-schemas = {os.path.basename(f): json.load(open(f)) for f in glob.glob(os.path.join(ROOT, "proto/schemas/*.json"))}
 failures, checked = [], {"default": 0, "range": 0, "enum": 0}
-
-
-def resolve(node, doc):
-    while isinstance(node, dict) and "$ref" in node:
-        ref = node["$ref"]
-        file, _, frag = ref.partition("#")
-        doc = file or doc
-        target = schemas[doc]
-        for part in frag.strip("/").split("/") if frag else []:
-            target = target[part]
-        rest = {k: v for k, v in node.items() if k != "$ref"}
-        node = {**target, **rest}
-    return node, doc
-
-
-def properties(node, doc, pointer=""):
-    """(pointer, property schema, parent schema) for every property reachable through objects."""
-    node, doc = resolve(node, doc)
-    for key, sub in node.get("properties", {}).items():
-        sub_r, sub_doc = resolve(sub, doc)
-        yield pointer + "/" + key, sub_r, node
-        if sub_r.get("type") == "object" or "properties" in sub_r:
-            yield from properties(sub_r, sub_doc, pointer + "/" + key)
 
 
 class Server:
@@ -79,25 +55,6 @@ class Server:
         data = r.read()
         c.close()
         return r.status, (json.loads(data) if data[:1] in (b"{", b"[") else data)
-
-
-def with_value(base, pointer, value, remove=False):
-    """base with the property at pointer set (or removed); parents created as {}; None when a
-    parent is not an object (e.g. an array in the example)."""
-    body = copy.deepcopy(base)
-    node = body
-    parts = pointer.strip("/").split("/")
-    for part in parts[:-1]:
-        if not isinstance(node, dict):
-            return None
-        node = node.setdefault(part, {})
-    if not isinstance(node, dict):
-        return None
-    if remove:
-        node.pop(parts[-1], None)
-    else:
-        node[parts[-1]] = value
-    return body
 
 
 def names_field(answer, pointer):

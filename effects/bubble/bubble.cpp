@@ -32,7 +32,10 @@ std::optional<Error> validate(const Params& p) {
   if (!in(p.betaSpeed, 0, 1e6)) return invalid("/betaSpeed", "must be in [0, 1e6]");
   if (!in(p.muSpeed, 0, 1e6)) return invalid("/muSpeed", "must be in [0, 1e6]");
   if (!in(p.rimPower, 0, 1e3)) return invalid("/rimPower", "must be in [0, 1000]");
-  if (!in(p.wobbleAmplitude, 0, 1e6)) return invalid("/wobbleAmplitude", "must be in [0, 1e6]");
+  // Eqn 11 moves x by a sin(phase + x): its Jacobian 1 + a cos(phase + x) turns negative, and
+  // the surface folds through itself, for a > 1.
+  if (!in(p.wobbleAmplitude, 0, 1))
+    return invalid("/wobbleAmplitude", "must be in [0, 1]: a larger amplitude folds the surface (eqn 11)");
   return std::nullopt;
 }
 
@@ -89,6 +92,17 @@ glm::dvec2 flowOffset(const Params& p, double t) {
 dvec3 wobble(const Params& p, const dvec3& x, double t) {
   const double ph = reducedPhase(p.deltaSpeed, t), a = p.wobbleAmplitude;  // eqn 11
   return {x.x + a * std::sin(ph + x.x), x.y + a * std::cos(ph + x.y), x.z + a * std::sin(ph + x.z)};
+}
+
+std::optional<Error> wobbleFits(const Params& p, double radius) {
+  // The wobble moves every point by up to a object units: float32 positions keep ~7 digits,
+  // so a sphere under a thousandth of that is translated whole and its shape lost.
+  if (radius < 1e-3 * p.wobbleAmplitude)
+    return unsatisfiable("/radius", "a sphere of radius " + std::to_string(radius) + " under a wobble of " +
+                                        std::to_string(p.wobbleAmplitude) +
+                                        " object units collapses in float32 positions: radius must be at least "
+                                        "1e-3 x wobbleAmplitude (or the wobble off)");
+  return std::nullopt;
 }
 
 dvec3 moveTowards(const dvec3& from, const dvec3& to, double s) {
@@ -200,7 +214,9 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
   if (auto e = validate(p)) return *e;
   if (o.level < 0 || o.level > o.maxLevel)
     return overLimit("/level", "must be in [0, " + std::to_string(o.maxLevel) + "]");
-  if (!(o.radius > 0) || !std::isfinite(o.radius) || o.radius > 1e6) return invalid("/radius", "must be in (0, 1e6]");
+  if (!(o.radius >= 1e-6) || !std::isfinite(o.radius) || o.radius > 1e6) return invalid("/radius", "must be in [1e-6, 1e6]");
+  if (o.wobble)
+    if (auto e = wobbleFits(p, o.radius)) return *e;
   if (!std::isfinite(o.t)) return invalid("/t", "must be finite");
   Stopwatch watch;
   // Unit icosahedron, then subdivision with shared midpoints.

@@ -79,6 +79,7 @@ glm::dvec3 color(const Sampling& s, double ior, double d, double cosTheta) {
 }  // namespace
 
 double filmReflectance(double n, double d, double cosTheta, double nm) {
+  if (!(n > 1)) return 0;  // a film of air's index has no interfaces (and 0/0 at grazing incidence)
   const double c1 = std::clamp(std::abs(cosTheta), 0.0, 1.0);
   const double sin1 = std::sqrt(std::max(0.0, 1 - c1 * c1));
   const double sinT = sin1 / n;  // n >= 1: never total internal reflection entering the film

@@ -37,7 +37,8 @@ struct Params {
   double betaSpeed = 0.4;        // texture-flow angular speed, rad/s (eqn 9)
   double rimPower = 2.8;         // eqn 10
   double muSpeed = 0.05;         // film drains: alpha = saturate(muSpeed t) (eqn 3), 1/s
-  double wobbleAmplitude = 1.0;  // eqn 11's sin() term is scaled by this (paper: 1)
+  double wobbleAmplitude = 1.0;  // eqn 11's sin() term is scaled by this (paper: 1); <= 1, as
+                                 // a larger one folds the surface
 };
 // Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; amplitude [0, 1e6].
 std::optional<Error> validate(const Params& p);
@@ -65,6 +66,9 @@ double rim(const Params& p, double gammaOut);  // eqn 10, in [0, 1]
 double reducedPhase(double omega, double t);
 glm::dvec2 flowOffset(const Params& p, double t);                                // eqn 9: (sin bt, cos bt)
 glm::dvec3 wobble(const Params& p, const glm::dvec3& x, double t);               // eqn 11
+// Whether a sphere of `radius` keeps its shape under the wobble in float32 (radius >= 1e-3 x
+// wobbleAmplitude); kUnsatisfiable naming /radius otherwise.
+std::optional<Error> wobbleFits(const Params& p, double radius);
 glm::dvec3 moveTowards(const glm::dvec3& from, const glm::dvec3& to, double s);  // lerp, s clamped to [0, 1]
 
 // ---- mesh -----------------------------------------------------------------------------------
