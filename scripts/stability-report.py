@@ -53,12 +53,12 @@ def scaled(mesh, k):
 CASES = [
     ("fog", "distance fog, d_c = 1e-9 over [0, 1e6]", "fog",
      fog({"fogType": "DISTANCE_EXP2", "distanceCoefficient": 1e-9}, table={"size": 64, "range": [0, 1e6]}),
-     ["table.factor"], "f = exp(−(d_c·d)²) ≥ exp(−1e-6): every factor ≈ 1, none above 1"),
+     ["table.factor"], "f = exp(−d_c·d²): 1 at the camera, exp(−1000) = 0 exactly by d = 1e6; no entry outside [0, 1]"),
     ("fog", "distance fog, d_c = 1e6", "fog",
      fog({"fogType": "DISTANCE_EXP2", "distanceCoefficient": 1e6}, table={"size": 64, "range": [0, 16]}),
-     ["table.factor"], "f falls to 0 within the first entry and stays 0 (underflow to 0, not NaN)"),
+     ["table.factor"], "f is 1 at d = 0 and underflows to exactly 0 from the next entry on (not NaN)"),
     ("fog", "exponential fog at d = 1e300", "fog",
-     fog({"fogType": "EXPONENTIAL", "visibilityRange": 10}, samples={"camera": [0, 0, 0], "points": [[0, 0, -1e300]]}),
+     fog({"fogType": "EXPONENTIAL", "visibilityRange": 10}, samples={"camera": [0, 0, 0], "points": [[0, 0, -1e300]]}, include=["samples"]),
      ["samples.factor"], "an object infinitely far is fully fogged: f = 0 exactly"),
     ("fog", "height fog, falloff 0 (uniform density)", "fog",
      fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0, "baseHeight": 0}, table={"size": 64, "elevations": 16, "cameraHeight": 3}),
@@ -68,10 +68,16 @@ CASES = [
      ["table.factor"], "a layer 1 cm thick seen from 3 m above it: almost no fog (factors ≈ 1)"),
     ("fog", "height fog, camera 1e6 above the layer", "fog",
      fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0}, table={"size": 64, "elevations": 16, "cameraHeight": 1e6}),
-     ["table.factor"], "exp(−b·h) underflows to 0 and the integral stays finite: no fog up there"),
+     [], "above the layer the fog never reaches 1/255 along most rays, so the default range (up to where it does) "
+         "is undefined: a 422 asking for an explicit range"),
+    ("fog", "height fog, camera 1e6 above the layer, range [0, 1e7]", "fog",
+     fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
+         table={"size": 64, "elevations": 16, "cameraHeight": 1e6, "range": [0, 1e7]}),
+     ["table.factor"], "exp(−b·h) underflows to 0 up there: rays that stay high see no fog (f = 1), rays that "
+                       "reach the layer are fogged; every factor finite in [0, 1]"),
     ("fog", "height fog, camera inside the layer, horizontal rays", "fog",
      fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
-         samples={"camera": [0, 0, 0], "points": [[1e3, 0, 0], [1e6, 0, 0], [0, 0, -50]]}),
+         samples={"camera": [0, 0, 0], "points": [[1e3, 0, 0], [1e6, 0, 0], [0, 0, -50]]}, include=["samples"]),
      ["samples.factor"], "a horizontal ray has no height change: the b·Δh → 0 limit (Beer–Lambert at the camera's density)"),
     ("lightning", "η = 0 (uniform growth), 64²", "lightning", bolt(64, eta=0),
      ["stats.counters.cells"], "every candidate equally likely: a bushy Eden cluster that still reaches the target"),
@@ -93,10 +99,13 @@ CASES = [
     ("bubble", "grazing view, TIR (n1 1.5 outside, n2 1.0)", "bubble",
      {"time": 1, "camera": [0, 0, 3], "params": {"n1": 1.5, "n2": 1.0, "wobbleAmplitude": 0.05}, "mesh": {"level": 3, "radius": 1},
       "include": ["mesh"]},
-     ["mesh.finalVectors"], "beyond the critical angle refraction becomes reflection: unit vectors, no NaN at the silhouette"),
+     ["mesh.finalVectors"], "eqn 8's Final = R·μ_top + T (not unit by design); beyond the critical angle T = 0 "
+                            "(total internal reflection): finite at the silhouette, no NaN"),
     ("bubble", "film thickness 0 … 1e4 nm", "bubble",
      {"features": {"iridescence": True}, "thinFilm": {"thicknessRange": [0, 10000], "width": 64, "height": 16}, "include": ["thinFilm"]},
-     ["thinFilm.rgb"], "zero thickness reflects nothing (black); thick films average to a pale, finite colour"),
+     ["thinFilm.rgb"], "zero thickness reflects nothing (black); thick films average to a pale colour; the most "
+                       "saturated film colours lie outside sRGB and are sent unclamped (the schema allows −1 … 2) "
+                       "for the client to clip or gamut-map"),
     ("bubble", "n2 = 1: a film of air's index", "bubble",
      {"features": {"iridescence": True}, "params": {"n2": 1}, "thinFilm": {"width": 16, "height": 16}, "include": ["thinFilm"]},
      ["thinFilm.rgb", "thinFilm.meanDeltaE"], "no interface, no reflection (was 0/0 at grazing incidence: NaN; found by the sweep)"),
@@ -126,25 +135,16 @@ CASES = [
 ]
 
 
-def numbers(answer, path):
-    """The numbers at a dotted path (flattened)."""
-    node = answer
-    for part in path.split("."):
-        if not isinstance(node, dict) or part not in node:
-            return []
-        node = node[part]
-    out = []
-
-    def walk(v):
-        if isinstance(v, bool):
-            return
-        if isinstance(v, (int, float)):
-            out.append(v)
-        elif isinstance(v, list):
-            for x in v:
-                walk(x)
-    walk(node)
-    return out
+def numbers(node, path):
+    """The numbers at a dotted path, flattened; a list on the way is mapped (samples.factor)."""
+    if isinstance(node, list):
+        return [x for item in node for x in numbers(item, path)]
+    if path:
+        head, _, rest = path.partition(".")
+        return numbers(node[head], rest) if isinstance(node, dict) and head in node else []
+    if isinstance(node, bool):
+        return []
+    return [node] if isinstance(node, (int, float)) else []
 
 
 def fmt(v):
