@@ -178,15 +178,20 @@ TEST(Lightning, ClearErrors) {
   EXPECT_EQ(grow(p).error().field, "/eta");
 }
 
-TEST(Lightning, MazeCorridorWithGuide) {
-  // A one-cell-wide serpentine corridor: walls every other row with alternating gaps.
-  const int n = 33;
+// A one-cell-wide serpentine corridor: walls every other row with alternating gaps, from the
+// top-left corner to the bottom-right one.
+Params serpentine(int n) {
   Params p = basic(n);
   p.obstacles.assign(size_t(n) * n, 0);
   for (int y = 1; y < n - 1; y += 2)
     for (int x = 0; x < n; ++x) p.obstacles[size_t(y) * n + x] = (y / 2) % 2 == 0 ? (x != n - 1) : (x != 0);
   p.start = {0, 0};
   p.targets = {{n - 1, n - 1}};
+  return p;
+}
+
+TEST(Lightning, MazeCorridorWithGuide) {
+  Params p = serpentine(33);
   for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
     p.method = m;
     auto b = grow(p);
@@ -199,14 +204,8 @@ TEST(Lightning, MazeCorridorWithGuide) {
 // paths (through a maze, and not through a diagonal gap: 422, not a hang), and the calibrated
 // fast method stays near 4-neighbourhood DBM.
 TEST(Lightning, FourNeighbourhood) {
-  const int n = 33;
-  Params maze = basic(n);
+  Params maze = serpentine(33);
   maze.neighbourhood = 4;
-  maze.obstacles.assign(size_t(n) * n, 0);
-  for (int y = 1; y < n - 1; y += 2)
-    for (int x = 0; x < n; ++x) maze.obstacles[size_t(y) * n + x] = (y / 2) % 2 == 0 ? (x != n - 1) : (x != 0);
-  maze.start = {0, 0};
-  maze.targets = {{n - 1, n - 1}};
   for (Method m : {Method::kFast, Method::kCharges, Method::kDbm}) {
     Params p = basic(48, m);
     p.neighbourhood = 4;

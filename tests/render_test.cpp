@@ -422,12 +422,20 @@ json strikeScene(int frames, const char* format) {
            {{"grid", {{"width", 48}, {"height", 48}}}, {"start", {24, 0}}, {"targets", {{24, 47}}}, {"timeScale", 4}}}};
 }
 
+// An animated render's answer: 200, its media type and frame count.
+httplib::Result renderFrames(const TestServer& s, const json& scene, const std::string& type) {
+  auto r = render(s, scene);
+  EXPECT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
+  if (!r || r->status != 200) return r;
+  EXPECT_EQ(r->get_header_value("Content-Type"), type);
+  EXPECT_EQ(r->get_header_value("X-Frame-Count"), std::to_string(scene["frames"]["count"].get<int>()));
+  return r;
+}
+
 TEST(Render, StrikeAsAnimatedGif) {
   TestServer s;
-  auto r = render(s, strikeScene(30, "gif"));
-  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
-  EXPECT_EQ(r->get_header_value("Content-Type"), "image/gif");
-  EXPECT_EQ(r->get_header_value("X-Frame-Count"), "30");
+  auto r = renderFrames(s, strikeScene(30, "gif"), "image/gif");
+  ASSERT_TRUE(r && r->status == 200);
   const std::vector<rd::Image> g = decodeGif(r->body);
   ASSERT_EQ(g.size(), 30u);
   EXPECT_EQ(g[0].width, 96);
@@ -449,9 +457,8 @@ TEST(Render, StrikeAsAnimatedGif) {
 
 TEST(Render, FlipbookHoldsTheFramesInAGrid) {
   TestServer s;
-  auto r = render(s, strikeScene(10, "flipbook"));
-  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
-  EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+  auto r = renderFrames(s, strikeScene(10, "flipbook"), "image/png");
+  ASSERT_TRUE(r && r->status == 200);
   EXPECT_EQ(r->get_header_value("X-Flipbook-Columns"), "4");
   EXPECT_EQ(r->get_header_value("X-Flipbook-Rows"), "3");
   const rd::Image sheet = decode(r->body);
@@ -462,8 +469,8 @@ TEST(Render, FlipbookHoldsTheFramesInAGrid) {
 
   // A wobbling bubble: frames differ.
   json bubble = {{"width", 64}, {"height", 64}, {"frames", {{"count", 4}, {"fps", 4}, {"format", "flipbook"}}}, {"bubble", json::object()}};
-  r = render(s, bubble);
-  ASSERT_TRUE(r && r->status == 200) << (r ? r->body.substr(0, 300) : "");
+  r = renderFrames(s, bubble, "image/png");
+  ASSERT_TRUE(r && r->status == 200);
   const rd::Image b = decode(r->body);
   double diff = 0;
   for (int y = 0; y < 64; ++y)
