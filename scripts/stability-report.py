@@ -210,10 +210,10 @@ def main():
            "(the CI runs 800 requests in Release, 150 under ASan+UBSan): requests drawn from the full "
            "ranges the request schemas allow — log-uniform magnitudes and the exact edges (minimum, "
            "maximum, 0, −0, 5e-324, one ulp inside each bound) — on every example request of fog, "
-           "lightning, bubble and tangents, one to three properties at a time, checked against invariants: "
+           "lightning, bubble, tangents and scene (/v1/scene; /v1/render is left out: its PNG/GIF pixels are 8-bit), one to three properties at a time, checked against invariants: "
            "no 5xx or hang, every 4xx names a field, no NaN/Infinity in an answer, every answer valid against "
            "its answer schema (python3-jsonschema), bolts inside the grid and connected, unit tangents "
-           "orthogonal to their normals, no inverted or degenerate bubble triangle.",
+           "orthogonal to their normals, no inverted or degenerate bubble triangle, 1-D fog tables never rising with distance.",
            "",
            f"- requests: {c['requests']} (regressions replayed first: {c['regressions']}); per endpoint: "
            + ", ".join(f"{k} {v}" for k, v in sorted(c["byEndpoint"].items())),

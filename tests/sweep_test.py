@@ -11,6 +11,7 @@ the smallest positive double, one ulp inside each bound). Invariants:
   - every 2xx JSON answer has no NaN or Infinity and is valid against its answer schema
     (proto/schemas/<e>-answer.json, checked by python3-jsonschema: fog factors in [0, 1],
     intensities, thin-film colours ...);
+  - fog: a 1-D table's factors never rise with distance;
   - lightning: every cell inside the grid, each one a neighbour of its parent, none twice;
   - tangents: unit tangents orthogonal to their normals, handedness +-1;
   - bubble meshes: no triangle inverted against the undisturbed sphere, no degenerate one.
@@ -35,7 +36,7 @@ import jsonschema
 from effectd_process import start
 from schema_walk import ROOT, SCHEMAS, examples, properties, resolve, with_value
 
-ENDPOINTS = ["fog", "lightning", "bubble", "tangents"]
+ENDPOINTS = ["fog", "lightning", "bubble", "tangents", "scene"]  # not render: its PNG/GIF bytes are 8-bit
 # Properties the sweep leaves alone, and why.
 SKIP = {
     "lightning": {"/maxSteps": "budget: 1e9 steps on the largest grid is minutes by design (capped by --max-growth-steps)",
@@ -218,7 +219,19 @@ def check_bubble(body, answer, server):
     return []
 
 
-CHECKS = {"lightning": check_lightning, "tangents": check_tangents, "bubble": check_bubble}
+def check_fog(body, answer, server):
+    """A 1-D table's factors never rise with distance: fog only accumulates along a ray."""
+    table = answer.get("table") or {}
+    f = table.get("factor")
+    if not f or table.get("elevations"):
+        return []
+    for i in range(1, len(f)):
+        if f[i] > f[i - 1] + 1e-6:
+            return [f"table factor rises with distance at entry {i}: {f[i - 1]} -> {f[i]}"]
+    return []
+
+
+CHECKS = {"lightning": check_lightning, "tangents": check_tangents, "bubble": check_bubble, "fog": check_fog}
 
 
 def violations(server, endpoint, body, status, answer, seconds, validators):
@@ -239,7 +252,7 @@ def violations(server, endpoint, body, status, answer, seconds, validators):
 
 def include_everything(endpoint, body):
     """The example asking for the answer parts the invariants look at."""
-    wanted = {"lightning": ["polylines", "cells", "tree"], "tangents": None, "bubble": None, "fog": None}[endpoint]
+    wanted = {"lightning": ["polylines", "cells", "tree"]}.get(endpoint)
     if wanted:
         body["include"] = wanted
     return body
