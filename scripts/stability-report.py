@@ -223,7 +223,7 @@ def main():
            "",
            "Found by the sweep and fixed (kept in `tests/sweep_regressions.json`): a thin film of air's index "
            "(n2 = 1) gave NaN at grazing incidence; a sphere far smaller than its wobble collapsed into "
-           "degenerate triangles (now 422); the smallest positive radius gave a mesh of zeros (now 400).",
+           "degenerate triangles (now 422); the smallest positive radius gave a mesh of zeros (now 400); a scene's bubble with `format: glb` answered null (now 422 naming `/bubble/format`).",
            ""]
     for f in sweep["failures"]:
         md.append(f"- VIOLATION: `{json.dumps(f)[:400]}`")

@@ -256,6 +256,9 @@ JsonReply handleScene(const json& body, const RequestContext& ctx) {
     RequestContext part = ctx;  // the part's problems name fields under "/<name>"
     part.at = std::string("/") + name;
     JsonReply r = handler(body[name], part);
+    if (!r.binary.empty())  // e.g. bubble "format": "glb"
+      throw fieldError(422, part.at + "/format",
+                       "a scene answers JSON: ask /v1/" + std::string(name) + " itself for this binary format");
     out[name] = std::move(r.body);
     reply.computeMs += r.computeMs;
   };
