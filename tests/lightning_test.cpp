@@ -86,7 +86,9 @@ void expectWellFormed(const Params& p, const Bolt& b) {
     const Cell& q = b.nodes[size_t(n.parent)].cell;
     EXPECT_LE(std::abs(q.x - n.cell.x), 1);
     EXPECT_LE(std::abs(q.y - n.cell.y), 1);
-    if (p.neighbourhood == 4) EXPECT_EQ(std::abs(q.x - n.cell.x) + std::abs(q.y - n.cell.y), 1);
+    if (p.neighbourhood == 4) {
+      EXPECT_EQ(std::abs(q.x - n.cell.x) + std::abs(q.y - n.cell.y), 1);
+    }
   }
   ASSERT_FALSE(b.mainChannel.empty());
   EXPECT_EQ(b.nodes[size_t(b.mainChannel.front())].cell, p.start);

@@ -37,7 +37,9 @@ TEST(Timeline, MonotoneFiniteAndWithinTheStrike) {
       for (size_t j = 0; j < tl.leader[i].size(); ++j) {
         EXPECT_TRUE(std::isfinite(tl.leader[i][j]) && tl.leader[i][j] >= 0 && tl.leader[i][j] <= tl.duration);
         EXPECT_TRUE(std::isfinite(tl.strokeDelay[i][j]) && tl.strokeDelay[i][j] >= 0);
-        if (j) EXPECT_GE(tl.leader[i][j], tl.leader[i][j - 1]) << "line " << i << " vertex " << j;
+        if (j) {
+          EXPECT_GE(tl.leader[i][j], tl.leader[i][j - 1]) << "line " << i << " vertex " << j;
+        }
       }
     }
     // The main channel: the leader arrives at its end at connect; the stroke runs back up it.
@@ -75,7 +77,9 @@ TEST(Timeline, PhysicalDefaultsAndTimeScale) {
   // Every stroke re-lights the main channel; only the first lights the branches.
   for (const Stroke& st : tl.strokes) {
     EXPECT_GT(channelsAt(tl, st.t + 1e-3).main, 0.4f * st.peak);
-    if (&st != &tl.strokes[0]) EXPECT_LT(channelsAt(tl, st.t + 1e-3).branches, 0.01f);
+    if (&st != &tl.strokes[0]) {
+      EXPECT_LT(channelsAt(tl, st.t + 1e-3).branches, 0.01f);
+    }
   }
 
   TimelineParams slow;

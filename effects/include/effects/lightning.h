@@ -51,8 +51,9 @@ enum class Guide { kAuto, kAstar, kNone };
 inline constexpr double kPaperAxisGrowth = 2.0;
 inline constexpr int kPaperLifetime = 4;
 // The base per cell (lifetime 0) that meets DBM's statistics (docs/lightning-calibration.md):
-// 1.2 in the 8-neighbourhood for every grid and eta measured (64^2-256^2, eta 0.5-4); in the
-// 4-neighbourhood the fitted base falls with the grid and rises with eta, as
+// 1.2 in the 8-neighbourhood for every grid and eta measured up to 256^2 (eta 0.5-4; at 512^2
+// it meets D at eta 2-3 but grows fewer cells than DBM); in the 4-neighbourhood the fitted base
+// falls with the grid and rises with eta, as
 // ln a = (0.2 + 0.025 eta) (128 / L)^0.35, L = the grid's longer side.
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
@@ -165,7 +166,7 @@ namespace effects::lightning {
 // the main channel (each dart leader follows the old channel); the channel flickers between
 // strokes and its glow fades over ~100 ms. Deterministic from `seed`; the bolt's shape is not
 // touched, so the same bolt can be animated many ways. Times are game seconds = physical
-// seconds * timeScale. Docs: docs/effects.md section 1 ("Strike timeline").
+// seconds * timeScale. Docs: docs/effects.md section 1.6.
 struct TimelineParams {
   uint64_t seed = 1;                 // the animation seed (pauses, stroke count and spacing, flicker)
   double timeScale = 1;              // game seconds per physical second, (0, 1e6]
