@@ -26,6 +26,8 @@ Result<std::string> encodePng(const Image& image, int bitDepth) {
   return std::string(bytes.begin(), bytes.end());
 }
 
+int gifDelay(double fps) { return std::max(2, int(std::lround(100.0 / fps))); }
+
 struct GifEncoder::Impl {
   std::vector<unsigned char> bytes;
   OIIO::Filesystem::IOVecOutput proxy{bytes};
@@ -38,8 +40,8 @@ struct GifEncoder::Impl {
 
 GifEncoder::GifEncoder(int width, int height, int count, double fps) : impl_(std::make_unique<Impl>()) {
   OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
-  // GIF delays are in hundredths of a second; OpenImageIO takes the rate as a rational.
-  const int rate[2] = {int(std::lround(fps * 100)), 100};
+  // GIF delays are whole hundredths of a second: the rate is 100 / delay (gifDelay()).
+  const int rate[2] = {100, gifDelay(fps)};
   spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
   spec.attribute("gif:LoopCount", 0);  // forever
   spec.attribute("oiio:UnassociatedAlpha", 1);
@@ -75,6 +77,11 @@ Result<std::string> GifEncoder::finish() {
   if (g.added != int(g.specs.size())) return invalid("/frames", "fewer frames than announced");
   if (!g.out->close()) return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
   return std::string(g.bytes.begin(), g.bytes.end());
+}
+
+int Flipbook::cells(int count) {
+  const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
+  return columns * ((count + columns - 1) / columns);
 }
 
 Flipbook::Flipbook(int width, int height, int count) : frameWidth(width), frameHeight(height) {

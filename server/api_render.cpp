@@ -204,7 +204,12 @@ Frames parseFrames(const json& f, const rd::Scene& s, const Config& config) {
   out.count = f["count"];
   out.fps = f.value("fps", out.fps);
   out.flipbook = f.value("format", "gif") == "flipbook";
-  const size_t pixels = size_t(out.count) * size_t(s.width) * size_t(s.height);
+  if (!out.flipbook && out.fps > 50)
+    throw fieldError(422, "/frames/fps", "a GIF plays at most 50 frames per second (delays are whole hundredths "
+                                         "of a second, at least 2); use a flipbook for faster rates");
+  // A flipbook's sheet holds whole rows: its unused cells are pixels too.
+  const size_t cells = out.flipbook ? size_t(rd::Flipbook::cells(out.count)) : size_t(out.count);
+  const size_t pixels = cells * size_t(s.width) * size_t(s.height);
   if (pixels > config.limits.maxRenderPixels)
     throw fieldError(413, "/frames/count",
                      std::to_string(out.count) + " frames of " + std::to_string(s.width) + "x" +

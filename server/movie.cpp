@@ -40,7 +40,9 @@ rd::Sequence MovieWriter::sequence() {
 effects::Result<Movie> MovieWriter::finish() {
   Movie m;
   const Frames& f = animation_.frames;
-  m.headers = {{"X-Frame-Count", std::to_string(f.count)}, {"X-Frame-Rate", nlohmann::json(f.fps).dump()}};
+  // A GIF plays at 100 / delay frames per second (whole hundredths); a flipbook at the rate asked.
+  const double rate = book_ ? f.fps : 100.0 / rd::gifDelay(f.fps);
+  m.headers = {{"X-Frame-Count", std::to_string(f.count)}, {"X-Frame-Rate", nlohmann::json(rate).dump()}};
   if (book_) {
     auto png = rd::encodePng(book_->sheet, bitDepth_);
     if (!png.ok()) return png.error();

@@ -487,6 +487,14 @@ TEST(Render, FramesAreBoundedByThePixelLimit) {
   EXPECT_EQ(render(s, strikeScene(20, "gif"))->status, 200);
   p = expectProblem(render(s, {{"frames", {{"count", 0}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/frames/count")) << p.dump();
+  // A flipbook's unused cells count: 18 frames make a 5 x 4 sheet, 20 frames' worth of pixels.
+  EXPECT_EQ(render(s, strikeScene(18, "gif"))->status, 200);
+  EXPECT_EQ(render(s, strikeScene(16, "flipbook"))->status, 200);  // 4 x 4
+  c.limits.maxRenderPixels = 96 * 96 * 19;
+  TestServer tight(c);
+  EXPECT_EQ(tight.postJson("/v1/render", strikeScene(18, "gif"))->status, 200);
+  p = expectProblem(tight.postJson("/v1/render", strikeScene(18, "flipbook")), 413);
+  EXPECT_TRUE(hasPointer(p, "/frames/count")) << p.dump();
 }
 
 TEST(Render, BackgroundImageFillsTheFrame) {

@@ -276,6 +276,10 @@ def minimise(server, endpoint, base, mutations, validators):
         for pointer, value in ms:
             body = with_value(body, pointer, value)
         status, answer, seconds = server.post("/v1/" + endpoint, body)
+        if answer is None:  # a trial that hung: the next one gets a fresh server
+            server.stop()
+            server.__init__(server.binary, server.timeout)
+            return True
         return bool(violations(server, endpoint, body, status, answer, seconds, validators))
     kept = list(mutations)
     for m in list(kept):
@@ -313,6 +317,9 @@ def main():
         found = violations(server, endpoint, body, status, answer, seconds, validators)
         if found:
             counts["violations"] += 1
+            if answer is None:  # the server may still be busy with it: minimise on a fresh one
+                server.stop()
+                server.__init__(args.binary, args.timeout)
             kept = minimise(server, endpoint, base, mutations, validators) if mutations else []
             for pointer, value in kept:
                 base = with_value(base, pointer, value)

@@ -131,6 +131,22 @@ TEST(Timeline, ExposureShowsTheLeaderThenTheStrokeThenNothing) {
   EXPECT_TRUE(exposure(tl, s.lines, tl.duration + 0.01, tl.duration + 0.02).empty());
 }
 
+// A slow return stroke on a long channel: the strike lasts until its farthest vertex is dark.
+TEST(Timeline, DurationCoversTheSlowestStroke) {
+  TimelineParams p;
+  p.returnStrokeSpeed = 1e5;
+  p.cellSize = 1e4;
+  const Strike s = strike(4, p, 48);
+  double latest = 0;
+  for (const auto& line : s.tl.strokeDelay)
+    for (double d : line) latest = std::max(latest, d);
+  EXPECT_GT(latest, 1.0);  // seconds of travel along the channel
+  EXPECT_GE(s.tl.duration, s.tl.strokes.back().t + latest);
+  for (size_t i = 0; i < s.lines.size(); ++i)
+    for (size_t j = 0; j < s.lines[i].vertices.size(); ++j)
+      EXPECT_LT(vertexBrightness(s.tl, s.lines, i, j, s.tl.duration), 0.01) << i << " " << j;
+}
+
 TEST(Timeline, ExtremeParametersStayFinite) {
   TimelineParams p;
   p.timeScale = 1e6;

@@ -114,12 +114,14 @@ std::vector<double> sampleTimes(const Strike& s, double end) {
   return t;
 }
 
-// The highest value of one channel (piecewise linear between keyframes) over [a, b].
+// The highest value of one channel (piecewise linear between keyframes) over [a, b]: its ends
+// and the keyframes inside (found by bisection: a frame holds a handful of them).
 double peak(const Timeline& tl, float Keyframe::*channel, double a, double b) {
   if (b < a) return 0;
   double best = std::max(channelsAt(tl, a).*channel, channelsAt(tl, b).*channel);
-  for (const Keyframe& k : tl.keyframes)
-    if (k.t > a && k.t < b) best = std::max(best, double(k.*channel));
+  const auto& k = tl.keyframes;
+  auto it = std::upper_bound(k.begin(), k.end(), a, [](double x, const Keyframe& f) { return x < f.t; });
+  for (; it != k.end() && it->t < b; ++it) best = std::max(best, double((*it).*channel));
   return best;
 }
 
@@ -150,9 +152,13 @@ Timeline timeline(const Bolt& bolt, const std::vector<Polyline>& lines, const Ti
   Strike s;
   s.p = p;
   const double connect = leader[size_t(bolt.mainChannel.back())];
-  s.leaderEnd = connect + *std::max_element(delay.begin(), delay.end());
+  const double maxDelay = *std::max_element(delay.begin(), delay.end());
+  s.leaderEnd = connect + maxDelay;
   s.strokes = strokesOf(p, connect);
-  const double end = s.strokes.back().t + p.glowMs * 1e-3 * std::log(1 / kDarkLevel);
+  // The channels go dark after the last stroke's glow; the farthest vertex sees that maxDelay
+  // later (a slow stroke on a long channel), and the leader's glow may outlast both.
+  const double end =
+      std::max(s.strokes.back().t + p.glowMs * 1e-3 * std::log(1 / kDarkLevel), s.leaderEnd + 1e-6) + maxDelay;
 
   Timeline tl;
   const double k = p.timeScale;

@@ -174,7 +174,10 @@ class Renderer {
 Result<std::string> encodePng(const Image& image, int bitDepth);
 
 // An animated GIF written frame by frame through OpenImageIO's GIF writer (256 colours per
-// frame, looping forever), so a sequence never holds more than one frame.
+// frame, looping forever), so a sequence never holds more than one frame. GIF delays are whole
+// hundredths of a second, at least 2 (browsers play shorter ones at 10 fps): a frame lasts
+// gifDelay(fps) hundredths, so the rate played is 100 / gifDelay(fps) (fps <= 50).
+int gifDelay(double fps);
 class GifEncoder {
  public:
   GifEncoder(int width, int height, int count, double fps);
@@ -192,11 +195,13 @@ class GifEncoder {
 // A flipbook (sprite sheet): `count` frames in a grid, left to right, top to bottom, as the
 // texture-sheet animations of engines play them (Unity's Texture Sheet Animation, Unreal's
 // SubUV). columns = ceil(sqrt(count)), rows = ceil(count / columns); unused cells transparent.
+// The sheet's size: Flipbook::cells(count) frames.
 // The sheet's pixels are allocated by the first put().
 struct Flipbook {
   int columns = 0, rows = 0, frameWidth = 0, frameHeight = 0;
   Image sheet;
   Flipbook(int width, int height, int count);
+  static int cells(int count);  // columns * rows
   void put(const Image& frame, int index);
 };
 
