@@ -8,10 +8,10 @@
 namespace effects::lightning {
 namespace {
 
-constexpr double kRiseS = 20e-6;       // a stroke's flash reaches its peak (current rise ~ microseconds)
-constexpr double kFlickerS = 4e-3;     // spacing of the flicker noise's lattice
-constexpr double kFlashShare = 0.75;   // of a stroke's peak: the flash; the rest is the channel's glow
-constexpr double kDarkLevel = 0.004;   // the glow is over below this
+constexpr double kRiseS = 20e-6;      // a stroke's flash reaches its peak (current rise ~ microseconds)
+constexpr double kFlickerS = 4e-3;    // spacing of the flicker noise's lattice
+constexpr double kFlashShare = 0.75;  // of a stroke's peak: the flash; the rest is the channel's glow
+constexpr double kDarkLevel = 0.004;  // the glow is over below this
 
 // A uniform in [0, 1) from (seed, a, b): independent of evaluation order.
 double hashUniform(uint64_t seed, uint64_t a, uint64_t b) {
@@ -32,22 +32,20 @@ struct Strike {
     const double a = hashUniform(p.seed, 7, i), b = hashUniform(p.seed, 7, i + 1);
     return 1 + p.flicker * (2 * (a + (b - a) * (x - f)) - 1);
   }
-  double flash(const Stroke& s, double t) const {
+  // A stroke's light: rising over kRiseS to its peak, then decaying with time constant decayMs.
+  static double pulse(const Stroke& s, double t, double decayMs) {
     if (t < s.t) return 0;
-    return s.peak * std::min(1.0, (t - s.t) / kRiseS) * std::exp(-(t - s.t) / (p.flashMs * 1e-3));
-  }
-  double glow(const Stroke& s, double t) const {
-    if (t < s.t) return 0;
-    return s.peak * std::min(1.0, (t - s.t) / kRiseS) * std::exp(-(t - s.t) / (p.glowMs * 1e-3));
+    return s.peak * std::min(1.0, (t - s.t) / kRiseS) * std::exp(-(t - s.t) / (decayMs * 1e-3));
   }
   Keyframe at(double t) const {
     Keyframe k;
     k.t = t;
     k.leader = float(t < leaderEnd ? p.leaderBrightness : 0.0);
     double main = 0;
-    for (const Stroke& s : strokes) main += kFlashShare * flash(s, t) + (1 - kFlashShare) * glow(s, t) * flick(t);
+    for (const Stroke& s : strokes)
+      main += kFlashShare * pulse(s, t, p.flashMs) + (1 - kFlashShare) * pulse(s, t, p.glowMs) * flick(t);
     k.main = float(std::min(1.0, main));
-    k.branches = float(kFlashShare * flash(strokes.front(), t));
+    k.branches = float(kFlashShare * pulse(strokes.front(), t, p.flashMs));
     return k;
   }
 };
@@ -114,35 +112,40 @@ std::vector<double> sampleTimes(const Strike& s, double end) {
   return t;
 }
 
+// The first keyframe after t.
+std::vector<Keyframe>::const_iterator after(const Timeline& tl, double t) {
+  return std::upper_bound(tl.keyframes.begin(), tl.keyframes.end(), t,
+                          [](double x, const Keyframe& f) { return x < f.t; });
+}
+
 // The highest value of one channel (piecewise linear between keyframes) over [a, b]: its ends
 // and the keyframes inside (found by bisection: a frame holds a handful of them).
 double peak(const Timeline& tl, float Keyframe::*channel, double a, double b) {
   if (b < a) return 0;
   double best = std::max(channelsAt(tl, a).*channel, channelsAt(tl, b).*channel);
-  const auto& k = tl.keyframes;
-  auto it = std::upper_bound(k.begin(), k.end(), a, [](double x, const Keyframe& f) { return x < f.t; });
-  for (; it != k.end() && it->t < b; ++it) best = std::max(best, double((*it).*channel));
+  for (auto it = after(tl, a); it != tl.keyframes.end() && it->t < b; ++it)
+    best = std::max(best, double((*it).*channel));
   return best;
 }
 
 }  // namespace
 
 std::optional<Error> validate(const TimelineParams& p) {
-  auto bad = [](const char* field, const char* why) { return invalid(field, why); };
-  if (!(p.timeScale > 0 && p.timeScale <= 1e6)) return bad("/timeScale", "must be in (0, 1e6]");
-  if (!(p.cellSize > 0 && p.cellSize <= 1e4)) return bad("/timeline/cellSize", "must be in (0, 1e4] metres");
-  if (!(p.leaderStep >= 1 && p.leaderStep <= 1e4)) return bad("/timeline/leaderStep", "must be in [1, 1e4] metres");
+  if (!(p.timeScale > 0 && p.timeScale <= 1e6)) return invalid("/timeScale", "must be in (0, 1e6]");
+  if (!(p.cellSize > 0 && p.cellSize <= 1e4)) return invalid("/timeline/cellSize", "must be in (0, 1e4] metres");
+  if (!(p.leaderStep >= 1 && p.leaderStep <= 1e4)) return invalid("/timeline/leaderStep", "must be in [1, 1e4] metres");
   if (!(p.pauseMinUs > 0 && p.pauseMaxUs >= p.pauseMinUs && p.pauseMaxUs <= 1e6))
-    return bad("/timeline/leaderPause", "must be [min, max] microseconds with 0 < min <= max <= 1e6");
+    return invalid("/timeline/leaderPause", "must be [min, max] microseconds with 0 < min <= max <= 1e6");
   if (!(p.returnStrokeSpeed >= 1e5 && p.returnStrokeSpeed <= 3e8))
-    return bad("/timeline/returnStrokeSpeed", "must be in [1e5, 3e8] m/s");
-  if (p.strokes < 0 || p.strokes > 64) return bad("/timeline/strokes", "must be in [0, 64]");
+    return invalid("/timeline/returnStrokeSpeed", "must be in [1e5, 3e8] m/s");
+  if (p.strokes < 0 || p.strokes > 64) return invalid("/timeline/strokes", "must be in [0, 64]");
   if (!(p.intervalMinMs > 0 && p.intervalMaxMs >= p.intervalMinMs && p.intervalMaxMs <= 1e4))
-    return bad("/timeline/strokeInterval", "must be [min, max] milliseconds with 0 < min <= max <= 1e4");
-  if (!(p.flashMs > 0 && p.flashMs <= 1e4)) return bad("/timeline/flashDecay", "must be in (0, 1e4] milliseconds");
-  if (!(p.glowMs > 0 && p.glowMs <= 1e4)) return bad("/timeline/glowDecay", "must be in (0, 1e4] milliseconds");
-  if (!(p.leaderBrightness >= 0 && p.leaderBrightness <= 1)) return bad("/timeline/leaderBrightness", "must be in [0, 1]");
-  if (!(p.flicker >= 0 && p.flicker <= 1)) return bad("/timeline/flicker", "must be in [0, 1]");
+    return invalid("/timeline/strokeInterval", "must be [min, max] milliseconds with 0 < min <= max <= 1e4");
+  if (!(p.flashMs > 0 && p.flashMs <= 1e4)) return invalid("/timeline/flashDecay", "must be in (0, 1e4] milliseconds");
+  if (!(p.glowMs > 0 && p.glowMs <= 1e4)) return invalid("/timeline/glowDecay", "must be in (0, 1e4] milliseconds");
+  if (!(p.leaderBrightness >= 0 && p.leaderBrightness <= 1))
+    return invalid("/timeline/leaderBrightness", "must be in [0, 1]");
+  if (!(p.flicker >= 0 && p.flicker <= 1)) return invalid("/timeline/flicker", "must be in [0, 1]");
   return std::nullopt;
 }
 
@@ -188,7 +191,7 @@ Keyframe channelsAt(const Timeline& tl, double t) {
   Keyframe out;
   out.t = t;
   if (k.empty() || t < k.front().t || t > k.back().t) return out;
-  auto it = std::upper_bound(k.begin(), k.end(), t, [](double x, const Keyframe& f) { return x < f.t; });
+  auto it = after(tl, t);
   if (it == k.end()) return k.back();
   const Keyframe& b = *it;
   const Keyframe& a = *(it - 1);
@@ -211,8 +214,9 @@ double vertexBrightness(const Timeline& tl, const std::vector<Polyline>& lines, 
 std::vector<Polyline> exposure(const Timeline& tl, const std::vector<Polyline>& lines, double t0, double t1) {
   std::vector<Polyline> out;
   for (size_t i = 0; i < lines.size(); ++i) {
-    Polyline cut = lines[i];
-    cut.vertices.clear();
+    Polyline cut;  // the line's channel and width, its vertices as far as the leader came
+    cut.main = lines[i].main;
+    cut.width = lines[i].width;
     bool lit = false;
     for (size_t j = 0; j < lines[i].vertices.size(); ++j) {
       const double arrive = tl.leader[i][j], delay = tl.strokeDelay[i][j];
@@ -220,9 +224,9 @@ std::vector<Polyline> exposure(const Timeline& tl, const std::vector<Polyline>& 
       Vertex v = lines[i].vertices[j];
       const double from = std::max(t0, arrive), stroke = tl.connect + delay;
       const double leaderPart = from < stroke ? peak(tl, &Keyframe::leader, from, std::min(t1, stroke)) : 0.0;
-      const double strokePart =
-          t1 >= stroke ? peak(tl, lines[i].main ? &Keyframe::main : &Keyframe::branches, std::max(from, stroke) - delay, t1 - delay)
-                       : 0.0;
+      const double strokePart = t1 >= stroke ? peak(tl, lines[i].main ? &Keyframe::main : &Keyframe::branches,
+                                                    std::max(from, stroke) - delay, t1 - delay)
+                                             : 0.0;
       const double b = v.intensity * std::max(leaderPart, strokePart);
       v.intensity = float(b);
       lit = lit || b > 0;
