@@ -1,7 +1,10 @@
 // POST /v1/bubble — seed 000's bubble: mesh, uniforms, GLSL variants, thin-film table, glTF.
 #include <algorithm>
 
+#include <glm/geometric.hpp>
+
 #include <effects/bubble.h>
+#include <render/render.h>
 
 #include "api_bubble.h"
 #include "api_common.h"
@@ -13,6 +16,7 @@ namespace effectd {
 
 using nlohmann::json;
 namespace bb = effects::bubble;
+namespace rd = effects::render;
 
 bb::Params parseBubbleParams(const json& j, const std::string& pointer) {
   bb::Params p;
@@ -22,12 +26,16 @@ bb::Params parseBubbleParams(const json& j, const std::string& pointer) {
   p.betaSpeed = j.value("betaSpeed", p.betaSpeed);
   p.rimPower = j.value("rimPower", p.rimPower);
   p.muSpeed = j.value("muSpeed", p.muSpeed);
-  p.wobbleAmplitude = j.value("wobbleAmplitude", p.wobbleAmplitude);
+  if (j.value("wobbleVariant", "relative") == "paper") p.wobbleVariant = bb::WobbleVariant::kPaper;
+  const bb::WobbleShape defaults = bb::wobbleDefaults(p.wobbleVariant);
+  p.wobbleAmplitude = j.value("wobbleAmplitude", defaults.amplitude);
+  p.wobbleFrequency = j.value("wobbleFrequency", defaults.frequency);
   if (auto e = bb::validate(p)) throwError(*e, pointer);
   return p;
 }
 
-bb::Features parseBubbleFeatures(const json& j) {
+bb::Features parseBubbleFeatures(const json& body) {
+  const json j = body.value("features", json::object());
   bb::Features f;
   f.reflection = j.value("reflection", f.reflection);
   f.refraction = j.value("refraction", f.refraction);
@@ -35,7 +43,47 @@ bb::Features parseBubbleFeatures(const json& j) {
   f.textureFlow = j.value("textureFlow", f.textureFlow);
   f.wobble = j.value("wobble", f.wobble);
   f.iridescence = j.value("iridescence", f.iridescence);
+  f.thickness = j.value("thickness", f.thickness);
+  f.backFace = j.value("backFace", f.backFace);
+  f.highlight = j.value("highlight", f.highlight);
+  if (body.value("shading", "film") == "paper") f.shading = bb::Shading::kPaper;
   return f;
+}
+
+bb::ThicknessOptions parseFilm(const json& body, const Config& config, const std::string& pointer) {
+  const json j = body.value("film", json::object());
+  bb::ThicknessOptions o;
+  o.seed = j.value("seed", o.seed);
+  o.bottomStartNm = j.value("bottomStartNm", o.bottomStartNm);
+  o.bottomEndNm = j.value("bottomEndNm", o.bottomEndNm);
+  o.swirl = j.value("swirl", o.swirl);
+  o.swirlSpeed = j.value("swirlSpeed", o.swirlSpeed);
+  o.width = j.value("width", o.width);
+  o.height = j.value("height", o.height);
+  if (auto e = bb::validate(o)) throwError(*e, pointer + "/film");
+  if (size_t(o.width) * size_t(o.height) > config.limits.maxThinFilmTexels)
+    throw fieldError(413, pointer + "/film/width",
+                     "a " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                         " thickness texture exceeds the limit of " + std::to_string(config.limits.maxThinFilmTexels) +
+                         " texels (--max-thin-film-texels)");
+  return o;
+}
+
+std::vector<bb::Light> parseLights(const json& body, const std::string& pointer) {
+  if (!body.contains("lights")) return {bb::Light{}};
+  std::vector<bb::Light> out;
+  for (size_t i = 0; i < body["lights"].size(); ++i) {
+    const json& l = body["lights"][i];
+    const std::string at = pointer + "/lights/" + std::to_string(i);
+    bb::Light light;
+    if (l.contains("direction")) light.direction = toVec3(l["direction"]);
+    requireNonZero(light.direction, at + "/direction");
+    if (l.contains("color")) light.color = toVec3(l["color"]);
+    light.intensity = l.value("intensity", light.intensity);
+    light.sizeDegrees = l.value("sizeDegrees", light.sizeDegrees);
+    out.push_back(light);
+  }
+  return out;
 }
 
 bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const Config& config,
@@ -59,17 +107,32 @@ bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, 
 namespace {
 
 // Values for the uniforms the CPU owns; only those the shader variant declares are sent.
-json uniforms(const bb::Params& p, const std::vector<std::string>& declared, double t) {
-  const bb::Film film = bb::film(p, t);
-  const double flow = bb::reducedPhase(p.betaSpeed, t);
+json uniforms(const bb::Params& p, const bb::ThicknessOptions& film, const std::vector<bb::Light>& lights,
+              const std::vector<std::string>& declared, double t, double radius, const json& thicknessRange) {
+  const bb::Film mu = bb::film(p, t);
+  const bb::WobbleShape wobble = bb::wobbleInObject(p, radius);
   json all = {{"uWobblePhase", bb::reducedPhase(p.deltaSpeed, t)},
-              {"uWobbleAmplitude", p.wobbleAmplitude},
-              {"uFilmTop", film.top},
-              {"uFilmBottom", film.bottom},
+              {"uWobbleAmplitude", wobble.amplitude},
+              {"uWobbleFrequency", wobble.frequency},
+              {"uFilmTop", mu.top},
+              {"uFilmBottom", mu.bottom},
               {"uEta", p.n1 / p.n2},
-              {"uFlowPhase", flow},
+              {"uFlowPhase", bb::reducedPhase(p.betaSpeed, t)},
               {"uRimPower", p.rimPower},
-              {"uThickness", film.top}};
+              {"uThickness", mu.top},
+              {"uThicknessRange", thicknessRange},
+              {"uThicknessNm", bb::equatorThickness(p, film, t)}};
+  json directions = json::array(), radiances = json::array(), sharpness = json::array();
+  for (size_t i = 0; i < lights.size() && i < size_t(bb::kMaxLights); ++i) {
+    const glm::dvec3 d = glm::normalize(lights[i].direction), r = lights[i].color * lights[i].intensity;
+    directions.push_back({d.x, d.y, d.z});
+    radiances.push_back({r.x, r.y, r.z});
+    sharpness.push_back(bb::highlightSharpness(lights[i]));
+  }
+  all["uLightCount"] = directions.size();
+  all["uLightDirection"] = directions;
+  all["uLightRadiance"] = radiances;
+  all["uLightSharpness"] = sharpness;
   json out = json::object();
   for (const std::string& name : declared)
     if (all.contains(name)) out[name] = all[name];
@@ -152,25 +215,70 @@ json thinFilmJson(const json& body, const bb::Params& params, const json& tf, co
 
 // `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks.
 void addShaderParts(const json& body, const Includes& include, const bb::Params& params, const bb::Features& features,
-                    double t, json& out) {
+                    const bb::ThicknessOptions& film, const std::vector<bb::Light>& lights, double t, json& out) {
   // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
   const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
   bb::ShaderSource s;
   if (include.has("uniforms") || include.has("shader"))
     s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
-  if (include.has("uniforms")) out["uniforms"] = uniforms(params, s.uniforms, t);
-  if (include.has("uniforms") && features.textureFlow) {  // eqn 9, for clients that offset on the CPU
-    const glm::dvec2 off = bb::flowOffset(params, t);
+  if (include.has("uniforms")) {
+    const double radius = body.value("mesh", json::object()).value("radius", 1.0);
+    const json range = body.value("thinFilm", json::object()).value("thicknessRange", json{0, 1000});
+    out["uniforms"] = uniforms(params, film, lights, s.uniforms, t, radius, range);
+  }
+  if (include.has("uniforms") && features.shading == bb::Shading::kPaper && features.textureFlow) {
+    const glm::dvec2 off = bb::flowOffset(params, t);  // eqn 9, for clients that offset on the CPU
     out["flowOffset"] = {off.x, off.y};
   }
   if (include.has("shader")) {
-    out["shader"] = {
-        {"language", es ? "glsl-es-300" : "glsl-330"},
-        {"vertex", s.vertex},
-        {"fragment", s.fragment},
-        {"uniforms", s.uniforms},
-        {"attributes", features.textureFlow ? json{"aPosition", "aNormal", "aUv"} : json{"aPosition", "aNormal"}}};
+    const bool film = features.shading == bb::Shading::kFilm;
+    out["shader"] = {{"language", es ? "glsl-es-300" : "glsl-330"},
+                     {"vertex", s.vertex},
+                     {"fragment", s.fragment},
+                     {"uniforms", s.uniforms},
+                     {"attributes", s.attributes},
+                     {"blend", film ? "premultiplied: ONE, ONE_MINUS_SRC_ALPHA" : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
+                     {"draw", film && features.backFace
+                                  ? "back faces (cull front), then front faces (cull back); depth test, no depth write"
+                                  : "front faces (cull back); depth test, no depth write"}};
   }
+}
+
+// The film's thickness texture over the mesh's UVs, as JSON numbers or float32 base64.
+json thicknessJson(const bb::ThicknessField& f, const std::string& encoding) {
+  json j = {{"width", f.width},
+            {"height", f.height},
+            {"axes", "equirectangular as the mesh's uvs: u = atan2(z, x) / 2 pi + 0.5 (wrap), v = 0 (row 0) at the "
+                     "bottom (y = -1) to 1 at the top"},
+            {"unit", "nm"},
+            {"meanErrorNm", f.meanErrorNm},
+            {"maxErrorNm", f.maxErrorNm}};
+  if (encoding == "json") {
+    j["nm"] = f.nm;
+  } else {
+    j["encoding"] = "r32f";
+    j["data"] = base64Encode(std::string(reinterpret_cast<const char*>(f.nm.data()), f.nm.size() * sizeof(float)));
+  }
+  return j;
+}
+
+// The thickness as glTF wants it: G = thickness / max, 16 bits, rows as the mesh's v.
+std::string thicknessPng(const bb::ThicknessField& f, double maxNm) {
+  rd::Image image;
+  image.width = f.width;
+  image.height = f.height;
+  image.rgba.assign(size_t(f.width) * size_t(f.height) * 4, 1.0f);
+  for (size_t i = 0; i < f.nm.size(); ++i) image.rgba[i * 4 + 1] = float(std::clamp(f.nm[i] / maxNm, 0.0, 1.0));
+  auto png = rd::encodePng(image, 16);
+  if (!png.ok()) throwError(png.error(), "/film");
+  return std::move(png.value());
+}
+
+bb::ThicknessField thicknessField(const bb::Params& params, const bb::ThicknessOptions& o, double t,
+                                  const RequestContext& ctx) {
+  auto r = bb::thicknessField(params, o, t, ctx.parallel);
+  if (!r.ok()) throwError(r.error(), ctx.at + "/film");
+  return std::move(r.value());
 }
 
 }  // namespace
@@ -178,20 +286,36 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   Includes include(body, kBubbleIncludes);
   const bb::Params params = parseBubbleParams(body.value("params", json::object()), ctx.at + "/params");
-  const bb::Features features = parseBubbleFeatures(body.value("features", json::object()));
+  const bb::Features features = parseBubbleFeatures(body);
+  const bool film = features.shading == bb::Shading::kFilm;
+  const bb::ThicknessOptions filmOptions = parseFilm(body, ctx.config, ctx.at);
+  const std::vector<bb::Light> lights = parseLights(body, ctx.at);
   const double t = body.value("time", 0.0);
   const json tf = body.value("thinFilm", json::object());
   const json range = tf.value("thicknessRange", json{0, 1000});
-  // glTF's default range is 100-400 nm; a request's thicknessRange overrides it.
-  const bool rangeGiven = tf.contains("thicknessRange");
-  const double gltfMin = rangeGiven ? range[0].get<double>() : 100.0;
-  const double gltfMax = rangeGiven ? range[1].get<double>() : 400.0;
+  // glTF: the film model's own thickness (the field's texture over [0, its thickest], or one
+  // thickness); the paper's iridescence the thin-film range (glTF's default 100-400 nm unless given).
+  GltfFilm gltf;
+  gltf.iridescent = film || features.iridescence;
+  if (film) {
+    gltf.minNm = 0;
+    gltf.maxNm = features.thickness ? std::max({filmOptions.bottomStartNm, filmOptions.bottomEndNm, 1.0})
+                                    : bb::equatorThickness(params, filmOptions, t);
+  } else if (tf.contains("thicknessRange")) {
+    gltf.minNm = range[0].get<double>();
+    gltf.maxNm = range[1].get<double>();
+  }
   JsonReply reply;
-  reply.method = "seed000";
+  reply.method = film ? "thin-film" : "seed000";
   if (body.value("format", "json") == "glb") {  // the whole bubble as one file instead of JSON
     const bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
     reply.computeMs = mesh.stats.elapsedMs;
-    reply.binary = bubbleGlb(mesh, params, features, gltfMin, gltfMax);
+    if (film && features.thickness) {
+      const bb::ThicknessField field = thicknessField(params, filmOptions, t, ctx);
+      reply.computeMs += field.stats.elapsedMs;
+      gltf.thicknessPng = thicknessPng(field, gltf.maxNm);
+    }
+    reply.binary = bubbleGlb(mesh, params, gltf);
     reply.contentType = "model/gltf-binary";
     return reply;
   }
@@ -204,13 +328,19 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
     out["position"] = {c.x, c.y, c.z};
   }
-  addShaderParts(body, include, params, features, t, out);
+  addShaderParts(body, include, params, features, filmOptions, lights, t, out);
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
     bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
     reply.computeMs += mesh.stats.elapsedMs;
     stats.push_back(statsJson(mesh.stats));
     out["mesh"] = meshJson(std::move(mesh), body.value("uvOrigin", "bottom-left") == "top-left");
+  }
+  if (include.has("thickness")) {
+    const bb::ThicknessField field = thicknessField(params, filmOptions, t, ctx);
+    reply.computeMs += field.stats.elapsedMs;
+    stats.push_back(statsJson(field.stats));
+    out["thickness"] = thicknessJson(field, body.value("film", json::object()).value("encoding", "json"));
   }
   if (include.has("thinFilm")) {
     effects::Stats st;
@@ -219,11 +349,13 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     stats.push_back(statsJson(st));
   }
   if (include.has("gltf")) {
-    out["gltf"] = {{"KHR_materials_iridescence",
-                    {{"iridescenceFactor", features.iridescence ? 1.0 : 0.0},
-                     {"iridescenceIor", params.n2},
-                     {"iridescenceThicknessMinimum", gltfMin},
-                     {"iridescenceThicknessMaximum", gltfMax}}}};
+    json ext = {{"iridescenceFactor", gltf.iridescent ? 1.0 : 0.0},
+                {"iridescenceIor", params.n2},
+                {"iridescenceThicknessMinimum", gltf.minNm},
+                {"iridescenceThicknessMaximum", gltf.maxNm}};
+    if (film && features.thickness)
+      ext["iridescenceThicknessTexture"] = "the thickness texture (include thickness) as G = nm / maximum";
+    out["gltf"] = {{"KHR_materials_iridescence", ext}};
   }
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);

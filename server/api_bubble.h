@@ -18,7 +18,12 @@ JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
 // The parts of a bubble body; `pointer` is where that part sits in the request (problems name
 // fields under it): params at "/params", the body itself at "" (or "/bubble" in a scene).
 effects::bubble::Params parseBubbleParams(const nlohmann::json& j, const std::string& pointer);
-effects::bubble::Features parseBubbleFeatures(const nlohmann::json& j);
+// Features from the body's "features" and its "shading" model.
+effects::bubble::Features parseBubbleFeatures(const nlohmann::json& body);
+// The thickness field of the body's "film" (413 over --max-thin-film-texels, naming pointer/film/width).
+effects::bubble::ThicknessOptions parseFilm(const nlohmann::json& body, const Config& config, const std::string& pointer);
+// The body's "lights" (the default sun when absent).
+std::vector<effects::bubble::Light> parseLights(const nlohmann::json& body, const std::string& pointer);
 effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
                                                  const Config& config,
                                                  const std::string& pointer);  // throws 413 over --max-thin-film-texels

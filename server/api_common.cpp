@@ -17,6 +17,10 @@ ApiError fieldError(int status, const std::string& pointer, const std::string& m
 
 glm::dvec3 toVec3(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
 
+void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
+  if (v.x == 0 && v.y == 0 && v.z == 0) throw fieldError(400, pointer, "must not be the zero vector");
+}
+
 Includes::Includes(const nlohmann::json& body, std::vector<std::string> defaults) : items_(std::move(defaults)) {
   if (auto it = body.find("include"); it != body.end()) {
     items_.clear();

@@ -18,6 +18,7 @@ struct Stats;
 namespace effectd {
 
 glm::dvec3 toVec3(const nlohmann::json& j);  // schema guarantees three numbers
+void requireNonZero(const glm::dvec3& v, const std::string& pointer);  // 400 naming pointer
 // A problem about one field: 400 invalid-field, 413 limit-exceeded, 422 (well-formed but
 // impossible); detail "<pointer>: <message>", errors [{pointer, message}].
 ApiError fieldError(int status, const std::string& pointer, const std::string& message);

@@ -58,10 +58,6 @@ std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOption
   return shared;
 }
 
-void requireNonZero(const glm::dvec3& v, const std::string& pointer) {
-  if (v.x == 0 && v.y == 0 && v.z == 0) throw fieldError(400, pointer, "must not be the zero vector");
-}
-
 void parseCamera(const json& body, rd::Scene& s) {
   const json cam = body.value("camera", json::object());
   if (cam.contains("position")) s.camera.position = toVec3(cam["position"]);
@@ -162,7 +158,8 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
   const json& bj = body["bubble"];
   const double t = bj.value("time", sceneTime);
   b.params = parseBubbleParams(bj.value("params", json::object()), "/bubble/params");
-  b.features = parseBubbleFeatures(bj.value("features", json::object()));
+  b.features = parseBubbleFeatures(bj);
+  const bool film = b.features.shading == bb::Shading::kFilm;
   bb::MeshOptions o;
   const json m = bj.value("mesh", json::object());
   o.level = m.value("level", kRenderedIcosphereLevel);
@@ -178,13 +175,20 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
   if (b.features.wobble)  // the shader wobbles what icosphere() left still
     if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, "/bubble/mesh");
   b.mesh = std::move(mesh.value());
-  if (b.features.iridescence) {
+  b.radius = o.radius;
+  if (film || b.features.iridescence) {
     bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, "/bubble");
     tf.measureError = false;
     auto table = cachedThinFilm(tf, "/bubble");
     b.thinFilm = table->rgb;
     b.thinFilmWidth = table->width;
     b.thinFilmHeight = table->height;
+    b.thinFilmRangeNm = {tf.thicknessMinNm, tf.thicknessMaxNm};
+  }
+  if (film) {
+    b.film = parseFilm(bj, config, "/bubble");
+    // The scene's lights light every effect; a bubble's own serve when the scene has none.
+    b.lights = body.contains("lights") ? parseLights(body, "") : parseLights(bj, "/bubble");
   }
   if (bj.contains("motion")) {
     const json& mo = bj["motion"];

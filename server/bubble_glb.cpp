@@ -12,14 +12,18 @@ namespace {
 
 // KHR_materials_transmission + ior make the film see-through with the right refraction;
 // KHR_materials_iridescence (when the feature is on) gives it thin-film colour.
-json material(const effects::bubble::Params& p, const effects::bubble::Features& f, double tMin, double tMax) {
+// The thickness texture, when there is one, is texture 0.
+json material(const effects::bubble::Params& p, const GltfFilm& film) {
   json extensions = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
                      {"KHR_materials_ior", {{"ior", p.n2}}}};
-  if (f.iridescence)
+  if (film.iridescent) {
     extensions["KHR_materials_iridescence"] = {{"iridescenceFactor", 1.0},
                                                {"iridescenceIor", p.n2},
-                                               {"iridescenceThicknessMinimum", tMin},
-                                               {"iridescenceThicknessMaximum", tMax}};
+                                               {"iridescenceThicknessMinimum", film.minNm},
+                                               {"iridescenceThicknessMaximum", film.maxNm}};
+    if (!film.thicknessPng.empty())
+      extensions["KHR_materials_iridescence"]["iridescenceThicknessTexture"] = {{"index", 0}};
+  }
   return {{"name", "soap film"},
           {"doubleSided", true},
           {"pbrMetallicRoughness",
@@ -29,8 +33,7 @@ json material(const effects::bubble::Params& p, const effects::bubble::Features&
 
 }  // namespace
 
-std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params,
-                      const effects::bubble::Features& features, double thicknessMinNm, double thicknessMaxNm) {
+std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params, const GltfFilm& film) {
   glb::Asset a;
   // Arrays of one element spelled json::array(...): a braced single element may collapse to
   // the element itself depending on the compiler (nlohmann::json's initializer lists).
@@ -60,9 +63,15 @@ std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::
   const int indices = glb::addIndexAccessor(a, mesh.indices);
   const json primitive = {{"attributes", attributes}, {"indices", indices}, {"material", 0}};
   a.gltf["meshes"] = json::array({json{{"name", "bubble"}, {"primitives", json::array({primitive})}}});
-  a.gltf["materials"] = json::array({material(params, features, thicknessMinNm, thicknessMaxNm)});
+  a.gltf["materials"] = json::array({material(params, film)});
+  if (film.iridescent && !film.thicknessPng.empty()) {
+    const int image = glb::addPngImage(a, film.thicknessPng);
+    // u wraps around the sphere (seam triangles run past 1); v stops at the poles.
+    a.gltf["samplers"] = json::array({json{{"magFilter", 9729}, {"minFilter", 9729}, {"wrapS", 10497}, {"wrapT", 33071}}});
+    a.gltf["textures"] = json::array({json{{"source", image}, {"sampler", 0}}});
+  }
   json used = {"KHR_materials_transmission", "KHR_materials_ior"};
-  if (features.iridescence) used.push_back("KHR_materials_iridescence");
+  if (film.iridescent) used.push_back("KHR_materials_iridescence");
   a.gltf["extensionsUsed"] = used;
   return glb::serialize(a);
 }

@@ -8,10 +8,16 @@
 
 namespace effectd {
 
+// The film in KHR_materials_iridescence's terms: thickness = mix(minNm, maxNm, texture.g), or
+// maxNm everywhere without a texture (glTF's rule).
+struct GltfFilm {
+  bool iridescent = false;
+  double minNm = 100, maxNm = 400;
+  std::string thicknessPng;  // iridescenceThicknessTexture (rows as the mesh's v), or empty
+};
+
 // `mesh` at the time it was built; tangent w is negated to glTF's convention (UV origin top
-// left, as /v1/tangents writes it). The thin-film range is in nm. No texture is written: the
-// iridescence thickness is the range's maximum everywhere (glTF's rule without a texture).
-std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params,
-                      const effects::bubble::Features& features, double thicknessMinNm, double thicknessMaxNm);
+// left, as /v1/tangents writes it).
+std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::Params& params, const GltfFilm& film);
 
 }  // namespace effectd

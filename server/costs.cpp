@@ -98,6 +98,13 @@ Cost bubbleCost(const json& body, const Config& config) {
         std::min(size_t(tf.value("width", 256)) * size_t(tf.value("height", 256)), config.limits.maxThinFilmTexels);
     c.bytes += texels * (24 + 3 * kAnswerNumber + 8);  // float RGB, its numbers, or RGBA16F base64
   }
+  if (include.has("thickness") || glb) {
+    const json f = body.value("film", json::object());
+    const effects::bubble::ThicknessOptions d;
+    const size_t texels = std::min(size_t(f.value("width", d.width)) * size_t(f.value("height", d.height)),
+                                   config.limits.maxThinFilmTexels);
+    c.bytes += texels * (4 + kAnswerNumber + 16);  // floats, their numbers or base64, a 16-bit PNG
+  }
   return c;
 }
 

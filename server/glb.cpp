@@ -383,6 +383,14 @@ int addFloatAccessor(Asset& a, const std::vector<float>& data, int components, b
                           {"type", typeName(components)}});
 }
 
+int addPngImage(Asset& a, const std::string& png) {
+  const size_t bv = appendBin(a, png, 0, 0);
+  a.gltf["bufferViews"][bv].erase("target");  // images are no vertex or index data
+  if (!a.gltf.contains("images")) a.gltf["images"] = json::array();
+  a.gltf["images"].push_back({{"bufferView", bv}, {"mimeType", "image/png"}});
+  return int(a.gltf["images"].size() - 1);
+}
+
 int addIndexAccessor(Asset& a, const std::vector<uint32_t>& indices) {
   size_t maxIndex = 0;
   for (uint32_t i : indices) maxIndex = std::max<size_t>(maxIndex, i);

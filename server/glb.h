@@ -58,6 +58,8 @@ std::vector<float> floats(const std::vector<V>& v) {
 // New accessors over data appended to the BIN chunk (tightly packed, 4-byte aligned rows).
 int addFloatAccessor(Asset& asset, const std::vector<float>& data, int components, bool vertexAttribute);
 int addIndexAccessor(Asset& asset, const std::vector<uint32_t>& indices);
+// A PNG embedded in the BIN chunk as a new image (bufferView + mimeType); its index.
+int addPngImage(Asset& asset, const std::string& png);
 // A copy of accessor `index` with element k = original element remap[k] (any type).
 std::optional<FieldError> addRemappedAccessor(Asset& asset, int index, const std::vector<uint32_t>& remap,
                                               int& newIndex);

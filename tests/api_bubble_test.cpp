@@ -1,6 +1,10 @@
 // POST /v1/bubble over HTTP: include-driven output, feature-driven shaders and uniforms,
 // long times, errors.
 #include <cmath>
+#include <cstring>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 #include "codec.h"
 #include "test_server.h"
@@ -10,9 +14,36 @@ namespace {
 
 using nlohmann::json;
 
-TEST(BubbleApi, DefaultsAreUniformsAndShaderOnly) {
+TEST(BubbleApi, DefaultsAreTheFilmsUniformsAndShaderOnly) {
   TestServer s;
   auto r = s.postJson("/v1/bubble", json::object());
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(r->get_header_value("X-Effect-Method"), "thin-film");
+  json j = json::parse(r->body);
+  EXPECT_TRUE(j.contains("uniforms") && j.contains("shader"));
+  EXPECT_FALSE(j.contains("mesh") || j.contains("thickness") || j.contains("gltf") || j.contains("stats"));
+  const json& u = j["uniforms"];
+  EXPECT_EQ(u["uThicknessRange"], json({0, 1000}));
+  EXPECT_EQ(u["uLightCount"], 1);  // the default sun
+  EXPECT_NEAR(glm::length(glm::dvec3(u["uLightDirection"][0][0], u["uLightDirection"][0][1],
+                                     u["uLightDirection"][0][2])),
+              1.0, 1e-12);
+  // The relative wobble in object units: 3 % of the unit radius, 3 rad per unit.
+  EXPECT_NEAR(u["uWobbleAmplitude"].get<double>(), 0.03, 1e-12);
+  EXPECT_NEAR(u["uWobbleFrequency"].get<double>(), 3.0, 1e-12);
+  for (const char* paper : {"uFilmTop", "uEta", "uRimPower", "uFlowPhase"}) EXPECT_FALSE(u.contains(paper)) << paper;
+  EXPECT_EQ(j["shader"]["attributes"], json({"aPosition", "aNormal", "aUv"}));
+  EXPECT_NE(j["shader"]["blend"].get<std::string>().find("ONE_MINUS_SRC_ALPHA"), std::string::npos);
+  // A twice larger bubble wobbles twice as far at half the frequency per object unit.
+  json big = json::parse(s.postJson("/v1/bubble", json{{"mesh", {{"radius", 2}}}, {"include", {"uniforms"}}})->body);
+  EXPECT_NEAR(big["uniforms"]["uWobbleAmplitude"].get<double>(), 0.06, 1e-12);
+  EXPECT_NEAR(big["uniforms"]["uWobbleFrequency"].get<double>(), 1.5, 1e-12);
+}
+
+TEST(BubbleApi, PaperModelUniformsAndShader) {
+  TestServer s;
+  auto r = s.postJson("/v1/bubble", json{{"shading", "paper"}});
   ASSERT_TRUE(r);
   ASSERT_EQ(r->status, 200) << r->body;
   EXPECT_EQ(r->get_header_value("X-Effect-Method"), "seed000");
@@ -28,6 +59,7 @@ TEST(BubbleApi, DefaultsAreUniformsAndShaderOnly) {
 TEST(BubbleApi, DisabledFeaturesLeaveNoUniformsOrCode) {
   TestServer s;
   json req = {{"features", {{"refraction", false}, {"wobble", false}, {"textureFlow", false}}},
+              {"shading", "paper"},
               {"shader", {{"language", "glsl-330"}}}};
   json j = json::parse(s.postJson("/v1/bubble", req)->body);
   for (const char* gone : {"uEta", "uFilmBottom", "uWobblePhase", "uFlowPhase"}) {
@@ -43,10 +75,12 @@ TEST(BubbleApi, DisabledFeaturesLeaveNoUniformsOrCode) {
 
 TEST(BubbleApi, HugeTimeGivesTheReducedPhases) {
   TestServer s;
-  json a = json::parse(s.postJson("/v1/bubble", json{{"time", 1e9}, {"include", {"uniforms"}}})->body);
+  json a = json::parse(
+      s.postJson("/v1/bubble", json{{"time", 1e9}, {"shading", "paper"}, {"include", {"uniforms"}}})->body);
   const long double pi = 3.14159265358979323846264338327950288L;
   double small = double(1e9L - std::floor(1e9L / pi) * pi);  // same wobble phase (period pi)
-  json b = json::parse(s.postJson("/v1/bubble", json{{"time", small}, {"include", {"uniforms"}}})->body);
+  json b = json::parse(
+      s.postJson("/v1/bubble", json{{"time", small}, {"shading", "paper"}, {"include", {"uniforms"}}})->body);
   EXPECT_NEAR(a["uniforms"]["uWobblePhase"].get<double>(), b["uniforms"]["uWobblePhase"].get<double>(), 1e-6);
   EXPECT_GE(a["uniforms"]["uFlowPhase"].get<double>(), 0.0);
   EXPECT_LT(a["uniforms"]["uFlowPhase"].get<double>(), 2 * M_PI);
@@ -59,6 +93,7 @@ TEST(BubbleApi, MeshThinFilmGltfAndMotion) {
       {"camera", {0, 0, 4}},
       {"motion", {{"from", {0, 0, 0}}, {"to", {2, 0, 0}}, {"s", 0.25}}},
       {"features", {{"iridescence", true}}},
+      {"shading", "paper"},
       {"thinFilm",
        {{"width", 16}, {"height", 8}, {"wavelengths", 8}, {"thicknessRange", {100, 700}}, {"encoding", "rgba16f"}}},
       {"include", {"mesh", "thinFilm", "gltf", "uniforms", "stats"}}};
@@ -94,6 +129,47 @@ TEST(BubbleApi, BadInputNamesTheField) {
   EXPECT_TRUE(hasPointer(p, "/thinFilm/thicknessRange")) << p.dump();
   p = expectProblem(s.postJson("/v1/bubble", json{{"time", 1e300}}), 400);
   EXPECT_TRUE(hasPointer(p, "/time")) << p.dump();
+  // The paper's literal wobble (a = 1, k = 1) would fold the surface: refused, never clamped.
+  p = expectProblem(s.postJson("/v1/bubble", json{{"params", {{"wobbleVariant", "paper"}, {"wobbleAmplitude", 1}}}}),
+                    422);
+  EXPECT_TRUE(hasPointer(p, "/params/wobbleAmplitude")) << p.dump();
+  p = expectProblem(s.postJson("/v1/bubble", json{{"film", {{"swirl", 20}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/film/swirl")) << p.dump();
+  p = expectProblem(s.postJson("/v1/bubble", json{{"lights", {{{"direction", {0, 0, 0}}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/lights/0/direction")) << p.dump();
+  p = expectProblem(s.postJson("/v1/bubble", json{{"film", {{"width", 4096}, {"height", 4096}}},
+                                                  {"include", {"thickness"}}}),
+                    413);
+  EXPECT_TRUE(hasPointer(p, "/film/width")) << p.dump();
+}
+
+TEST(BubbleApi, ThicknessTextureAndGlbCarryTheField) {
+  TestServer s;
+  json req = {{"film", {{"width", 32}, {"height", 16}}}, {"time", 3}, {"include", {"thickness", "gltf", "stats"}}};
+  auto r = s.postJson("/v1/bubble", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  const json& t = j["thickness"];
+  ASSERT_EQ(t["nm"].size(), 32u * 16);
+  double lo = 1e9, hi = 0;
+  for (double v : t["nm"]) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_LT(lo, 100.0);  // a thin top
+  EXPECT_GT(hi, 600.0);  // a thick bottom
+  EXPECT_TRUE(j["gltf"]["KHR_materials_iridescence"].contains("iridescenceThicknessTexture"));
+  EXPECT_EQ(j["stats"][0]["method"], "drainage+swirl");
+  req["film"]["encoding"] = "r32f";
+  json b = json::parse(s.postJson("/v1/bubble", req)->body);
+  auto bytes = base64Decode(b["thickness"]["data"].get<std::string>());
+  ASSERT_TRUE(bytes);
+  ASSERT_EQ(bytes->size(), 32u * 16 * 4);
+  float first;
+  std::memcpy(&first, bytes->data(), 4);
+  EXPECT_FLOAT_EQ(first, t["nm"][0].get<float>());
+  // The glb embeds the texture as KHR_materials_iridescence's thickness texture.
+  auto g = s.postJson("/v1/bubble", json{{"format", "glb"}, {"film", {{"width", 32}, {"height", 16}}}});
+  ASSERT_EQ(g->status, 200);
+  EXPECT_NE(g->body.find("iridescenceThicknessTexture"), std::string::npos);
+  EXPECT_NE(g->body.find("image/png"), std::string::npos);
 }
 
 }  // namespace

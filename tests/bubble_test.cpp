@@ -102,7 +102,7 @@ TEST(Bubble, PhasesAtHugeTimesEqualTheReducedSmallTime) {
   const double small = double(static_cast<long double>(t) - std::floor(static_cast<long double>(t) / pi) * pi);
   EXPECT_NEAR(reducedPhase(p.deltaSpeed, t), reducedPhase(p.deltaSpeed, small), 1e-6);
   const dvec3 x(0.3, -0.2, 0.9);
-  expectVec(wobble(p, x, t), wobble(p, x, small), 1e-6);
+  expectVec(wobble(p, x, t, 1.0), wobble(p, x, small, 1.0), 1e-6);
   // Naive float evaluation is far off: delta * t = 2e9 + 1 rounds to 2e9 in a float.
   const double t2 = 1e9 + 0.5;
   double naivePhase = double(float(p.deltaSpeed * t2));
@@ -115,13 +115,84 @@ TEST(Bubble, PhasesAtHugeTimesEqualTheReducedSmallTime) {
 
 TEST(Bubble, WobbleAndMotionByHand) {
   Params p;
+  p.wobbleVariant = WobbleVariant::kPaper;  // eqn 11 in object units
   p.wobbleAmplitude = 0.5;
+  p.wobbleFrequency = 1;
   const double t = 0.25;  // phase 0.5
-  dvec3 w = wobble(p, {0.1, 0.2, 0.3}, t);
+  dvec3 w = wobble(p, {0.1, 0.2, 0.3}, t, 7.0);  // the paper's wobble ignores the radius
   expectVec(w, {0.1 + 0.5 * std::sin(0.6), 0.2 + 0.5 * std::cos(0.7), 0.3 + 0.5 * std::sin(0.8)}, 1e-12);
+  // The relative wobble scales with the radius: a sphere 10x larger moves 10x as far.
+  Params r;
+  const double k = r.wobbleFrequency, a = r.wobbleAmplitude;
+  w = wobble(r, {1, 2, 3}, t, 10.0);
+  expectVec(w, {1 + 10 * a * std::sin(0.5 + k * 0.1), 2 + 10 * a * std::cos(0.5 + k * 0.2),
+                3 + 10 * a * std::sin(0.5 + k * 0.3)},
+            1e-12);
+  expectVec(wobble(r, {0.1, 0.2, 0.3}, t, 1.0) * 10.0, w, 1e-12);
   expectVec(moveTowards({0, 0, 0}, {2, 4, 6}, 0.5), {1, 2, 3});
   expectVec(moveTowards({0, 0, 0}, {2, 4, 6}, 7), {2, 4, 6});
   EXPECT_TRUE(finite(moveTowards({0, 0, 0}, {2, 4, 6}, NAN)));
+}
+
+TEST(Bubble, WobbleThatWouldSquashOrFoldIsRefused) {
+  for (WobbleVariant v : {WobbleVariant::kRelative, WobbleVariant::kPaper}) {
+    Params p;
+    p.wobbleVariant = v;
+    const WobbleShape d = wobbleDefaults(v);
+    p.wobbleAmplitude = d.amplitude, p.wobbleFrequency = d.frequency;
+    EXPECT_FALSE(validate(p)) << "defaults of each variant are within the bound";
+    EXPECT_LE(d.amplitude * d.frequency, kMaxWobbleStretch);
+    p.wobbleAmplitude = 1.0, p.wobbleFrequency = 1.0;  // the paper's literal constants: a k = 1 folds
+    auto e = validate(p);
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->field, "/wobbleAmplitude");
+    EXPECT_EQ(e->kind, ErrorKind::kUnsatisfiable);
+    p.wobbleAmplitude = 0.01, p.wobbleFrequency = 65;
+    EXPECT_EQ(validate(p)->field, "/wobbleFrequency");
+  }
+}
+
+// Per triangle, the signed volume of the tetrahedron (the mesh's centroid, triangle): positive
+// for an outward-facing triangle of a closed star-shaped mesh.
+std::vector<double> orientations(const Mesh& m) {
+  dvec3 centre(0);
+  for (const auto& x : m.positions) centre += dvec3(x);
+  centre /= double(m.positions.size());
+  std::vector<double> out;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const dvec3 a(m.positions[m.indices[t]]), b(m.positions[m.indices[t + 1]]), c(m.positions[m.indices[t + 2]]);
+    out.push_back(glm::dot(glm::cross(b - a, c - a), (a + b + c) / 3.0 - centre));
+  }
+  return out;
+}
+
+TEST(Bubble, NoTriangleInvertsAtAnyTimeForEveryVariant) {
+  // Over a long sweep of times (phase wraps many times), at the bound a k = 0.5 and at each
+  // variant's defaults, every triangle keeps its orientation and a good share of its area.
+  for (WobbleVariant v : {WobbleVariant::kRelative, WobbleVariant::kPaper})
+    for (double frequency : {wobbleDefaults(v).frequency, 0.5, 6.0, 16.0})
+      for (int level : {1, 3}) {
+        Params p;
+        p.wobbleVariant = v;
+        p.wobbleFrequency = frequency;
+        p.wobbleAmplitude = kMaxWobbleStretch / frequency;
+        MeshOptions still;
+        still.level = level;
+        still.wobble = false;
+        const std::vector<double> rest = orientations(icosphere(p, still).value());
+        double worst = 1e9;
+        for (double t = 0; t < 400; t += 3.7) {
+          MeshOptions o = still;
+          o.wobble = true;
+          o.t = t;
+          auto r = icosphere(p, o);
+          ASSERT_TRUE(r.ok());
+          const std::vector<double> now = orientations(r.value());
+          for (size_t i = 0; i < now.size(); ++i) worst = std::min(worst, now[i] / rest[i]);
+        }
+        // The Jacobian's diagonal stays within [0.5, 1.5]; level 1's big triangles bend more.
+        EXPECT_GT(worst, 0.05) << int(v) << " k " << frequency << " level " << level;
+      }
 }
 
 TEST(Bubble, IcosphereLevelsAndFrames) {
@@ -152,7 +223,6 @@ TEST(Bubble, IcosphereLevelsAndFrames) {
 
 TEST(Bubble, WobbledMeshAtHugeTimeEqualsReducedTime) {
   Params p;
-  p.wobbleAmplitude = 0.05;
   MeshOptions a, b;
   a.level = b.level = 2;
   a.t = 1e9;
@@ -182,32 +252,119 @@ bool compiles(const std::string& source, const char* stage, std::string& log) {
 
 TEST(BubbleShader, EveryVariantCompilesAndHoldsOnlyItsFeatures) {
   ASSERT_EQ(std::system("glslangValidator -v > /dev/null 2>&1"), 0) << "glslang-tools missing: scripts/setup.sh";
-  const std::vector<std::pair<std::string, std::vector<std::string>>> featureMarks = {
-      {"reflection", {"uFilmTop"}},
-      {"refraction", {"uFilmBottom", "uEta", "nuIn"}},
-      {"rim", {"uRimPower"}},
-      {"textureFlow", {"uFlowTexture", "uFlowPhase", "vUv", "aUv"}},
-      {"wobble", {"uWobblePhase", "uWobbleAmplitude"}},
-      {"iridescence", {"uThinFilm", "uThickness"}}};
-  for (int mask = 0; mask < 64; ++mask) {
-    Features f{bool(mask & 1), bool(mask & 2), bool(mask & 4), bool(mask & 8), bool(mask & 16), bool(mask & 32)};
-    for (Glsl v : {Glsl::kEs300, Glsl::kCore330}) {
-      ShaderSource s = shader(f, v);
-      std::string log;
-      EXPECT_TRUE(compiles(s.vertex, "vert", log)) << mask << "\n" << s.vertex << log;
-      EXPECT_TRUE(compiles(s.fragment, "frag", log)) << mask << "\n" << s.fragment << log;
-      for (size_t k = 0; k < featureMarks.size(); ++k) {
-        bool on = mask & (1 << k);
-        for (const auto& mark : featureMarks[k].second) {
-          bool present = (s.vertex + s.fragment).find(mark) != std::string::npos;
-          EXPECT_EQ(present, on) << featureMarks[k].first << " " << mark << " mask " << mask;
+  using Marks = std::vector<std::pair<std::string, std::vector<std::string>>>;
+  // Per model, each feature flag's bit and what only it may put in the source.
+  const Marks paperMarks = {{"reflection", {"uFilmTop"}},
+                            {"refraction", {"uFilmBottom", "uEta", "nuIn"}},
+                            {"rim", {"uRimPower"}},
+                            {"textureFlow", {"uFlowTexture", "uFlowPhase", "vUv", "aUv"}},
+                            {"wobble", {"uWobblePhase", "uWobbleAmplitude", "uWobbleFrequency"}},
+                            {"iridescence", {"uThinFilm", "uThickness"}}};
+  const Marks filmMarks = {{"wobble", {"uWobblePhase", "uWobbleAmplitude", "uWobbleFrequency"}},
+                           {"thickness", {"uThicknessField", "vUv", "aUv"}},
+                           {"backFace", {"gl_FrontFacing"}},
+                           {"highlight", {"uLight"}}};
+  for (Shading model : {Shading::kPaper, Shading::kFilm}) {
+    const Marks& marks = model == Shading::kPaper ? paperMarks : filmMarks;
+    for (int mask = 0; mask < (1 << marks.size()); ++mask) {
+      Features f;
+      f.shading = model;
+      bool* paperFlags[] = {&f.reflection, &f.refraction, &f.rim, &f.textureFlow, &f.wobble, &f.iridescence};
+      bool* filmFlags[] = {&f.wobble, &f.thickness, &f.backFace, &f.highlight};
+      for (size_t k = 0; k < marks.size(); ++k) *(model == Shading::kPaper ? paperFlags : filmFlags)[k] = mask & (1 << k);
+      for (Glsl v : {Glsl::kEs300, Glsl::kCore330}) {
+        ShaderSource s = shader(f, v);
+        std::string log;
+        EXPECT_TRUE(compiles(s.vertex, "vert", log)) << mask << "\n" << s.vertex << log;
+        EXPECT_TRUE(compiles(s.fragment, "frag", log)) << mask << "\n" << s.fragment << log;
+        for (size_t k = 0; k < marks.size(); ++k) {
+          bool on = mask & (1 << k);
+          for (const auto& mark : marks[k].second) {
+            bool present = (s.vertex + s.fragment).find(mark) != std::string::npos;
+            EXPECT_EQ(present, on) << marks[k].first << " " << mark << " mask " << mask << " model " << int(model);
+          }
         }
-      }
-      if (!(mask & 3)) {
-        EXPECT_EQ(s.fragment.find("uEnvironment"), std::string::npos);
+        if (model == Shading::kPaper && !(mask & 3)) {
+          EXPECT_EQ(s.fragment.find("uEnvironment"), std::string::npos);
+        }
+        if (model == Shading::kFilm) {  // the paper's terms never reach the film
+          for (const char* paper : {"uFilmTop", "uEta", "uRimPower", "uFlowTexture", "uBaseColor"})
+            EXPECT_EQ((s.vertex + s.fragment).find(paper), std::string::npos) << paper;
+        }
       }
     }
   }
+}
+
+// ---- film thickness ----
+
+TEST(Thickness, DrainsThinTopThickBottomAndThinsOverTime) {
+  Params p;
+  ThicknessOptions o;
+  o.swirl = 0;  // drainage alone
+  const double top = thicknessAt(p, o, {0, 1, 0}, 0), bottom = thicknessAt(p, o, {0, -1, 0}, 0);
+  EXPECT_NEAR(top, 0.0, 1e-9);
+  EXPECT_NEAR(bottom, o.bottomStartNm, 1e-9);
+  EXPECT_NEAR(thicknessAt(p, o, {1, 0, 0}, 0), o.bottomStartNm * std::sqrt(0.5), 1e-9);  // Mysels: sqrt depth
+  // Eqn 3's alpha drives the drain: at saturate(muSpeed t) = 1 the bottom reaches bottomEndNm.
+  EXPECT_NEAR(thicknessAt(p, o, {0, -1, 0}, 1 / p.muSpeed), o.bottomEndNm, 1e-9);
+  EXPECT_NEAR(thicknessAt(p, o, {0, -1, 0}, 1e9), o.bottomEndNm, 1e-9);
+  double previous = 1e9;
+  for (double y = -1; y <= 1; y += 0.1) {  // monotone: thinner towards the top
+    const double h = thicknessAt(p, o, {std::sqrt(std::max(0.0, 1 - y * y)), y, 0}, 3);
+    EXPECT_LE(h, previous + 1e-9);
+    previous = h;
+  }
+}
+
+TEST(Thickness, SwirlMovesFilmWithoutCreatingItDeterministically) {
+  Params p;
+  ThicknessOptions o;
+  auto a = thicknessField(p, o, 4.0), b = thicknessField(p, o, 4.0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a.value().nm, b.value().nm);
+  const ThicknessField& f = a.value();
+  EXPECT_EQ(f.nm.size(), size_t(o.width) * size_t(o.height));
+  // The flow only moves film: every value is one the drainage profile holds at that time.
+  ThicknessOptions still = o;
+  still.swirl = 0;
+  const double hi = thicknessAt(p, still, {0, -1, 0}, 4.0);
+  double changed = 0;
+  auto calm = thicknessField(p, still, 4.0);
+  ASSERT_TRUE(calm.ok());
+  for (size_t i = 0; i < f.nm.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(f.nm[i]));
+    EXPECT_GE(f.nm[i], 0.0f);
+    EXPECT_LE(f.nm[i], hi * (1 + 1e-6));
+    changed = std::max(changed, std::abs(double(f.nm[i]) - calm.value().nm[i]));
+  }
+  EXPECT_GT(changed, 100.0) << "the swirl moves bands of thickness";
+  // A different seed, a different swirl; the same seed at a later time, a drifted one.
+  ThicknessOptions other = o;
+  other.seed = 2;
+  EXPECT_NE(thicknessField(p, other, 4.0).value().nm, f.nm);
+  EXPECT_NE(thicknessField(p, o, 5.0).value().nm, f.nm);
+  // The texture's error against the exact field is measured and small next to the range.
+  EXPECT_GT(f.maxErrorNm, 0.0);
+  EXPECT_LT(f.meanErrorNm, 10.0);
+}
+
+TEST(Thickness, ExtremeTimesAndParametersStayFinite) {
+  Params p;
+  ThicknessOptions o;
+  o.width = 32, o.height = 16;
+  for (double t : {-1e15, 0.0, 1e9, 1e15}) {
+    auto f = thicknessField(p, o, t);
+    ASSERT_TRUE(f.ok()) << t;
+    for (float v : f.value().nm) EXPECT_TRUE(std::isfinite(v) && v >= 0) << t;
+  }
+  o.swirl = 10, o.swirlSpeed = 1e6, o.bottomStartNm = 1e5;
+  auto f = thicknessField(p, o, 1e12);
+  ASSERT_TRUE(f.ok());
+  for (float v : f.value().nm) EXPECT_TRUE(std::isfinite(v) && v >= 0 && v <= 1e5 * 1.000001);
+  EXPECT_FALSE(thicknessField(p, o, NAN).ok());
+  o.swirl = 11;
+  EXPECT_EQ(thicknessField(p, o, 0).error().field, "/swirl");
 }
 
 // ---- thin film ----

@@ -5,6 +5,7 @@
 // Golden images are the PNGs in examples/. EFFECTD_UPDATE_GOLDEN=1 rewrites them.
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -280,6 +281,62 @@ TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
   ASSERT_TRUE(ready);
   EXPECT_EQ(ready->status, 200);
   EXPECT_FALSE(json::parse(ready->body)["info"].value("renderer", "").empty()) << ready->body;
+}
+
+// The default bubble is a soap film: over a grey backdrop it changes most of its disc, in many
+// hues (the paper's shader with the old example changed 6 % of it, in one or two), and it only
+// reflects: over black with no light it stays black.
+TEST(Render, FilmBubbleShowsBandsOfColourOverItsFace) {
+  TestServer s;
+  const int n = 192;
+  json scene = {{"width", n},
+                {"height", n},
+                {"time", 7},
+                {"camera", {{"position", {0, 0, 4}}, {"target", {0, 0, 0}}, {"fovY", 45}}},
+                {"background", {{"color", {0.5, 0.5, 0.5, 1}}}},
+                {"bubble", {{"mesh", {{"level", 4}}}}}};
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->get_header_value("X-Render-Passes").find("bubble-film"), std::string::npos);
+  const rd::Image img = decode(r->body);
+  // The unit sphere seen from 4 units: its disc's radius on screen.
+  const double disc = std::tan(std::asin(0.25)) / std::tan(22.5 * M_PI / 180) * n / 2;
+  int inside = 0, changed = 0;
+  std::array<int, 6> hues{};
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      if (std::hypot(x + 0.5 - n / 2.0, y + 0.5 - n / 2.0) > 0.9 * disc) continue;
+      ++inside;
+      const glm::vec4 c = pixel(img, x, y);
+      const float mx = std::max({c.r, c.g, c.b}), mn = std::min({c.r, c.g, c.b});
+      if (std::max({std::abs(c.r - 0.5f), std::abs(c.g - 0.5f), std::abs(c.b - 0.5f)}) > 0.01f) ++changed;
+      if (mx - mn > 0.015f) {  // a visible tint: which sixth of the hue circle
+        const double h = std::atan2(std::sqrt(3.0) * (c.g - c.b), 2.0 * c.r - c.g - c.b) + M_PI;
+        ++hues[std::min(5, int(h / (2 * M_PI) * 6))];
+      }
+    }
+  ASSERT_GT(inside, 1000);
+  EXPECT_GT(changed, inside / 2) << changed << " of " << inside;
+  int huesSeen = 0;
+  for (int h : hues) huesSeen += h > inside / 50;
+  EXPECT_GE(huesSeen, 4) << ::testing::PrintToString(hues);
+
+  // The far side adds its own reflection through the near side.
+  json front = scene;
+  front["bubble"]["features"] = {{"backFace", false}};
+  const rd::Image frontOnly = decode(render(s, front)->body);
+  EXPECT_NE(frontOnly.rgba, img.rgba);
+
+  // Nothing to reflect, nothing drawn: the film adds no light of its own.
+  json dark = scene;
+  dark["background"] = {{"color", {0, 0, 0, 1}}};
+  dark["bubble"]["features"] = {{"highlight", false}};
+  const rd::Image black = decode(render(s, dark)->body);
+  float brightest = 0;
+  for (size_t i = 0; i < black.rgba.size(); i += 4)
+    brightest = std::max({brightest, black.rgba[i], black.rgba[i + 1], black.rgba[i + 2]});
+  EXPECT_LT(brightest, 0.01f);
 }
 
 TEST(Render, SceneReturnsEachPresentEffectAndNothingElse) {

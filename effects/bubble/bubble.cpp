@@ -32,12 +32,20 @@ std::optional<Error> validate(const Params& p) {
   if (!in(p.betaSpeed, 0, 1e6)) return invalid("/betaSpeed", "must be in [0, 1e6]");
   if (!in(p.muSpeed, 0, 1e6)) return invalid("/muSpeed", "must be in [0, 1e6]");
   if (!in(p.rimPower, 0, 1e3)) return invalid("/rimPower", "must be in [0, 1000]");
-  // Eqn 11 moves x by a sin(phase + x): its Jacobian 1 + a cos(phase + x) turns negative, and
-  // the surface folds through itself, for a > 1.
-  if (!in(p.wobbleAmplitude, 0, 1))
-    return invalid("/wobbleAmplitude", "must be in [0, 1]: a larger amplitude folds the surface (eqn 11)");
+  if (!in(p.wobbleFrequency, 0, kMaxWobbleFrequency))
+    return invalid("/wobbleFrequency", "must be in [0, " + std::to_string(int(kMaxWobbleFrequency)) + "]");
+  if (!in(p.wobbleAmplitude, 0, 1e6)) return invalid("/wobbleAmplitude", "must be in [0, 1e6]");
+  // Eqn 11's Jacobian is 1 + a k cos(...): at a k = 1 the surface creases, beyond it folds.
+  if (p.wobbleAmplitude * p.wobbleFrequency > kMaxWobbleStretch)
+    return unsatisfiable("/wobbleAmplitude",
+                         "amplitude x frequency = " + std::to_string(p.wobbleAmplitude * p.wobbleFrequency) +
+                             " exceeds " + std::to_string(kMaxWobbleStretch) +
+                             ": eqn 11's Jacobian 1 + a k cos(...) would squash the surface (at 1 it folds); "
+                             "lower wobbleAmplitude or wobbleFrequency");
   return std::nullopt;
 }
+
+WobbleShape wobbleDefaults(WobbleVariant v) { return v == WobbleVariant::kPaper ? kPaperWobble : kRelativeWobble; }
 
 Film film(const Params& p, double t) {
   double a = saturate(p.muSpeed * t);  // eqn 3; t < 0 counts as 0
@@ -89,15 +97,21 @@ glm::dvec2 flowOffset(const Params& p, double t) {
   return {std::sin(ph), std::cos(ph)};  // eqn 9
 }
 
-dvec3 wobble(const Params& p, const dvec3& x, double t) {
-  const double ph = reducedPhase(p.deltaSpeed, t), a = p.wobbleAmplitude;  // eqn 11
-  return {x.x + a * std::sin(ph + x.x), x.y + a * std::cos(ph + x.y), x.z + a * std::sin(ph + x.z)};
+WobbleShape wobbleInObject(const Params& p, double radius) {
+  const double unit = p.wobbleVariant == WobbleVariant::kRelative ? radius : 1.0;
+  return {p.wobbleAmplitude * unit, p.wobbleFrequency / unit};
+}
+
+dvec3 wobble(const Params& p, const dvec3& x, double t, double radius) {
+  const double ph = reducedPhase(p.deltaSpeed, t);  // eqn 11
+  const auto [a, k] = wobbleInObject(p, radius);
+  return {x.x + a * std::sin(ph + k * x.x), x.y + a * std::cos(ph + k * x.y), x.z + a * std::sin(ph + k * x.z)};
 }
 
 std::optional<Error> wobbleFits(const Params& p, double radius) {
-  // The wobble moves every point by up to a object units: float32 positions keep ~7 digits,
-  // so a sphere under a thousandth of that is translated whole and its shape lost.
-  if (radius < 1e-3 * p.wobbleAmplitude)
+  // The paper's wobble moves every point by up to a object units: float32 positions keep ~7
+  // digits, so a sphere under a thousandth of that is translated whole and its shape lost.
+  if (p.wobbleVariant == WobbleVariant::kPaper && radius < 1e-3 * p.wobbleAmplitude)
     return unsatisfiable("/radius", "a sphere of radius " + std::to_string(radius) + " under a wobble of " +
                                         std::to_string(p.wobbleAmplitude) +
                                         " object units collapses in float32 positions: radius must be at least "
@@ -184,7 +198,7 @@ tangents::Mesh project(const Sphere& s, const Params& p, const MeshOptions& o) {
     auto [it, fresh] = copies.emplace((uint64_t(base) << 32) | bits, uint32_t(m.positions.size()));
     if (fresh) {
       dvec3 x = s.v[base] * o.radius;
-      if (o.wobble) x = wobble(p, x, o.t);
+      if (o.wobble) x = wobble(p, x, o.t, o.radius);
       m.positions.push_back(glm::vec3(x));
       m.uvs.push_back({fu, float(vv)});
     }

@@ -1,5 +1,8 @@
-// GLSL for seed 000's bubble, assembled from the enabled features only: a disabled feature
+// GLSL for the bubble, assembled from the enabled features only: a disabled feature
 // contributes no line and no uniform. Time enters as phases reduced on the CPU (reducedPhase).
+// Two models (effects/bubble.h): seed 000's (eqns 3-11) and the soap film.
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "effects/bubble.h"
@@ -10,8 +13,9 @@ namespace {
 struct Builder {
   std::ostringstream src;
   std::vector<std::string>* uniforms;
-  void uniform(const std::string& type, const std::string& name, const std::string& comment) {
-    src << "uniform " << type << " " << name << ";  // " << comment << "\n";
+  void uniform(const std::string& type, const std::string& name, const std::string& comment, int array = 0) {
+    src << "uniform " << type << " " << name << (array ? "[" + std::to_string(array) + "]" : "") << ";  // "
+        << comment << "\n";
     uniforms->push_back(name);
   }
   Builder& operator<<(const std::string& s) {
@@ -25,42 +29,41 @@ std::string header(Glsl v, bool fragment) {
   return fragment ? "#version 300 es\nprecision highp float;\n" : "#version 300 es\n";
 }
 
-// The vertex shader: position (wobbled, eqn 11), world position, normal, and the UV for the
-// texture flow. Its uniforms are appended to `uniforms`.
-std::string vertexShader(const Features& f, Glsl version, std::vector<std::string>& uniforms) {
-  Builder vs{{}, &uniforms};
+bool film(const Features& f) { return f.shading == Shading::kFilm; }
+bool usesUv(const Features& f) { return film(f) ? f.thickness : f.textureFlow; }
+
+// The vertex shader: position (wobbled, eqn 11) with its normal carried through the wobble's
+// Jacobian, world position, and the UV for the texture flow or the thickness texture.
+std::string vertexShader(const Features& f, Glsl version, ShaderSource& out) {
+  Builder vs{{}, &out.uniforms};
+  out.attributes = {"aPosition", "aNormal"};
   vs << header(version, false) << "layout(location = 0) in vec3 aPosition;\nlayout(location = 1) in vec3 aNormal;\n";
-  if (f.textureFlow) vs << "layout(location = 2) in vec2 aUv;\n";
-  vs.uniform("mat4", "uModel", "object -> world");
+  if (usesUv(f)) vs << "layout(location = 2) in vec2 aUv;\n", out.attributes.push_back("aUv");
+  vs.uniform("mat4", "uModel", "object -> world (translation and uniform scale)");
   vs.uniform("mat4", "uViewProjection", "world -> clip");
   if (f.wobble) {
     vs.uniform("float", "uWobblePhase", "deltaSpeed * t mod 2 pi, reduced on the CPU (eqn 11)");
     vs.uniform("float", "uWobbleAmplitude", "object units");
+    vs.uniform("float", "uWobbleFrequency", "radians per object unit");
   }
   vs << "out vec3 vNormal;\nout vec3 vWorld;\n";
-  if (f.textureFlow) vs << "out vec2 vUv;\n";
-  vs << "void main() {\n  vec3 p = aPosition;\n";
-  if (f.wobble)  // eqn 11
-    vs << "  p += uWobbleAmplitude * vec3(sin(uWobblePhase + p.x), cos(uWobblePhase + p.y), sin(uWobblePhase + "
-          "p.z));\n";
+  if (usesUv(f)) vs << "out vec2 vUv;\n";
+  vs << "void main() {\n  vec3 p = aPosition;\n  vec3 n = aNormal;\n";
+  if (f.wobble)  // eqn 11; the normal by the inverse transpose of its diagonal Jacobian
+    vs << "  vec3 arg = vec3(uWobblePhase) + uWobbleFrequency * p;\n"
+          "  p += uWobbleAmplitude * vec3(sin(arg.x), cos(arg.y), sin(arg.z));\n"
+          "  n /= 1.0 + uWobbleAmplitude * uWobbleFrequency * vec3(cos(arg.x), -sin(arg.y), cos(arg.z));\n";
   vs << "  vec4 world = uModel * vec4(p, 1.0);\n  vWorld = world.xyz;\n"
-        "  vNormal = mat3(uModel) * aNormal;\n";
-  if (f.textureFlow) vs << "  vUv = aUv;\n";
+        "  vNormal = mat3(uModel) * n;\n";
+  if (usesUv(f)) vs << "  vUv = aUv;\n";
   vs << "  gl_Position = uViewProjection * world;\n}\n";
   return vs.src.str();
 }
 
-// The fragment shader: the base colour, then each enabled feature's factor or term in turn,
-// with the caller's prelude (declarations) and finish (before the output). Its uniforms are
-// appended to `uniforms`.
-std::string fragmentShader(const Features& f, Glsl version, const std::string& fragmentPrelude,
-                           const std::string& fragmentFinish, std::vector<std::string>& uniforms) {
+// Seed 000's fragment shader: the base colour, then each enabled feature's factor or term.
+std::string paperFragment(const Features& f, Builder& fs) {
   const bool env = f.reflection || f.refraction;
   const bool needsView = env || f.rim || f.iridescence;
-  Builder fs{{}, &uniforms};
-  fs << header(version, true) << "in vec3 vNormal;\nin vec3 vWorld;\n";
-  if (f.textureFlow) fs << "in vec2 vUv;\n";
-  fs << "out vec4 fragColor;\n";
   fs.uniform("vec4", "uBaseColor", "colour and alpha without any feature");
   if (needsView) fs.uniform("vec3", "uCameraPosition", "world space");
   if (env) fs.uniform("samplerCube", "uEnvironment", "looked up with the final vector (eqn 8)");
@@ -78,35 +81,81 @@ std::string fragmentShader(const Features& f, Glsl version, const std::string& f
     fs.uniform("sampler2D", "uThinFilm", "thin-film table: u = thickness, v = cos(theta)");
     fs.uniform("float", "uThickness", "film thickness as the table's u coordinate");
   }
-  fs << fragmentPrelude << "void main() {\n  vec4 color = uBaseColor;\n";
+  std::ostringstream body;
+  body << "  vec4 color = uBaseColor;\n";
   if (needsView)
-    fs << "  vec3 N = normalize(vNormal);\n  vec3 V = normalize(uCameraPosition - vWorld);\n"
-          "  float gammaOut = dot(N, V);  // eqn 4\n";
+    body << "  vec3 N = normalize(vNormal);\n  vec3 V = normalize(uCameraPosition - vWorld);\n"
+            "  float gammaOut = dot(N, V);  // eqn 4\n";
   if (env) {
-    fs << "  vec3 I = -V;\n  vec3 finalVector = vec3(0.0);\n";
-    if (f.reflection) fs << "  finalVector += (I + 2.0 * N * dot(-I, N)) * uFilmTop;  // eqns 6, 8\n";
+    body << "  vec3 I = -V;\n  vec3 finalVector = vec3(0.0);\n";
+    if (f.reflection) body << "  finalVector += (I + 2.0 * N * dot(-I, N)) * uFilmTop;  // eqns 6, 8\n";
     if (f.refraction)
-      fs << "  float nuIn = uEta * sqrt(max(0.0, 1.0 - gammaOut * gammaOut));  // eqn 5\n"
-            "  if (nuIn < 1.0)  // otherwise total internal reflection: no refracted ray\n"
-            "    finalVector += (uEta * I + (uEta * gammaOut - sqrt(1.0 - nuIn * nuIn)) * N) * uFilmBottom;  // eqn "
-            "7\n";
-    fs << "  color.rgb *= texture(uEnvironment, finalVector).rgb;\n";
+      body << "  float nuIn = uEta * sqrt(max(0.0, 1.0 - gammaOut * gammaOut));  // eqn 5\n"
+              "  if (nuIn < 1.0)  // otherwise total internal reflection: no refracted ray\n"
+              "    finalVector += (uEta * I + (uEta * gammaOut - sqrt(1.0 - nuIn * nuIn)) * N) * uFilmBottom;  // "
+              "eqn 7\n";
+    body << "  color.rgb *= texture(uEnvironment, finalVector).rgb;\n";
   }
   if (f.textureFlow)
-    fs << "  color.rgb *= texture(uFlowTexture, vUv + vec2(sin(uFlowPhase), cos(uFlowPhase))).rgb;  // eqn 9\n";
-  if (f.iridescence) fs << "  color.rgb += texture(uThinFilm, vec2(uThickness, abs(gammaOut))).rgb;\n";
-  if (f.rim) fs << "  color.a *= clamp(pow(max(1.0 - gammaOut, 0.0), uRimPower), 0.0, 1.0);  // eqn 10\n";
-  fs << fragmentFinish << "  fragColor = color;\n}\n";
-  return fs.src.str();
+    body << "  color.rgb *= texture(uFlowTexture, vUv + vec2(sin(uFlowPhase), cos(uFlowPhase))).rgb;  // eqn 9\n";
+  if (f.iridescence) body << "  color.rgb += texture(uThinFilm, vec2(uThickness, abs(gammaOut))).rgb;\n";
+  if (f.rim) body << "  color.a *= clamp(pow(max(1.0 - gammaOut, 0.0), uRimPower), 0.0, 1.0);  // eqn 10\n";
+  return body.str();
+}
+
+// The soap film's fragment shader: reflectance per fragment, premultiplied output.
+std::string filmFragment(const Features& f, Builder& fs) {
+  fs.uniform("vec3", "uCameraPosition", "world space");
+  fs.uniform("samplerCube", "uEnvironment", "what the mirror direction sees");
+  fs.uniform("sampler2D", "uThinFilm", "film reflectance: u = thickness over uThicknessRange, v = cos(theta)");
+  fs.uniform("vec2", "uThicknessRange", "nm at the table's first and last column");
+  if (f.thickness)
+    fs.uniform("sampler2D", "uThicknessField", "nm: drainage and swirl (equirectangular, REPEAT in u)");
+  else
+    fs.uniform("float", "uThicknessNm", "one thickness for the whole film");
+  if (f.highlight) {
+    fs.uniform("int", "uLightCount", "lights in use, at most " + std::to_string(kMaxLights));
+    fs.uniform("vec3", "uLightDirection", "world, towards the light, unit", kMaxLights);
+    fs.uniform("vec3", "uLightRadiance", "colour x intensity", kMaxLights);
+    fs.uniform("float", "uLightSharpness", "lobe exponent", kMaxLights);
+  }
+  std::ostringstream body;
+  body << "  vec3 N = normalize(vNormal);\n";
+  if (f.backFace) body << "  if (!gl_FrontFacing) N = -N;  // the film seen from inside\n";
+  body << "  vec3 V = normalize(uCameraPosition - vWorld);\n"
+          "  float cosTheta = clamp(abs(dot(N, V)), 0.0, 1.0);\n";
+  body << (f.thickness ? "  float thickness = texture(uThicknessField, vUv).r;\n"
+                       : "  float thickness = uThicknessNm;\n");
+  body << "  float u = (thickness - uThicknessRange.x) / max(uThicknessRange.y - uThicknessRange.x, 1e-6);\n"
+          "  vec3 R = texture(uThinFilm, vec2(u, cosTheta)).rgb;  // Airy, s and p, CIE\n"
+          "  vec3 r = reflect(-V, N);\n"
+          "  vec3 seen = texture(uEnvironment, r).rgb;\n";
+  if (f.highlight)
+    body << "  for (int i = 0; i < uLightCount; ++i)\n"
+            "    seen += uLightRadiance[i] * pow(max(dot(r, uLightDirection[i]), 0.0), uLightSharpness[i]);\n";
+  body << "  // premultiplied: what is behind shows through 1 - R\n"
+          "  vec4 color = vec4(R * seen, dot(R, vec3(0.2126, 0.7152, 0.0722)));\n";
+  return body.str();
 }
 
 }  // namespace
 
+double highlightSharpness(const Light& l) {
+  const double c = std::cos(std::clamp(l.sizeDegrees, 1e-3, 89.0) * 3.14159265358979323846 / 180);
+  return std::log(0.5) / std::log(c);  // c^n = 1/2
+}
+
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude,
                     const std::string& fragmentFinish) {
   ShaderSource out;
-  out.vertex = vertexShader(f, version, out.uniforms);
-  out.fragment = fragmentShader(f, version, fragmentPrelude, fragmentFinish, out.uniforms);
+  out.vertex = vertexShader(f, version, out);
+  Builder fs{{}, &out.uniforms};
+  fs << header(version, true) << "in vec3 vNormal;\nin vec3 vWorld;\n";
+  if (usesUv(f)) fs << "in vec2 vUv;\n";
+  fs << "out vec4 fragColor;\n";
+  const std::string body = film(f) ? filmFragment(f, fs) : paperFragment(f, fs);
+  fs << fragmentPrelude << "void main() {\n" << body << fragmentFinish << "  fragColor = color;\n}\n";
+  out.fragment = fs.src.str();
   return out;
 }
 

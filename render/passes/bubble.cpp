@@ -1,5 +1,6 @@
-// Seed 000's soap bubble: the backdrop rendered into a cube map (what eqn 8's final vector
-// looks up), then the near side of the sphere, blended over the frame.
+// The bubble: the backdrop rendered into a cube map (what the film's mirror direction and eqn
+// 8's final vector look up), then the sphere blended over the frame (the soap film: far side,
+// then near side, premultiplied; seed 000's model: the near side).
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../gpu.h"
@@ -38,11 +39,11 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   return std::nullopt;
 }
 
-// The program's cache key: one bit per feature, in the order of bubble::Features.
-std::string programKey(const bubble::Features& features) {
-  std::string key = "bubble:";
-  for (bool on : {features.reflection, features.refraction, features.rim, features.textureFlow, features.wobble,
-                  features.iridescence})
+// The program's cache key: the model, then one bit per feature in the order of bubble::Features.
+std::string programKey(const bubble::Features& f) {
+  std::string key = f.shading == bubble::Shading::kFilm ? "bubble:film:" : "bubble:paper:";
+  for (bool on : {f.reflection, f.refraction, f.rim, f.textureFlow, f.wobble, f.iridescence, f.thickness, f.backFace,
+                  f.highlight})
     key += on ? '1' : '0';
   return key;
 }
@@ -51,10 +52,12 @@ std::string programKey(const bubble::Features& features) {
 void setUniforms(Program& p, const Bubble& b, const FrameState& f) {
   const bubble::Params& bp = b.params;
   const bubble::Film film = bubble::film(bp, b.time);
+  const bubble::WobbleShape wobble = bubble::wobbleInObject(bp, b.radius);
   p.set("uModel", glm::translate(glm::mat4(1), glm::vec3(b.center)));
   p.set("uViewProjection", f.view.viewProjection);
   p.set("uWobblePhase", float(bubble::reducedPhase(bp.deltaSpeed, b.time)));
-  p.set("uWobbleAmplitude", float(bp.wobbleAmplitude));
+  p.set("uWobbleAmplitude", float(wobble.amplitude));
+  p.set("uWobbleFrequency", float(wobble.frequency));
   p.set("uBaseColor", glm::vec4(b.baseColor));
   p.set("uCameraPosition", f.view.eye);
   p.set("uFilmTop", float(film.top));
@@ -63,6 +66,17 @@ void setUniforms(Program& p, const Bubble& b, const FrameState& f) {
   p.set("uFlowPhase", float(bubble::reducedPhase(bp.betaSpeed, b.time)));
   p.set("uRimPower", float(bp.rimPower));
   p.set("uThickness", float(film.top));
+  p.set("uThicknessRange", glm::vec2(b.thinFilmRangeNm));
+  p.set("uThicknessNm", float(bubble::equatorThickness(bp, b.film, b.time)));
+  const int lights = int(std::min<size_t>(b.lights.size(), bubble::kMaxLights));
+  p.set("uLightCount", lights);
+  for (int i = 0; i < lights; ++i) {
+    const bubble::Light& l = b.lights[size_t(i)];
+    const std::string at = "[" + std::to_string(i) + "]";
+    p.set("uLightDirection" + at, glm::vec3(glm::normalize(l.direction)));
+    p.set("uLightRadiance" + at, glm::vec3(l.color * l.intensity));
+    p.set("uLightSharpness" + at, float(bubble::highlightSharpness(l)));
+  }
 }
 
 // The mesh's vertices interleaved as the program reads them: position, normal, uv.
@@ -77,15 +91,24 @@ std::vector<float> interleaved(const bubble::Mesh& m) {
   return data;
 }
 
-// Draws the bound mesh blended over the frame, depth-tested without writing depth.
-void drawNearSide(GLsizei indexCount) {
+// Draws the bound mesh over the frame, depth-tested without writing depth: the paper's near
+// side with straight alpha; the film premultiplied, its far side (seen through the near one)
+// first when the feature is on.
+void drawMesh(const bubble::Features& f, GLsizei indexCount) {
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
   glEnable(GL_BLEND);
-  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  // The near side only: eqns 4-10 are written for the surface facing the viewer.
   glEnable(GL_CULL_FACE);
-  glCullFace(GL_BACK);
+  if (f.shading == bubble::Shading::kFilm) {
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    if (f.backFace) {
+      glCullFace(GL_FRONT);
+      glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    }
+  } else {
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  }
+  glCullFace(GL_BACK);  // eqns 4-10 are written for the surface facing the viewer
   glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
@@ -93,33 +116,52 @@ void drawNearSide(GLsizei indexCount) {
   glDisable(GL_DEPTH_TEST);
 }
 
+// Fog over the bubble: straight alpha mixes; premultiplied (the film) fogs the light it
+// reflects and adds the fog's own colour in proportion to the light it stops (applyFog is
+// affine in the colour: mix(fog, rgb, f)).
+std::string fogFinish(const bubble::Features& f) {
+  if (f.shading == bubble::Shading::kPaper) return "  color.rgb = applyFog(color.rgb, vWorld);\n";
+  return "  vec3 fogged0 = applyFog(vec3(0.0), vWorld);\n"
+         "  color.rgb = color.rgb * (applyFog(vec3(1.0), vWorld) - fogged0) + color.a * fogged0;\n";
+}
+
 }  // namespace
 
 std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
   const Bubble& b = *f.scene.bubble;
   const bubble::Features& features = b.features;
+  const bool film = features.shading == bubble::Shading::kFilm;
   Texture environment;
-  if (features.reflection || features.refraction)
+  if (film || features.reflection || features.refraction)
     if (auto e = environmentCube(gpu, f, environment)) return e;
   bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
-                                            f.fog ? "  color.rgb = applyFog(color.rgb, vWorld);\n" : "");
+                                            f.fog ? fogFinish(features) : "");
   auto program = gpu.program(programKey(features) + f.fogKey, src.vertex, src.fragment);
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
   setUniforms(p, b, f);
-  if (environment.id) environment.bind(0), p.set("uEnvironment", 0);
-  Texture flowOwned, thinFilm;
-  if (features.textureFlow) gpu.flowTexture(b, flowOwned).bind(1), p.set("uFlowTexture", 1);
-  if (features.iridescence) {
+  // Made first, bound after: making a texture binds it to the active unit.
+  Texture flowOwned, thinFilm, thickness;
+  if (film || features.iridescence)
     thinFilm =
         texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
-    thinFilm.bind(2), p.set("uThinFilm", 2);
+  if (film && features.thickness) {  // R16F filters everywhere (R32F needs an extension)
+    auto field = bubble::thicknessField(b.params, b.film, b.time);
+    if (!field.ok()) return field.error();
+    const bubble::ThicknessField& t = field.value();
+    thickness = texture2D(t.width, t.height, GL_R16F, GL_RED, GL_FLOAT, t.nm.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   }
+  const Texture* flow = !film && features.textureFlow ? &gpu.flowTexture(b, flowOwned) : nullptr;
+  if (environment.id) environment.bind(0), p.set("uEnvironment", 0);
+  if (flow) flow->bind(1), p.set("uFlowTexture", 1);
+  if (thinFilm.id) thinFilm.bind(2), p.set("uThinFilm", 2);
+  if (thickness.id) thickness.bind(3), p.set("uThicknessField", 3);
   Vertices mesh(interleaved(b.mesh), {3, 3, 2}, &b.mesh.indices);
-  drawNearSide(GLsizei(b.mesh.indices.size()));
+  drawMesh(features, GLsizei(b.mesh.indices.size()));
   glBindVertexArray(gpu.emptyVao);
-  f.frame.passes.push_back(f.scene.fog ? "bubble+fog" : "bubble");
+  f.frame.passes.push_back(std::string(film ? "bubble-film" : "bubble") + (f.scene.fog ? "+fog" : ""));
   return std::nullopt;
 }
 

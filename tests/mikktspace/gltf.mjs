@@ -219,16 +219,24 @@ for (const [name, glb] of models) await written(name, new Uint8Array(glb));
   }
 }
 
-// The bubble: as a whole GLB, and its mesh frames with /v1/tangents' convention.
-for (const iridescence of [true, false]) {
+// The bubble: as a whole GLB (the paper model with and without iridescence; the film model
+// with its thickness texture), and its mesh frames with /v1/tangents' convention.
+for (const [name, request, iridescent, texture] of [
+  ['paper, iridescence true', { shading: 'paper', features: { iridescence: true } }, true, false],
+  ['paper, iridescence false', { shading: 'paper', features: { iridescence: false } }, false, false],
+  ['film with thickness texture', {}, true, true],
+]) {
   const res = await fetch(`${base}/v1/bubble`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                                 body: JSON.stringify({ format: 'glb', time: 2, mesh: { level: 3 }, features: { iridescence } }) });
+                                                 body: JSON.stringify({ format: 'glb', time: 2, mesh: { level: 3 }, ...request }) });
   const bytes = new Uint8Array(await res.arrayBuffer());
-  if (!check(res.status === 200 && res.headers.get('Content-Type') === 'model/gltf-binary', `bubble GLB (iridescence ${iridescence}): 200 model/gltf-binary`, res.status)) continue;
+  if (!check(res.status === 200 && res.headers.get('Content-Type') === 'model/gltf-binary', `bubble GLB (${name}): 200 model/gltf-binary`, res.status)) continue;
   const v = await issues(bytes);
-  check(v.errors === 0 && v.warnings === 0, `bubble GLB (iridescence ${iridescence}): validator finds 0 errors, 0 warnings`, v.messages);
+  check(v.errors === 0 && v.warnings === 0, `bubble GLB (${name}): validator finds 0 errors, 0 warnings`, v.messages);
   const { doc } = parseGlb(bytes);
-  check(('KHR_materials_iridescence' in doc.materials[0].extensions) === iridescence, `bubble GLB (iridescence ${iridescence}): iridescence extension present exactly when on`);
+  const ext = doc.materials[0].extensions.KHR_materials_iridescence;
+  check(Boolean(ext) === iridescent, `bubble GLB (${name}): iridescence extension present exactly when on`);
+  check(Boolean(ext && ext.iridescenceThicknessTexture) === texture && (!texture || (doc.images || []).length === 1),
+        `bubble GLB (${name}): thickness texture ${texture ? 'embedded as a PNG' : 'absent'}`);
 }
 {
   const post = async (route, body) => (await fetch(`${base}${route}`, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) })).json();

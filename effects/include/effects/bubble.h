@@ -30,18 +30,39 @@
 
 namespace effects::bubble {
 
-struct Params {
-  double n1 = 1.0;               // outside (air)
-  double n2 = 1.33;              // film (water)
-  double deltaSpeed = 2.0;       // wobble angular speed, rad/s (eqn 11)
-  double betaSpeed = 0.4;        // texture-flow angular speed, rad/s (eqn 9)
-  double rimPower = 2.8;         // eqn 10
-  double muSpeed = 0.05;         // film drains: alpha = saturate(muSpeed t) (eqn 3), 1/s
-  double wobbleAmplitude = 1.0;  // eqn 11's sin() term is scaled by this (paper: 1); <= 1, as
-                                 // a larger one folds the surface
+// Eqn 11 moves x by a sin(phase + k x): its Jacobian is diagonal, 1 + a k cos(...), and the
+// surface folds where it reaches 0 (a k >= 1). The paper's literal wobble (a = 1, k = 1 per
+// object unit) does: on the unit sphere at t = 7 it squashes the bubble into a sliver.
+//   kRelative (default): a is a fraction of the radius and k radians per radius, so the shape
+//     is the same at every size: x += R a (sin(phase + k x/R), cos(phase + k y/R), sin(...)).
+//   kPaper: eqn 11's form in object units (x += a sin(phase + k x) ...), the paper's k = 1.
+// Both keep a k <= kMaxWobbleStretch (the surface stretches by at most 1 +- a k); a request
+// beyond it is refused (422 naming wobbleAmplitude), never clamped.
+enum class WobbleVariant { kRelative, kPaper };
+struct WobbleShape {
+  double amplitude, frequency;
 };
-// Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; amplitude [0, 1e6].
+inline constexpr WobbleShape kRelativeWobble{0.03, 3.0};  // 3 % of the radius, 3 rad per radius
+inline constexpr WobbleShape kPaperWobble{0.5, 1.0};      // the paper's k; its a = 1 folds, so 0.5
+inline constexpr double kMaxWobbleStretch = 0.5;          // bound on a k
+inline constexpr double kMaxWobbleFrequency = 64;         // rad per radius (or object unit)
+
+struct Params {
+  double n1 = 1.0;          // outside (air)
+  double n2 = 1.33;         // film (water)
+  double deltaSpeed = 2.0;  // wobble angular speed, rad/s (eqn 11)
+  double betaSpeed = 0.4;   // texture-flow angular speed, rad/s (eqn 9)
+  double rimPower = 2.8;    // eqn 10
+  double muSpeed = 0.05;    // film drains: alpha = saturate(muSpeed t) (eqn 3), 1/s
+  WobbleVariant wobbleVariant = WobbleVariant::kRelative;
+  double wobbleAmplitude = kRelativeWobble.amplitude;  // of the variant's unit (see above)
+  double wobbleFrequency = kRelativeWobble.frequency;
+};
+// Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; wobble amplitude
+// >= 0, frequency in [0, kMaxWobbleFrequency], amplitude x frequency <= kMaxWobbleStretch.
 std::optional<Error> validate(const Params& p);
+// The defaults of a wobble variant (what a request that names the variant alone gets).
+WobbleShape wobbleDefaults(WobbleVariant v);
 
 // Eqn 3: alpha = saturate(muSpeed t); top = lerp(1, 0.1, alpha), bottom = lerp(0.1, 1, alpha).
 struct Film {
@@ -65,11 +86,48 @@ double rim(const Params& p, double gammaOut);  // eqn 10, in [0, 1]
 // omega t mod 2 pi in [0, 2 pi), computed in long double.
 double reducedPhase(double omega, double t);
 glm::dvec2 flowOffset(const Params& p, double t);                                // eqn 9: (sin bt, cos bt)
-glm::dvec3 wobble(const Params& p, const glm::dvec3& x, double t);               // eqn 11
-// Whether a sphere of `radius` keeps its shape under the wobble in float32 (radius >= 1e-3 x
-// wobbleAmplitude); kUnsatisfiable naming /radius otherwise.
+// The wobble of a sphere of `radius` in object units: x += amplitude sin(phase + frequency x)
+// (what the vertex shader's uWobbleAmplitude and uWobbleFrequency hold).
+WobbleShape wobbleInObject(const Params& p, double radius);
+glm::dvec3 wobble(const Params& p, const glm::dvec3& x, double t, double radius);  // eqn 11
+// Whether a sphere of `radius` keeps its shape under the paper's wobble in float32 (radius >=
+// 1e-3 x amplitude in object units; the relative wobble always does); kUnsatisfiable naming
+// /radius otherwise.
 std::optional<Error> wobbleFits(const Params& p, double radius);
 glm::dvec3 moveTowards(const glm::dvec3& from, const glm::dvec3& to, double s);  // lerp, s clamped to [0, 1]
+
+// ---- film thickness ---------------------------------------------------------------------------
+// The film's thickness over the sphere (beyond seed 000; docs/effects.md section 3.3).
+// Drainage: h = H(t) sqrt(s), s = (1 - y) / 2 the depth below the top in object space (y up):
+// Mysels' profile of a vertical film draining under gravity, thin at the top, thick at the
+// bottom; H(t) = lerp(bottomStartNm, bottomEndNm, alpha), alpha = saturate(muSpeed t) of eqn 3,
+// the paper's drain as the first-order term. Swirl: a divergence-free flow on the sphere,
+// v = x cross grad psi with psi a sum of seeded sines drifting at swirlSpeed; the film at a
+// point is the drainage profile where it was `swirl` flow-seconds ago (traced back through the
+// flow), so bands of thickness curl around without creating or losing film.
+struct ThicknessOptions {
+  uint64_t seed = 1;
+  double bottomStartNm = 1000;   // bottom thickness of a young bubble (t = 0)
+  double bottomEndNm = 300;      // ... once drained (alpha = 1)
+  double swirl = 0.8;            // how far the flow carries the film, radians on the unit sphere
+  double swirlSpeed = 0.25;      // how fast the flow pattern drifts, rad/s
+  int width = 256, height = 128;  // texture: u = atan2(z, x) / 2 pi + 0.5 (REPEAT), v = 0 at y = -1
+};
+// Fields "/seed", "/bottomStartNm", "/bottomEndNm" in [0, 1e5], "/swirl" in [0, 10],
+// "/swirlSpeed" in [0, 1e6], "/width" in [4, 4096], "/height" in [2, 4096].
+std::optional<Error> validate(const ThicknessOptions& o);
+// The exact thickness in nm at a point of the unit sphere (normalised; zero -> +y) at time t.
+double thicknessAt(const Params& p, const ThicknessOptions& o, const glm::dvec3& unitPoint, double t);
+// Without the field, the whole film takes the drainage profile's thickness at the equator.
+double equatorThickness(const Params& p, const ThicknessOptions& o, double t);
+struct ThicknessField {
+  int width = 0, height = 0;
+  std::vector<float> nm;  // row-major, row 0 at v = 0 (the bottom), texel centres
+  double meanErrorNm = 0, maxErrorNm = 0;  // bilinear lookup against thicknessAt between texels
+  Stats stats;
+};
+Result<ThicknessField> thicknessField(const Params& p, const ThicknessOptions& o, double t,
+                                      Parallel* parallel = nullptr);
 
 // ---- mesh -----------------------------------------------------------------------------------
 struct MeshOptions {
@@ -93,19 +151,47 @@ struct Mesh {
 Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 
 // ---- shaders ----------------------------------------------------------------------------------
+// Two shading models (docs/effects.md section 3.4):
+//   kFilm (default): a soap film. Per fragment, the film's reflectance R (the thin-film table
+//     at the fragment's thickness and |cos theta|: Airy, s and p, CIE) weights what the mirror
+//     direction sees (the environment, plus each light's highlight); the light behind passes
+//     through weighted 1 - R, as premultiplied alpha: the output is (R * reflected, mean R),
+//     blended with (ONE, ONE_MINUS_SRC_ALPHA). Back faces see the film from inside (normal
+//     flipped by gl_FrontFacing): draw them first, then the front faces.
+//   kPaper: seed 000's eqns 3-10 (final vector lookup, rim alpha, texture flow), straight alpha
+//     blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA); iridescence adds the table's colour.
+enum class Shading { kFilm, kPaper };
+inline constexpr int kMaxLights = 4;
 struct Features {
+  // The paper model's.
   bool reflection = true, refraction = true, rim = true, textureFlow = true, wobble = true, iridescence = false;
+  // The film model's: thickness from the drainage/swirl texture (else one thickness for the
+  // whole film), back faces, light highlights.
+  bool thickness = true, backFace = true, highlight = true;
+  Shading shading = Shading::kFilm;
 };
 enum class Glsl { kEs300, kCore330 };
 struct ShaderSource {
   std::string vertex, fragment;
-  std::vector<std::string> uniforms;  // every uniform the two stages declare
+  std::vector<std::string> uniforms;    // every uniform the two stages declare
+  std::vector<std::string> attributes;  // at locations 0, 1, ...
 };
 // A renderer may splice its own code into the fragment stage: `fragmentPrelude` goes after
-// the declarations, `fragmentFinish` runs just before the write and may change `color`
-// (vec4, straight alpha); both see vWorld (world position).
+// the declarations, `fragmentFinish` runs just before the write and may change `color` (vec4:
+// straight alpha in the paper model, premultiplied in the film model); both see vWorld.
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
                     const std::string& fragmentFinish = "");
+
+// A directional light for the film's highlights: towards the light, its radiance, and the
+// angular radius (degrees) at which its highlight falls to half.
+struct Light {
+  glm::dvec3 direction{0.5, 0.8, 0.6};
+  glm::dvec3 color{1.0, 0.97, 0.92};
+  double intensity = 6.0;
+  double sizeDegrees = 1.5;
+};
+// The exponent n of the highlight lobe max(0, r . l)^n that halves at `sizeDegrees`.
+double highlightSharpness(const Light& l);
 
 // ---- thin film ----------------------------------------------------------------------------
 // Reflectance of an air/film/air film (Airy), mean of s and p, at wavelength `nm`.

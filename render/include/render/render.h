@@ -104,8 +104,9 @@ struct Fog {
 };
 inline constexpr size_t kMaxFogRegions = 16;
 
-// Seed 000's bubble with effectd's shader (bubble::shader) for `features`; wobble runs in
-// the vertex shader, so the mesh is the undisturbed icosphere of `radius` around `center`.
+// The bubble with effectd's shader (bubble::shader) for `features` (the soap film, or seed
+// 000's model); wobble runs in the vertex shader, so the mesh is the undisturbed icosphere of
+// `radius` around `center`.
 struct Bubble {
   bubble::Params params;
   bubble::Features features;
@@ -113,8 +114,12 @@ struct Bubble {
   glm::dvec3 center{0, 0, 0};
   double time = 0;  // seconds (eqns 3, 9, 11)
   glm::dvec4 baseColor{1, 1, 1, 1};
-  std::vector<float> thinFilm;  // iridescence: RGB table (bubble::ThinFilmTable::rgb)
+  double radius = 1;  // of the mesh, object units (the wobble's unit)
+  std::vector<float> thinFilm;  // film model, or iridescence: RGB table (bubble::ThinFilmTable::rgb)
   int thinFilmWidth = 0, thinFilmHeight = 0;
+  glm::dvec2 thinFilmRangeNm{0, 1000};  // thickness at the table's first and last column
+  bubble::ThicknessOptions film;        // film model: the thickness field, computed per frame at `time`
+  std::vector<bubble::Light> lights;    // film model with features.highlight, at most kMaxLights
   Image flowTexture;  // eqn 9's texture; empty = a generated soft swirl
 };
 
