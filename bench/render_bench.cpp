@@ -1,5 +1,6 @@
 // 512x512 render latency on whatever EGL offers (llvmpipe without a GPU), p50 and p99, for
-// lightning only, fog only, bubble only and all three. Two columns: the frame itself (GPU
+// lightning only, fog only, bubble only and all three, then the bubble's shading variants (the
+// paper's model, + its film table; the film front only, + the far side, + highlights). Two columns: the frame itself (GPU
 // passes + read-back, variants already compiled) and the whole request path (scene building:
 // bolt growth, icosphere, thin-film table; the frame; PNG encoding).
 //   build/bench/render_bench [iterations=40]
@@ -22,8 +23,7 @@ const json kLightning = {
     {"grid", {{"width", 128}, {"height", 128}}}, {"start", {64, 0}}, {"targets", {{64, 127}}}, {"seed", 7}};
 const json kFog = {
     {"fog", {{"fogType", "HEIGHT"}, {"color", {0.5, 0.55, 0.6}}, {"density", 0.08}, {"heightFalloff", 0.5}}}};
-const json kBubble = {
-    {"features", {{"iridescence", true}}}, {"mesh", {{"level", 4}}}, {"params", {{"wobbleAmplitude", 0.03}}}};
+const json kBubble = {{"mesh", {{"level", 4}}}};
 const json kQuads = {{{"center", {0, -1, -10}}, {"normal", {0, 1, 0}}, {"up", {0, 0, -1}}, {"size", {40, 30}}},
                      {{"center", {-3, 0.5, -6}}, {"size", {1.5, 3}}}};
 
@@ -40,6 +40,33 @@ json scene(bool lightning, bool fog, bool bubble) {
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, size_t(p * double(v.size() - 1) + 0.5))];
+}
+
+// Renders `body` iterations + 1 times as a request would (the first, which compiles the
+// variants, not counted) and prints one row; false when the renderer refuses.
+bool measure(rd::Renderer& renderer, const effectd::Config& config, const char* name, const json& body,
+             int iterations) {
+  std::vector<double> frame, request;
+  std::string passes;
+  for (int i = 0; i <= iterations; ++i) {
+    effects::Stopwatch watch;
+    rd::Scene s = effectd::buildScene(body, effectd::RequestContext{"bench", config});
+    auto f = renderer.render(s);
+    if (!f.ok()) {
+      std::fprintf(stderr, "%s: %s\n", name, f.error().message.c_str());
+      return false;
+    }
+    auto png = rd::encodePng(f.value().image, 8);
+    if (i == 0) {
+      passes = f.value().passList();
+      continue;
+    }
+    frame.push_back(f.value().ms);
+    request.push_back(watch.ms());
+  }
+  std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", name, percentile(frame, 0.5),
+              percentile(frame, 0.99), percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
+  return true;
 }
 
 }  // namespace
@@ -61,27 +88,28 @@ int main(int argc, char** argv) {
   };
   for (const Case& c : {Case{"lightning only", true, false, false}, Case{"fog only", false, true, false},
                         Case{"bubble only", false, false, true}, Case{"all three", true, true, true}}) {
-    const json body = scene(c.lightning, c.fog, c.bubble);
-    std::vector<double> frame, request;
-    std::string passes;
-    for (int i = 0; i <= iterations; ++i) {
-      effects::Stopwatch watch;
-      rd::Scene s = effectd::buildScene(body, effectd::RequestContext{"bench", config});
-      auto f = renderer.value()->render(s);
-      if (!f.ok()) {
-        std::fprintf(stderr, "%s: %s\n", c.name, f.error().message.c_str());
-        return 1;
-      }
-      auto png = rd::encodePng(f.value().image, 8);
-      if (i == 0) {  // the first frame compiles the variants: not counted
-        passes = f.value().passList();
-        continue;
-      }
-      frame.push_back(f.value().ms);
-      request.push_back(watch.ms());
-    }
-    std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", c.name, percentile(frame, 0.5),
-                percentile(frame, 0.99), percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
+    if (!measure(*renderer.value(), config, c.name, scene(c.lightning, c.fog, c.bubble), iterations)) return 1;
+  }
+  // The bubble's shading variants alone, each building its scene as a request does; the film's
+  // frames include its thickness texture (128 x 64 by default), recomputed each frame.
+  struct Variant {
+    const char* name;
+    json bubble;
+  };
+  const json film = {{"mesh", {{"level", 4}}}};
+  auto with = [&](json b, const json& extra) {
+    b.update(extra);
+    return b;
+  };
+  for (const Variant& v :
+       {Variant{"paper", with(film, {{"shading", "paper"}})},
+        Variant{"paper+table", with(film, {{"shading", "paper"}, {"features", {{"iridescence", true}}}})},
+        Variant{"film front", with(film, {{"features", {{"backFace", false}, {"highlight", false}}}})},
+        Variant{"film +back", with(film, {{"features", {{"highlight", false}}}})},
+        Variant{"film +highlight", film}}) {
+    json body = scene(false, false, false);
+    body["bubble"] = v.bubble;
+    if (!measure(*renderer.value(), config, v.name, body, iterations)) return 1;
   }
   std::printf("\ntarget: all three, request p50 <= 150 ms on the 2-core CI-class machine\n");
   return 0;

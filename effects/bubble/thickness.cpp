@@ -14,7 +14,7 @@ namespace {
 using glm::dvec3;
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kModes = 6;        // sines in the stream function
-constexpr int kTraceSteps = 12;  // midpoint steps back through the flow
+constexpr int kTraceSteps = 6;  // midpoint steps back through the flow: 0.6 nm from 48 steps
 
 // psi(x, t) = sum a_m sin(w_m . x + phase_m(t)): smooth, seeded; its surface curl is the flow.
 struct Stream {
@@ -112,6 +112,9 @@ Result<ThicknessField> thicknessField(const Params& p, const ThicknessOptions& o
             float(traced(p, o, s, pointOf((i + 0.5) / o.width, (j + 0.5) / o.height), t));
   });
   f.stats.elapsedMs = watch.ms();
+  f.stats.method = "drainage+swirl";
+  f.stats.counters = {{"width", double(o.width)}, {"height", double(o.height)}};
+  if (!o.measureError) return f;
   // The texture's error: a bilinear lookup (REPEAT in u, clamped in v) between texel centres
   // against the exact thickness there, on a 64 x 32 sub-grid offset from the centres.
   auto at = [&](int i, int j) {
@@ -133,11 +136,10 @@ Result<ThicknessField> thicknessField(const Params& p, const ThicknessOptions& o
       sum += e, f.maxErrorNm = std::max(f.maxErrorNm, e), ++n;
     }
   f.meanErrorNm = sum / n;
-  f.stats.method = "drainage+swirl";
   f.stats.error = f.maxErrorNm;
   f.stats.errorMetric = "max |bilinear texture - exact| nm, 64 x 32 points between texels";
   f.stats.reference = "thickness traced per point";
-  f.stats.counters = {{"width", double(o.width)}, {"height", double(o.height)}, {"meanErrorNm", f.meanErrorNm}};
+  f.stats.counters["meanErrorNm"] = f.meanErrorNm;
   return f;
 }
 

@@ -147,7 +147,9 @@ std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
     thinFilm =
         texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
   if (film && features.thickness) {  // R16F filters everywhere (R32F needs an extension)
-    auto field = bubble::thicknessField(b.params, b.film, b.time);
+    bubble::ThicknessOptions o = b.film;
+    o.measureError = false;  // the request's answer measures it; a frame only draws
+    auto field = bubble::thicknessField(b.params, o, b.time);
     if (!field.ok()) return field.error();
     const bubble::ThicknessField& t = field.value();
     thickness = texture2D(t.width, t.height, GL_R16F, GL_RED, GL_FLOAT, t.nm.data());

@@ -111,7 +111,8 @@ struct ThicknessOptions {
   double bottomEndNm = 300;      // ... once drained (alpha = 1)
   double swirl = 0.8;            // how far the flow carries the film, radians on the unit sphere
   double swirlSpeed = 0.25;      // how fast the flow pattern drifts, rad/s
-  int width = 256, height = 128;  // texture: u = atan2(z, x) / 2 pi + 0.5 (REPEAT), v = 0 at y = -1
+  int width = 128, height = 64;  // texture: u = atan2(z, x) / 2 pi + 0.5 (REPEAT), v = 0 at y = -1
+  bool measureError = true;      // the bilinear lookup against thicknessAt between texels
 };
 // Fields "/seed", "/bottomStartNm", "/bottomEndNm" in [0, 1e5], "/swirl" in [0, 10],
 // "/swirlSpeed" in [0, 1e6], "/width" in [4, 4096], "/height" in [2, 4096].
