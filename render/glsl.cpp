@@ -108,8 +108,20 @@ std::string backgroundFragment(Background::Kind kind) {
          "void main() { fragColor = backgroundAt(vUv); }\n";
 }
 
-std::string environmentFragment(Background::Kind kind) {
+std::string environmentFragment(Background::Kind kind, bool sky) {
   // GL cube-map face conventions: (s, t) in [-1, 1] on the face -> direction.
+  if (sky)
+    return std::string(kFragmentHeader) +
+           "in vec2 vUv;\nout vec4 fragColor;\n"
+           "uniform int uFace;\nuniform vec3 uZenith;\nuniform vec3 uHorizon;\nuniform vec3 uGround;\n"
+           "void main() {\n"
+           "  float s = 2.0 * vUv.x - 1.0, t = 2.0 * vUv.y - 1.0;\n"
+           "  vec3 dir = normalize(uFace == 0 ? vec3(1.0, -t, -s) : uFace == 1 ? vec3(-1.0, -t, s)\n"
+           "           : uFace == 2 ? vec3(s, 1.0, t) : uFace == 3 ? vec3(s, -1.0, -t)\n"
+           "           : uFace == 4 ? vec3(s, -t, 1.0) : vec3(-s, -t, -1.0));\n"
+           "  vec3 c = dir.y >= 0.0 ? mix(uHorizon, uZenith, sqrt(dir.y))\n"
+           "                        : mix(uHorizon, uGround, sqrt(min(-4.0 * dir.y, 1.0)));  // render::skyAt\n"
+           "  fragColor = vec4(c, 1.0);\n}\n";
   return std::string(kFragmentHeader) + "in vec2 vUv;\nout vec4 fragColor;\n" + backgroundGlsl(kind) +
          "uniform int uFace;\n"
          "uniform mat3 uView;        // world -> view rotation\n"

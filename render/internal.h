@@ -36,7 +36,8 @@ std::string fogGlsl(const FogVariant& v);
 std::string backgroundGlsl(Background::Kind kind);  // vec4 backgroundAt(vec2 uv) (premultiplied)
 std::string screenVertex();                         // full-screen triangle, no attributes
 std::string backgroundFragment(Background::Kind kind);
-std::string environmentFragment(Background::Kind kind);  // one cube face: direction -> backdrop
+// One cube face: direction -> the backdrop, or the sky (render::skyAt) when `sky`.
+std::string environmentFragment(Background::Kind kind, bool sky);
 std::string waveVertex();
 std::string waveFragment();
 std::string quadVertex();

@@ -95,7 +95,7 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   std::vector<Pass> passes = {backgroundPass};
   if (scene.wave) passes.push_back(surfaceWavePass);
   if (!scene.quads.empty()) passes.push_back(quadsPass);
-  if (scene.bubble) passes.push_back(bubblePass);
+  if (!scene.bubbles.empty()) passes.push_back(bubblePass);
   if (scene.lightning && !scene.lightning->polylines.empty()) passes.push_back(lightningPass);
   if (scene.blend && scene.blend->amount > 0) passes.push_back(cameraBlendPass);
   for (Pass pass : passes)

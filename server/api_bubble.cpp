@@ -121,7 +121,8 @@ json uniforms(const bb::Params& p, const bb::ThicknessOptions& film, const std::
               {"uRimPower", p.rimPower},
               {"uThickness", mu.top},
               {"uThicknessRange", thicknessRange},
-              {"uThicknessNm", bb::equatorThickness(p, film, t)}};
+              {"uThicknessNm", bb::equatorThickness(p, film, t)},
+              {"uPass", 0}};
   json directions = json::array(), radiances = json::array(), sharpness = json::array();
   for (size_t i = 0; i < lights.size() && i < size_t(bb::kMaxLights); ++i) {
     const glm::dvec3 d = glm::normalize(lights[i].direction), r = lights[i].color * lights[i].intensity;
@@ -237,10 +238,13 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
                      {"fragment", s.fragment},
                      {"uniforms", s.uniforms},
                      {"attributes", s.attributes},
-                     {"blend", film ? "premultiplied: ONE, ONE_MINUS_SRC_ALPHA" : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
-                     {"draw", film && features.backFace
-                                  ? "back faces (cull front), then front faces (cull back); depth test, no depth write"
-                                  : "front faces (cull back); depth test, no depth write"}};
+                     {"blend", film ? "uPass 0: ZERO, SRC_COLOR; uPass 1: ONE, ONE (or uPass 2 alone: ONE, "
+                                      "ONE_MINUS_SRC_ALPHA, grey transmission)"
+                                    : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
+                     {"draw", std::string(film && features.backFace ? "back faces (cull front), then front faces (cull "
+                                                                      "back)"
+                                                                    : "front faces (cull back)") +
+                                  (film ? ", each with uPass 0 then 1" : "") + "; depth test, no depth write"}};
   }
 }
 

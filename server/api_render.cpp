@@ -151,13 +151,14 @@ rd::Lightning sceneLightning(const json& body, const Config& config, Animation* 
   return l;
 }
 
-// The bubble: its mesh and thin-film table computed once here, wobbled by the shader.
-rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double sceneTime) {
+// A bubble (its request `bj` at pointer `at`, its style at `styleAt`): mesh and thin-film
+// table computed once here, wobbled by the shader.
+rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at, const std::string& styleAt,
+                       const json& scene, const RequestContext& ctx, double sceneTime) {
   const Config& config = ctx.config;
   rd::Bubble b;
-  const json& bj = body["bubble"];
   const double t = bj.value("time", sceneTime);
-  b.params = parseBubbleParams(bj.value("params", json::object()), "/bubble/params");
+  b.params = parseBubbleParams(bj.value("params", json::object()), at + "/params");
   b.features = parseBubbleFeatures(bj);
   const bool film = b.features.shading == bb::Shading::kFilm;
   bb::MeshOptions o;
@@ -170,34 +171,33 @@ rd::Bubble sceneBubble(const json& body, const RequestContext& ctx, double scene
   auto mesh = bb::icosphere(b.params, o);
   if (!mesh.ok()) {
     effects::Error e = mesh.error();
-    throwError(e, e.field == "/level" || e.field == "/radius" ? "/bubble/mesh" : "/bubble");
+    throwError(e, e.field == "/level" || e.field == "/radius" ? at + "/mesh" : at);
   }
   if (b.features.wobble)  // the shader wobbles what icosphere() left still
-    if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, "/bubble/mesh");
+    if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, at + "/mesh");
   b.mesh = std::move(mesh.value());
   b.radius = o.radius;
   if (film || b.features.iridescence) {
-    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, "/bubble");
+    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, at);
     tf.measureError = false;
-    auto table = cachedThinFilm(tf, "/bubble");
+    auto table = cachedThinFilm(tf, at);
     b.thinFilm = table->rgb;
     b.thinFilmWidth = table->width;
     b.thinFilmHeight = table->height;
     b.thinFilmRangeNm = {tf.thicknessMinNm, tf.thicknessMaxNm};
   }
   if (film) {
-    b.film = parseFilm(bj, config, "/bubble");
+    b.film = parseFilm(bj, config, at);
     // The scene's lights light every effect; a bubble's own serve when the scene has none.
-    b.lights = body.contains("lights") ? parseLights(body, "") : parseLights(bj, "/bubble");
+    b.lights = scene.contains("lights") ? parseLights(scene, "") : parseLights(bj, at);
   }
   if (bj.contains("motion")) {
     const json& mo = bj["motion"];
     b.center = bb::moveTowards(toVec3(mo["from"]), toVec3(mo["to"]), mo["s"].get<double>());
   }
-  const json st = body.value("bubbleStyle", json::object());
-  if (st.contains("center") && !bj.contains("motion")) b.center = toVec3(st["center"]);
-  if (st.contains("baseColor")) b.baseColor = rgba(st["baseColor"]);
-  if (st.contains("flowTexture")) b.flowTexture = image(st["flowTexture"], "/bubbleStyle/flowTexture", config);
+  if (style.contains("center") && !bj.contains("motion")) b.center = toVec3(style["center"]);
+  if (style.contains("baseColor")) b.baseColor = rgba(style["baseColor"]);
+  if (style.contains("flowTexture")) b.flowTexture = image(style["flowTexture"], styleAt + "/flowTexture", config);
   b.time = t;
   return b;
 }
@@ -239,17 +239,34 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
   if (animation) {
     animation->time = s.time;
     if (body.contains("frames")) animation->frames = parseFrames(body["frames"], s, config);
-    if (body.contains("bubble") && body["bubble"].contains("time")) animation->bubbleTime = body["bubble"]["time"].get<double>();
   }
   parseCamera(body, s);
   if (body.contains("background")) parseBackground(body["background"], config, s);
+  if (body.contains("environment")) {
+    const json& e = body["environment"];
+    rd::Environment env;
+    if (e.contains("zenith")) env.zenith = toVec3(e["zenith"]);
+    if (e.contains("horizon")) env.horizon = toVec3(e["horizon"]);
+    if (e.contains("ground")) env.ground = toVec3(e["ground"]);
+    s.environment = env;
+  }
   if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"]);
   if (body.contains("cameraBlend"))
     s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
   if (body.contains("quads")) parseQuads(body["quads"], s);
   if (body.contains("fog")) s.fog = parseSceneFog(body["fog"]);
   if (body.contains("lightning")) s.lightning = sceneLightning(body, config, animation);
-  if (body.contains("bubble")) s.bubble = sceneBubble(body, ctx, s.time);
+  if (body.contains("bubble"))
+    s.bubbles.push_back(sceneBubble(body["bubble"], body.value("bubbleStyle", json::object()), "/bubble",
+                                    "/bubbleStyle", body, ctx, s.time));
+  if (body.contains("bubbles"))
+    for (size_t i = 0; i < body["bubbles"].size(); ++i) {
+      const json& item = body["bubbles"][i];
+      const std::string at = "/bubbles/" + std::to_string(i);
+      s.bubbles.push_back(sceneBubble(item["bubble"], item, at + "/bubble", at, body, ctx, s.time));
+    }
+  if (animation)
+    for (const rd::Bubble& b : s.bubbles) animation->bubbleTimes.push_back(b.time);
   if (computeMs) *computeMs = watch.ms();
   return s;
 }
@@ -260,21 +277,55 @@ JsonReply handleScene(const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = "scene";
   json out = json::object();
-  auto add = [&](const char* name, JsonReply (*handler)(const json&, const RequestContext&)) {
-    if (!body.contains(name)) return;
-    RequestContext part = ctx;  // the part's problems name fields under "/<name>"
-    part.at = std::string("/") + name;
-    JsonReply r = handler(body[name], part);
+  // One part's answer; its problems name fields under `at`.
+  auto answer = [&](const json& part, const std::string& at, const char* endpoint,
+                    JsonReply (*handler)(const json&, const RequestContext&)) {
+    RequestContext c = ctx;
+    c.at = at;
+    JsonReply r = handler(part, c);
     if (!r.binary.empty())  // e.g. bubble "format": "glb"
-      throw fieldError(422, part.at + "/format",
-                       "a scene answers JSON: ask /v1/" + std::string(name) + " itself for this binary format");
-    out[name] = std::move(r.body);
+      throw fieldError(422, at + "/format",
+                       "a scene answers JSON: ask /v1/" + std::string(endpoint) + " itself for this binary format");
     reply.computeMs += r.computeMs;
+    return std::move(r.body);
+  };
+  auto add = [&](const char* name, JsonReply (*handler)(const json&, const RequestContext&)) {
+    if (body.contains(name)) out[name] = answer(body[name], std::string("/") + name, name, handler);
   };
   add("lightning", handleLightning);
   add("fog", handleFog);
   add("bubble", handleBubble);
+  if (body.contains("bubbles")) {
+    out["bubbles"] = json::array();
+    for (size_t i = 0; i < body["bubbles"].size(); ++i)
+      out["bubbles"].push_back(
+          answer(body["bubbles"][i]["bubble"], "/bubbles/" + std::to_string(i) + "/bubble", "bubble", handleBubble));
+  }
   reply.body = std::move(out);
+  return reply;
+}
+
+// `reference: true`: the bubble ray traced on the CPU (render::referenceRender), a still of
+// at most kMaxReferencePixels.
+JsonReply referenceReply(const json& body, const RequestContext& ctx) {
+  if (body.contains("frames")) throw fieldError(422, "/frames", "the reference is a still: leave frames out");
+  const size_t pixels = size_t(body.value("width", 512)) * size_t(body.value("height", 512));
+  if (pixels > kMaxReferencePixels)
+    throw fieldError(413, "/width",
+                     "the reference traces " + std::to_string(rd::kReferenceWavelengths) +
+                         " wavelengths per pixel: at most " + std::to_string(kMaxReferencePixels) + " pixels");
+  JsonReply reply;
+  reply.method = "reference";
+  rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+  auto r = rd::referenceRender(scene, ctx.parallel);
+  if (!r.ok()) throwError(r.error());
+  auto png = rd::encodePng(r.value().image, scene.bitDepth);
+  if (!png.ok()) throwError(png.error());
+  reply.binary = std::move(png.value());
+  reply.contentType = "image/png";
+  reply.computeMs += r.value().ms;
+  reply.headers = {{"X-Renderer", "reference: CPU ray tracing, " + std::to_string(rd::kReferenceWavelengths) +
+                                      " wavelengths"}};
   return reply;
 }
 
@@ -291,6 +342,7 @@ void addRenderEndpoints(Service& service) {
   service.addJsonEndpoint(
       "/v1/render", "scene.json",
       [pool, metrics](const json& body, const RequestContext& ctx) {
+        if (body.value("reference", false)) return referenceReply(body, ctx);
         JsonReply reply;
         reply.method = "render";
         Animation animation;

@@ -113,11 +113,14 @@ Cost sceneCost(const json& body, const Config& config) {
   if (body.contains("lightning")) c += lightningCost(body["lightning"], config);
   if (body.contains("fog")) c += fogCost(body["fog"], config);
   if (body.contains("bubble")) c += bubbleCost(body["bubble"], config);
+  if (body.contains("bubbles"))
+    for (const json& item : body["bubbles"]) c += bubbleCost(item.value("bubble", json::object()), config);
   return c;
 }
 
 Cost renderCost(const json& body, const Config& config) {
   Cost c = sceneCost(body, config);
+  c.heavy = c.heavy || body.value("reference", false);  // seconds of CPU ray tracing
   const size_t pixels =
       std::min(size_t(body.value("width", 512)) * size_t(body.value("height", 512)), config.limits.maxRenderPixels);
   // Render targets and read-back (RGBA float), the converted 8/16-bit image, the PNG; a

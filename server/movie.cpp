@@ -20,7 +20,8 @@ rd::Sequence MovieWriter::sequence() {
     const Animation& a = animation_;
     const double dt = 1.0 / a.frames.fps, offset = i * dt;
     scene.time = a.time + offset;
-    if (scene.bubble) scene.bubble->time = a.bubbleTime.value_or(a.time) + offset;
+    for (size_t k = 0; k < scene.bubbles.size() && k < a.bubbleTimes.size(); ++k)
+      scene.bubbles[k].time = a.bubbleTimes[k] + offset;
     if (scene.lightning && a.strike) {
       // The strike as an eye sees it: each vertex at its brightest moment in the frame.
       const double t = scene.time - a.strikeTime;

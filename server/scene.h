@@ -22,7 +22,7 @@ struct Frames {
 struct Animation {
   Frames frames;
   double time = 0;                   // the scene's time at frame 0
-  std::optional<double> bubbleTime;  // the bubble's own time at frame 0 (bubble.time)
+  std::vector<double> bubbleTimes;  // each bubble's own time at frame 0 (its time, else the scene's)
   double strikeTime = 0;             // scene time at which the strike's leader sets off
   std::vector<effects::lightning::Polyline> bolt;
   std::optional<effects::lightning::Timeline> strike;

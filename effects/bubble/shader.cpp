@@ -105,6 +105,9 @@ std::string paperFragment(const Features& f, Builder& fs) {
 
 // The soap film's fragment shader: reflectance per fragment, premultiplied output.
 std::string filmFragment(const Features& f, Builder& fs) {
+  fs.uniform("int", "uPass",
+             "0: the film's transmittance (blend ZERO, SRC_COLOR), then 1: its reflection (ONE, ONE); 2: both in "
+             "one pass, premultiplied, transmission grey (ONE, ONE_MINUS_SRC_ALPHA)");
   fs.uniform("vec3", "uCameraPosition", "world space");
   fs.uniform("samplerCube", "uEnvironment", "what the mirror direction sees");
   fs.uniform("sampler2D", "uThinFilm", "film reflectance: u = thickness over uThicknessRange, v = cos(theta)");
@@ -133,8 +136,10 @@ std::string filmFragment(const Features& f, Builder& fs) {
   if (f.highlight)
     body << "  for (int i = 0; i < uLightCount; ++i)\n"
             "    seen += uLightRadiance[i] * pow(max(dot(r, uLightDirection[i]), 0.0), uLightSharpness[i]);\n";
-  body << "  // premultiplied: what is behind shows through 1 - R\n"
-          "  vec4 color = vec4(R * seen, dot(R, vec3(0.2126, 0.7152, 0.0722)));\n";
+  body << "  vec4 color;\n"
+          "  if (uPass == 0) color = vec4(1.0 - R, 1.0);  // blend (ZERO, SRC_COLOR): what passes through\n"
+          "  else if (uPass == 1) color = vec4(R * seen, 0.0);  // blend (ONE, ONE): what the film reflects\n"
+          "  else color = vec4(R * seen, dot(R, vec3(0.2126, 0.7152, 0.0722)));  // one pass, grey transmission\n";
   return body.str();
 }
 

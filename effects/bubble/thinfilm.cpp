@@ -78,8 +78,8 @@ glm::dvec3 color(const Sampling& s, double ior, double d, double cosTheta) {
 
 }  // namespace
 
-double filmReflectance(double n, double d, double cosTheta, double nm) {
-  if (!(n > 1)) return 0;  // a film of air's index has no interfaces (and 0/0 at grazing incidence)
+glm::dvec2 filmReflectanceSP(double n, double d, double cosTheta, double nm) {
+  if (!(n > 1)) return {0, 0};  // a film of air's index has no interfaces (and 0/0 at grazing incidence)
   const double c1 = std::clamp(std::abs(cosTheta), 0.0, 1.0);
   const double sin1 = std::sqrt(std::max(0.0, 1 - c1 * c1));
   const double sinT = sin1 / n;  // n >= 1: never total internal reflection entering the film
@@ -87,18 +87,34 @@ double filmReflectance(double n, double d, double cosTheta, double nm) {
   const double rs = (c1 - n * ct) / (c1 + n * ct), rp = (n * c1 - ct) / (n * c1 + ct);
   const double sinHalf = std::sin(2 * kPi * n * std::max(0.0, d) * ct / nm);  // sin(delta / 2)
   const double s2 = sinHalf * sinHalf;
-  double total = 0;
-  for (double r : {rs, rp}) {
-    double R12 = r * r;
-    if (R12 >= 1) {  // grazing incidence: the interface reflects everything
-      total += 1;
-      continue;
-    }
-    double F = 4 * R12 / ((1 - R12) * (1 - R12));
-    total += F * s2 / (1 + F * s2);
-  }
-  return total / 2;
+  auto airy = [s2](double r) {
+    const double R12 = r * r;
+    if (R12 >= 1) return 1.0;  // grazing incidence: the interface reflects everything
+    const double F = 4 * R12 / ((1 - R12) * (1 - R12));
+    return F * s2 / (1 + F * s2);
+  };
+  return {airy(rs), airy(rp)};
 }
+
+double filmReflectance(double n, double d, double cosTheta, double nm) {
+  const glm::dvec2 r = filmReflectanceSP(n, d, cosTheta, nm);
+  return (r.x + r.y) / 2;
+}
+
+SpectrumToRgb::SpectrumToRgb(int wavelengths) {
+  const Sampling s = sampling(std::clamp(wavelengths, 1, 400));
+  nm_ = s.nm;
+  weight_ = s.weight;
+  white_ = s.white;
+}
+
+glm::dvec3 SpectrumToRgb::operator()(const double* values) const {
+  glm::dvec3 xyz(0);
+  for (size_t k = 0; k < nm_.size(); ++k) xyz += values[k] * weight_[k];
+  return xyzToLinearSrgb(xyz) / white_;
+}
+
+double deltaE(const glm::dvec3& a, const glm::dvec3& b) { return glm::length(lab(a) - lab(b)); }
 
 glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavelengths) {
   return color(sampling(std::clamp(wavelengths, 1, 400)), ior, thicknessNm, cosTheta);

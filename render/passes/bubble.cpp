@@ -1,6 +1,9 @@
 // The bubble: the backdrop rendered into a cube map (what the film's mirror direction and eqn
 // 8's final vector look up), then the sphere blended over the frame (the soap film: far side,
 // then near side, premultiplied; seed 000's model: the near side).
+#include <algorithm>
+
+#include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../gpu.h"
@@ -15,12 +18,19 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   for (int face = 0; face < 6; ++face)
     glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, kEnvironmentSize, kEnvironmentSize, 0, GL_RGBA,
                  GL_HALF_FLOAT, nullptr);
-  auto program =
-      gpu.program("environment:" + std::to_string(int(bg.kind)), screenVertex(), environmentFragment(bg.kind));
+  const std::optional<Environment>& sky = f.scene.environment;
+  auto program = gpu.program("environment:" + (sky ? std::string("sky") : std::to_string(int(bg.kind))),
+                             screenVertex(), environmentFragment(bg.kind, sky.has_value()));
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
-  setBackground(p, bg, &f.backgroundImage);
+  if (sky) {
+    p.set("uZenith", glm::vec3(sky->zenith));
+    p.set("uHorizon", glm::vec3(sky->horizon));
+    p.set("uGround", glm::vec3(sky->ground));
+  } else {
+    setBackground(p, bg, &f.backgroundImage);
+  }
   p.set("uView", glm::mat3(f.view.view));
   p.set("uTanHalfFov", f.view.tanHalfFov);
   GLuint fbo = 0;
@@ -92,48 +102,52 @@ std::vector<float> interleaved(const bubble::Mesh& m) {
 }
 
 // Draws the bound mesh over the frame, depth-tested without writing depth: the paper's near
-// side with straight alpha; the film premultiplied, its far side (seen through the near one)
-// first when the feature is on.
-void drawMesh(const bubble::Features& f, GLsizei indexCount) {
+// side with straight alpha; the film's far side (seen through the near one) first when the
+// feature is on, each side twice: what passes through it (multiplied), then what it reflects
+// (added).
+void drawMesh(Program& p, const bubble::Features& f, GLsizei indexCount) {
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
   glEnable(GL_BLEND);
   glEnable(GL_CULL_FACE);
-  if (f.shading == bubble::Shading::kFilm) {
-    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    if (f.backFace) {
-      glCullFace(GL_FRONT);
+  auto draw = [&](GLenum cull) {
+    glCullFace(cull);
+    if (f.shading == bubble::Shading::kPaper) {
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
       glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+      return;
     }
-  } else {
-    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  }
-  glCullFace(GL_BACK);  // eqns 4-10 are written for the surface facing the viewer
-  glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    p.set("uPass", 0);
+    glBlendFunc(GL_ZERO, GL_SRC_COLOR);
+    glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    p.set("uPass", 1);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+  };
+  if (f.shading == bubble::Shading::kFilm && f.backFace) draw(GL_FRONT);
+  draw(GL_BACK);  // eqns 4-10 are written for the surface facing the viewer
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
   glDisable(GL_DEPTH_TEST);
 }
 
-// Fog over the bubble: straight alpha mixes; premultiplied (the film) fogs the light it
-// reflects and adds the fog's own colour in proportion to the light it stops (applyFog is
-// affine in the colour: mix(fog, rgb, f)).
+// Fog over the bubble: straight alpha mixes; the film fogs the light it reflects and adds the
+// fog's own colour in proportion to the light it stops (applyFog is affine in the colour:
+// mix(fog, rgb, f)); what passes through it was fogged where it came from.
 std::string fogFinish(const bubble::Features& f) {
   if (f.shading == bubble::Shading::kPaper) return "  color.rgb = applyFog(color.rgb, vWorld);\n";
-  return "  vec3 fogged0 = applyFog(vec3(0.0), vWorld);\n"
-         "  color.rgb = color.rgb * (applyFog(vec3(1.0), vWorld) - fogged0) + color.a * fogged0;\n";
+  return "  if (uPass != 0) {\n"
+         "    vec3 fogged0 = applyFog(vec3(0.0), vWorld);\n"
+         "    color.rgb = color.rgb * (applyFog(vec3(1.0), vWorld) - fogged0) + (uPass == 1 ? R : vec3(color.a)) * "
+         "fogged0;\n"
+         "  }\n";
 }
 
-}  // namespace
-
-std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
-  const Bubble& b = *f.scene.bubble;
+// One bubble over the frame with the environment cube bound to unit 0.
+std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   const bubble::Features& features = b.features;
   const bool film = features.shading == bubble::Shading::kFilm;
-  Texture environment;
-  if (film || features.reflection || features.refraction)
-    if (auto e = environmentCube(gpu, f, environment)) return e;
   bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
                                             f.fog ? fogFinish(features) : "");
   auto program = gpu.program(programKey(features) + f.fogKey, src.vertex, src.fragment);
@@ -156,14 +170,37 @@ std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   }
   const Texture* flow = !film && features.textureFlow ? &gpu.flowTexture(b, flowOwned) : nullptr;
-  if (environment.id) environment.bind(0), p.set("uEnvironment", 0);
+  p.set("uEnvironment", 0);
   if (flow) flow->bind(1), p.set("uFlowTexture", 1);
   if (thinFilm.id) thinFilm.bind(2), p.set("uThinFilm", 2);
   if (thickness.id) thickness.bind(3), p.set("uThicknessField", 3);
   Vertices mesh(interleaved(b.mesh), {3, 3, 2}, &b.mesh.indices);
-  drawMesh(features, GLsizei(b.mesh.indices.size()));
+  drawMesh(p, features, GLsizei(b.mesh.indices.size()));
   glBindVertexArray(gpu.emptyVao);
   f.frame.passes.push_back(std::string(film ? "bubble-film" : "bubble") + (f.scene.fog ? "+fog" : ""));
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
+  bool needsEnvironment = false;
+  for (const Bubble& b : f.scene.bubbles)
+    needsEnvironment |= b.features.shading == bubble::Shading::kFilm || b.features.reflection || b.features.refraction;
+  Texture environment;  // one cube for every bubble
+  if (needsEnvironment)
+    if (auto e = environmentCube(gpu, f, environment)) return e;
+  // Far to near, so each is blended over those behind it.
+  std::vector<const Bubble*> order;
+  for (const Bubble& b : f.scene.bubbles) order.push_back(&b);
+  const glm::dvec3 eye(f.view.eye);
+  std::stable_sort(order.begin(), order.end(), [&](const Bubble* a, const Bubble* b) {
+    return glm::length(a->center - eye) > glm::length(b->center - eye);
+  });
+  for (const Bubble* b : order) {
+    if (environment.id) environment.bind(0);
+    if (auto e = drawBubble(gpu, f, *b)) return e;
+  }
   return std::nullopt;
 }
 

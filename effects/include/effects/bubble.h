@@ -156,9 +156,11 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 //   kFilm (default): a soap film. Per fragment, the film's reflectance R (the thin-film table
 //     at the fragment's thickness and |cos theta|: Airy, s and p, CIE) weights what the mirror
 //     direction sees (the environment, plus each light's highlight); the light behind passes
-//     through weighted 1 - R, as premultiplied alpha: the output is (R * reflected, mean R),
-//     blended with (ONE, ONE_MINUS_SRC_ALPHA). Back faces see the film from inside (normal
-//     flipped by gl_FrontFacing): draw them first, then the front faces.
+//     through weighted 1 - R per channel (the film absorbs nothing). Two draws per face set:
+//     uPass 0 writes 1 - R blended with (ZERO, SRC_COLOR), uPass 1 writes R * seen blended with
+//     (ONE, ONE); uPass 2 is one draw, premultiplied (R * seen, luminance of R) with (ONE,
+//     ONE_MINUS_SRC_ALPHA), for engines that cannot draw twice (its transmission is grey). Back
+//     faces see the film from inside (normal flipped by gl_FrontFacing): draw them first.
 //   kPaper: seed 000's eqns 3-10 (final vector lookup, rim alpha, texture flow), straight alpha
 //     blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA); iridescence adds the table's colour.
 enum class Shading { kFilm, kPaper };
@@ -179,7 +181,8 @@ struct ShaderSource {
 };
 // A renderer may splice its own code into the fragment stage: `fragmentPrelude` goes after
 // the declarations, `fragmentFinish` runs just before the write and may change `color` (vec4:
-// straight alpha in the paper model, premultiplied in the film model); both see vWorld.
+// straight alpha in the paper model; in the film model per uPass, with R the film's reflectance
+// in scope); both see vWorld.
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
                     const std::string& fragmentFinish = "");
 
@@ -195,8 +198,24 @@ struct Light {
 double highlightSharpness(const Light& l);
 
 // ---- thin film ----------------------------------------------------------------------------
-// Reflectance of an air/film/air film (Airy), mean of s and p, at wavelength `nm`.
+// Reflectance of an air/film/air film (Airy), mean of s and p, at wavelength `nm`; the two
+// polarisations apart (x: s, y: p). The film absorbs nothing: transmittance is 1 - R.
 double filmReflectance(double ior, double thicknessNm, double cosTheta, double nm);
+glm::dvec2 filmReflectanceSP(double ior, double thicknessNm, double cosTheta, double nm);
+// Spectra to colour as the table does it: midpoints of `wavelengths` bins over 380-780 nm,
+// weighted by D65 x CIE 1931, to linear sRGB, white-balanced (a spectrum of 1s gives (1, 1, 1)).
+class SpectrumToRgb {
+ public:
+  explicit SpectrumToRgb(int wavelengths);
+  const std::vector<double>& wavelengthsNm() const { return nm_; }
+  glm::dvec3 operator()(const double* values) const;  // one value per wavelength
+ private:
+  std::vector<double> nm_;
+  std::vector<glm::dvec3> weight_;
+  glm::dvec3 white_;
+};
+// CIE76 Delta E*ab between two linear sRGB colours (D65, white = (1, 1, 1)).
+double deltaE(const glm::dvec3& a, const glm::dvec3& b);
 // Linear sRGB reflectance colour under D65 using `wavelengths` midpoint samples over
 // 380-780 nm (white-balanced so that R = 1 gives (1, 1, 1)); 400 = the 1 nm reference.
 glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavelengths);

@@ -61,6 +61,16 @@ struct Background {
   Image image;
 };
 
+// What reflections see when the scene gives it: a sky in world directions (y up), zenith to
+// horizon to ground, instead of the backdrop (the screen's picture, mirrored behind the
+// camera). Games reflect a sky box; the backdrop is what lies behind the bubble.
+struct Environment {
+  glm::dvec3 zenith{0.25, 0.5, 0.95}, horizon{0.9, 0.93, 1.0}, ground{0.25, 0.22, 0.2};
+};
+// The sky in direction d (unit): y >= 0 mix(horizon, zenith, sqrt(y)), below mix(horizon,
+// ground, sqrt(min(-4 y, 1))); the environment pass evaluates the same in GLSL (skyGlsl).
+glm::dvec3 skyAt(const Environment& e, const glm::dvec3& d);
+
 // Seed 000 section 2.2: a quad in front of the backdrop with two normal maps scrolling in
 // different directions, lit through the quad's MikkTSpace TBN frame (seed 004), and an alpha
 // texture: "sunlight under water".
@@ -129,10 +139,11 @@ struct Scene {
   double time = 0;
   Camera camera;
   Background background;
+  std::optional<Environment> environment;  // reflections: this sky, else the backdrop
   std::optional<SurfaceWave> wave;
   std::vector<Quad> quads;
   std::optional<Fog> fog;
-  std::optional<Bubble> bubble;
+  std::vector<Bubble> bubbles;  // drawn far to near
   std::optional<Lightning> lightning;
   std::optional<CameraBlend> blend;
 };
@@ -174,6 +185,21 @@ class Renderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// A physical reference of the scene's bubble, ray traced on the CPU (reference.cpp): the
+// analytic sphere (the wobble must be off), the backdrop as the renderer sees it, and the film
+// per wavelength (400, 1 nm: Airy for s and p, at the exact traced thickness of each point):
+// the front film's reflection, the light through both films, and the far film's reflection
+// seen back through the near one; lights as in the film shader. What the shading variants are
+// measured against (docs/bubble-shading.md). A scene with anything but a backdrop and a
+// bubble is refused (kUnsatisfiable naming the field).
+struct Reference {
+  Image image;                 // opaque, straight alpha
+  std::vector<uint8_t> bubble;  // per pixel: 1 where the ray meets the bubble
+  double ms = 0;
+};
+inline constexpr int kReferenceWavelengths = 400;
+Result<Reference> referenceRender(const Scene& scene, Parallel* parallel = nullptr);
 
 // PNG bytes of `frame` (8 or 16 bits per channel, straight alpha) via OpenImageIO.
 Result<std::string> encodePng(const Image& image, int bitDepth);
