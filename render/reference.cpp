@@ -1,5 +1,5 @@
 // The bubble's physical reference: CPU ray tracing of the analytic sphere with the soap film
-// evaluated per wavelength (see render.h, docs/effects.md section 3.6).
+// evaluated per wavelength (see render.h, docs/effects.md section 3.5).
 #include <algorithm>
 #include <cmath>
 #include <optional>

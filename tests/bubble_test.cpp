@@ -404,6 +404,23 @@ TEST(ThinFilm, KnownColourOrderWithGrowingThickness) {
   EXPECT_EQ(std::vector<std::string>(seen.begin(), seen.begin() + 4), expected) << ::testing::PrintToString(seen);
 }
 
+TEST(ThinFilm, AnalyticFormFollowsSamplingWithinItsFitError) {
+  // Belcour & Barla's closed form against 1 nm sampling: the same film colours within the error
+  // of its Gaussian fits (docs/bubble-shading.md: mean 5.0); no film, no reflection.
+  EXPECT_LT(glm::length(filmColorAnalytic(1.33, 0, 1.0)), 0.01);
+  EXPECT_EQ(filmColorAnalytic(1.0, 300, 0.5), glm::dvec3(0));
+  double sum = 0;
+  int n = 0;
+  for (double d = 50; d < 1000; d += 50)
+    for (double c : {1.0, 0.7, 0.4}) {
+      const glm::dvec3 a = filmColorAnalytic(1.33, d, c);
+      EXPECT_TRUE(std::isfinite(a.x + a.y + a.z));
+      sum += deltaE(a, filmColor(1.33, d, c, 400)), ++n;
+    }
+  EXPECT_LT(sum / n, 6.0);
+  EXPECT_GT(sum / n, 0.5) << "a fit, not the same computation";
+}
+
 TEST(ThinFilm, ErrorFallsAsWavelengthSamplesGrow) {
   double previous = 1e9;
   for (int w : {3, 8, 16, 32, 81}) {

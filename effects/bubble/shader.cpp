@@ -14,8 +14,9 @@ struct Builder {
   std::ostringstream src;
   std::vector<std::string>* uniforms;
   void uniform(const std::string& type, const std::string& name, const std::string& comment, int array = 0) {
-    src << "uniform " << type << " " << name << (array ? "[" + std::to_string(array) + "]" : "") << ";  // "
-        << comment << "\n";
+    src << "uniform " << type << " " << name;
+    if (array) src << "[" << array << "]";
+    src << ";  // " << comment << "\n";
     uniforms->push_back(name);
   }
   Builder& operator<<(const std::string& s) {
@@ -129,8 +130,12 @@ std::string filmFragment(const Features& f, Builder& fs) {
           "  float cosTheta = clamp(abs(dot(N, V)), 0.0, 1.0);\n";
   body << (f.thickness ? "  float thickness = texture(uThicknessField, vUv).r;\n"
                        : "  float thickness = uThicknessNm;\n");
-  body << "  float u = (thickness - uThicknessRange.x) / max(uThicknessRange.y - uThicknessRange.x, 1e-6);\n"
-          "  vec3 R = texture(uThinFilm, vec2(u, cosTheta)).rgb;  // Airy, s and p, CIE\n"
+  body << "  float u = clamp((thickness - uThicknessRange.x) / max(uThicknessRange.y - uThicknessRange.x, 1e-6), 0.0, "
+          "1.0);\n"
+          "  // the table's first and last texel centres hold the ends of its axes\n"
+          "  vec2 size = vec2(textureSize(uThinFilm, 0));\n"
+          "  vec2 at = (vec2(u, cosTheta) * (size - 1.0) + 0.5) / size;\n"
+          "  vec3 R = texture(uThinFilm, at).rgb;  // Airy, s and p, CIE\n"
           "  vec3 r = reflect(-V, N);\n"
           "  vec3 seen = texture(uEnvironment, r).rgb;\n";
   if (f.highlight)

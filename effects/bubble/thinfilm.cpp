@@ -116,6 +116,51 @@ glm::dvec3 SpectrumToRgb::operator()(const double* values) const {
 
 double deltaE(const glm::dvec3& a, const glm::dvec3& b) { return glm::length(lab(a) - lab(b)); }
 
+namespace {
+
+// Unpolarised Fresnel reflectance entering a medium of relative index eta at cos(theta) = c.
+double fresnel(double c, double eta) {
+  const double g2 = eta * eta - 1 + c * c;
+  if (g2 <= 0) return 1;  // total internal reflection
+  const double g = std::sqrt(g2), a = (g - c) / (g + c), b = (c * (g + c) - 1) / (c * (g - c) + 1);
+  return 0.5 * a * a * (1 + b * b);
+}
+
+// The CIE functions' response to cos(2 pi opd / lambda + shift), from Gaussian fits of x, y, z
+// (Belcour & Barla 2017, supplemental), as linear sRGB.
+glm::dvec3 sensitivity(double opdNm, double shift) {
+  const double phase = 2 * kPi * opdNm * 1e-9;
+  const glm::dvec3 value(5.4856e-13, 4.4201e-13, 5.2481e-13), mean(1.6810e+06, 1.7953e+06, 2.2084e+06),
+      variance(4.3278e+09, 9.3046e+09, 6.6121e+09);
+  glm::dvec3 xyz;
+  for (int i = 0; i < 3; ++i)
+    xyz[i] = value[i] * std::sqrt(2 * kPi * variance[i]) * std::cos(mean[i] * phase + shift) *
+             std::exp(-phase * phase * variance[i]);
+  xyz.x += 9.7470e-14 * std::sqrt(2 * kPi * 4.5282e+09) * std::cos(2.2399e+06 * phase + shift) *
+           std::exp(-4.5282e+09 * phase * phase);
+  return xyzToLinearSrgb(xyz / 1.0685e-7);
+}
+
+}  // namespace
+
+glm::dvec3 filmColorAnalytic(double n, double d, double cosTheta) {
+  if (!(n > 1)) return glm::dvec3(0);
+  const double c1 = std::clamp(std::abs(cosTheta), 0.0, 1.0);
+  const double sin2 = (1 - c1 * c1) / (n * n), c2 = std::sqrt(std::max(0.0, 1 - sin2));
+  const double R12 = fresnel(c1, n), T121 = 1 - R12, R23 = fresnel(c2, 1 / n);
+  if (R12 >= 1) return glm::dvec3(1);
+  // Air / film / air: the round trip's two reflections shift the phase by pi + pi.
+  const double opd = 2 * n * std::max(0.0, d) * c2, r123 = std::sqrt(R12 * R23);
+  const double Rs = T121 * T121 * R23 / (1 - R12 * R23);
+  glm::dvec3 I(R12 + Rs);
+  double C = Rs - T121;
+  for (int m = 1; m <= 2; ++m) {
+    C *= r123;
+    I += C * 2.0 * sensitivity(m * opd, 0.0);
+  }
+  return glm::max(I, glm::dvec3(0));
+}
+
 glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavelengths) {
   return color(sampling(std::clamp(wavelengths, 1, 400)), ior, thicknessNm, cosTheta);
 }

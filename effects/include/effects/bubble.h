@@ -152,7 +152,7 @@ struct Mesh {
 Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 
 // ---- shaders ----------------------------------------------------------------------------------
-// Two shading models (docs/effects.md section 3.4):
+// Two shading models (docs/effects.md sections 3.4-3.5):
 //   kFilm (default): a soap film. Per fragment, the film's reflectance R (the thin-film table
 //     at the fragment's thickness and |cos theta|: Airy, s and p, CIE) weights what the mirror
 //     direction sees (the environment, plus each light's highlight); the light behind passes
@@ -216,6 +216,11 @@ class SpectrumToRgb {
 };
 // CIE76 Delta E*ab between two linear sRGB colours (D65, white = (1, 1, 1)).
 double deltaE(const glm::dvec3& a, const glm::dvec3& b);
+// Belcour & Barla 2017's analytic alternative: the Airy series to its second order, each order
+// integrated against Gaussian fits of the CIE colour matching functions in closed form (their
+// "evalSensitivity"), unpolarised Fresnel: linear sRGB without sampling wavelengths. Compared
+// with the table in docs/bubble-shading.md (build/bench/bubble_shading).
+glm::dvec3 filmColorAnalytic(double ior, double thicknessNm, double cosTheta);
 // Linear sRGB reflectance colour under D65 using `wavelengths` midpoint samples over
 // 380-780 nm (white-balanced so that R = 1 gives (1, 1, 1)); 400 = the 1 nm reference.
 glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavelengths);
