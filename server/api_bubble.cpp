@@ -1,5 +1,8 @@
 // POST /v1/bubble — seed 000's bubble: mesh, uniforms, GLSL variants, thin-film table, glTF.
 #include <algorithm>
+#include <map>
+#include <memory>
+#include <mutex>
 
 #include <glm/geometric.hpp>
 
@@ -11,6 +14,7 @@
 #include "bubble_glb.h"
 #include "codec.h"
 #include "costs.h"
+#include "shader_targets.h"
 
 namespace effectd {
 
@@ -214,11 +218,60 @@ json thinFilmJson(const json& body, const bb::Params& params, const json& tf, co
   return j;
 }
 
-// `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks.
+// The variant for another engine, translated once per process and feature set (the shader
+// cache: the same features and language give the same bytes, as the ETag does).
+std::shared_ptr<const TranslatedShader> translated(const bb::Features& f, ShaderTarget target,
+                                                   const bb::ShaderSource& glsl, bool& cached) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<const TranslatedShader>> cache;
+  std::string key = std::to_string(int(target)) + (f.shading == bb::Shading::kFilm ? "film:" : "paper:");
+  for (bool on : {f.reflection, f.refraction, f.rim, f.textureFlow, f.wobble, f.iridescence, f.thickness, f.backFace,
+                  f.highlight})
+    key += on ? '1' : '0';
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (auto it = cache.find(key); it != cache.end()) return cached = true, it->second;
+  }
+  auto r = translateShader(glsl.vertex, glsl.fragment, target);
+  if (!r.ok()) throwError(r.error());
+  auto shared = std::make_shared<const TranslatedShader>(std::move(r.value()));
+  std::lock_guard<std::mutex> lock(mu);
+  cache.emplace(key, shared);  // at most 2^9 x 2 feature sets x 3 targets: bounded
+  return cached = false, shared;
+}
+
+// A translated stage's code: text, or SPIR-V words as little-endian base64.
+json stageCode(const ShaderStage& s) {
+  if (s.spirv.empty()) return s.source;
+  return base64Encode(std::string(reinterpret_cast<const char*>(s.spirv.data()), s.spirv.size() * 4));
+}
+
+json resourcesJson(const std::vector<ShaderResource>& resources) {
+  json out = json::array();
+  for (const ShaderResource& r : resources) {
+    json j = {{"name", r.name}, {"kind", r.kind}, {"stage", r.stage}};
+    if (r.set >= 0) j["set"] = r.set;
+    if (r.binding >= 0) j["binding"] = r.binding;
+    if (r.location >= 0) j["location"] = r.location;
+    if (r.mslIndex >= 0) j["mslIndex"] = r.mslIndex;
+    if (!r.members.empty()) {
+      j["members"] = json::array();
+      for (const auto& [name, offset] : r.members) j["members"].push_back({{"name", name}, {"offset", offset}});
+    }
+    out.push_back(std::move(j));
+  }
+  return out;
+}
+
+// `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks; a
+// translation's cache state and compile time go to `reply`.
 void addShaderParts(const json& body, const Includes& include, const bb::Params& params, const bb::Features& features,
-                    const bb::ThicknessOptions& film, const std::vector<bb::Light>& lights, double t, json& out) {
-  // Both GLSL versions declare the same uniforms, so one variant serves uniforms and shader.
-  const bool es = body.value("shader", json::object()).value("language", "glsl-es-300") == "glsl-es-300";
+                    const bb::ThicknessOptions& film, const std::vector<bb::Light>& lights, double t, json& out,
+                    JsonReply& reply) {
+  // Every language declares the same uniforms, so one variant serves uniforms and shader;
+  // SPIR-V, HLSL and MSL are translated from the 330 core source.
+  const std::string language = body.value("shader", json::object()).value("language", "glsl-es-300");
+  const bool es = language == "glsl-es-300";
   bb::ShaderSource s;
   if (include.has("uniforms") || include.has("shader"))
     s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
@@ -231,21 +284,36 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
     const glm::dvec2 off = bb::flowOffset(params, t);  // eqn 9, for clients that offset on the CPU
     out["flowOffset"] = {off.x, off.y};
   }
-  if (include.has("shader")) {
-    const bool film = features.shading == bb::Shading::kFilm;
-    out["shader"] = {{"language", es ? "glsl-es-300" : "glsl-330"},
-                     {"vertex", s.vertex},
-                     {"fragment", s.fragment},
-                     {"uniforms", s.uniforms},
-                     {"attributes", s.attributes},
-                     {"blend", film ? "uPass 0: ZERO, SRC_COLOR; uPass 1: ONE, ONE (or uPass 2 alone: ONE, "
-                                      "ONE_MINUS_SRC_ALPHA, grey transmission)"
-                                    : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
-                     {"draw", std::string(film && features.backFace ? "back faces (cull front), then front faces (cull "
-                                                                      "back)"
-                                                                    : "front faces (cull back)") +
-                                  (film ? ", each with uPass 0 then 1" : "") + "; depth test, no depth write"}};
+  if (!include.has("shader")) return;
+  const bool filmModel = features.shading == bb::Shading::kFilm;
+  json shader = {{"language", language},
+                 {"vertex", s.vertex},
+                 {"fragment", s.fragment},
+                 {"entryPoints", {{"vertex", "main"}, {"fragment", "main"}}},
+                 {"uniforms", s.uniforms},
+                 {"attributes", s.attributes},
+                 {"blend", filmModel ? "uPass 0: ZERO, SRC_COLOR; uPass 1: ONE, ONE (or uPass 2 alone: ONE, "
+                                       "ONE_MINUS_SRC_ALPHA, grey transmission)"
+                                     : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
+                 {"draw", std::string(filmModel && features.backFace ? "back faces (cull front), then front faces "
+                                                                       "(cull back)"
+                                                                     : "front faces (cull back)") +
+                              (filmModel ? ", each with uPass 0 then 1" : "") + "; depth test, no depth write"}};
+  if (language == "spirv" || language == "hlsl" || language == "msl") {
+    const ShaderTarget target = language == "spirv"  ? ShaderTarget::kSpirv
+                                : language == "hlsl" ? ShaderTarget::kHlsl
+                                                     : ShaderTarget::kMsl;
+    bool cached = false;
+    const auto t = translated(features, target, s, cached);
+    shader["vertex"] = stageCode(t->vertex);
+    shader["fragment"] = stageCode(t->fragment);
+    shader["entryPoints"] = {{"vertex", t->vertex.entryPoint}, {"fragment", t->fragment.entryPoint}};
+    shader["resources"] = resourcesJson(t->resources);
+    if (target == ShaderTarget::kSpirv) shader["encoding"] = "base64: SPIR-V 1.0 words, little-endian (Vulkan 1.0)";
+    reply.runHeaders["X-Shader-Cache"] = cached ? "hit" : "miss";
+    if (!cached) reply.computeMs += t->compileMs;
   }
+  out["shader"] = std::move(shader);
 }
 
 // The film's thickness texture over the mesh's UVs, as JSON numbers or float32 base64.
@@ -332,7 +400,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
     glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
     out["position"] = {c.x, c.y, c.z};
   }
-  addShaderParts(body, include, params, features, filmOptions, lights, t, out);
+  addShaderParts(body, include, params, features, filmOptions, lights, t, out, reply);
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
     bb::Mesh mesh = buildMesh(body, params, features, t, ctx);

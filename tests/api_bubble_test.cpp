@@ -143,6 +143,40 @@ TEST(BubbleApi, BadInputNamesTheField) {
   EXPECT_TRUE(hasPointer(p, "/film/width")) << p.dump();
 }
 
+TEST(BubbleApi, ShadersForEveryEngine) {
+  TestServer s;
+  json req = {{"shader", {{"language", "spirv"}}}, {"include", {"shader"}}};
+  auto r = s.postJson("/v1/bubble", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  auto bytes = base64Decode(j["shader"]["vertex"].get<std::string>());
+  ASSERT_TRUE(bytes && bytes->size() >= 20);
+  uint32_t magic;
+  std::memcpy(&magic, bytes->data(), 4);
+  EXPECT_EQ(magic, 0x07230203u);  // SPIR-V, little-endian words
+  EXPECT_EQ(j["shader"]["entryPoints"]["vertex"], "main");
+  bool block = false;
+  for (const json& res : j["shader"]["resources"]) block |= res["kind"] == "uniformBlock" && res["name"] == "Uniforms";
+  EXPECT_TRUE(block);
+  EXPECT_FALSE(r->get_header_value("X-Shader-Cache").empty());
+  // A disabled feature leaves no trace in HLSL or MSL either; the same variant again is cached.
+  for (const char* language : {"hlsl", "msl"}) {
+    json q = {{"shader", {{"language", language}}},
+              {"features", {{"highlight", false}, {"thickness", false}}},
+              {"include", {"shader"}}};
+    json a = json::parse(s.postJson("/v1/bubble", q)->body);
+    const std::string code = a["shader"]["vertex"].get<std::string>() + a["shader"]["fragment"].get<std::string>();
+    EXPECT_EQ(code.find("uLight"), std::string::npos) << language;
+    EXPECT_EQ(code.find("uThicknessField"), std::string::npos) << language;
+    EXPECT_NE(code.find("uThicknessNm"), std::string::npos) << language;
+    q["time"] = 1;  // another answer, the same shader variant
+    EXPECT_EQ(s.postJson("/v1/bubble", q)->get_header_value("X-Shader-Cache"), "hit") << language;
+  }
+  EXPECT_EQ(json::parse(s.postJson("/v1/bubble", json{{"shader", {{"language", "msl"}}}})->body)["shader"]["entryPoints"]
+                ["fragment"],
+            "main0");
+}
+
 TEST(BubbleApi, ThicknessTextureAndGlbCarryTheField) {
   TestServer s;
   json req = {{"film", {{"width", 32}, {"height", 16}}}, {"time", 3}, {"include", {"thickness", "gltf", "stats"}}};
