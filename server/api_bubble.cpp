@@ -82,6 +82,9 @@ std::vector<bb::Light> parseLights(const json& body, const std::string& pointer)
     bb::Light light;
     if (l.contains("direction")) light.direction = toVec3(l["direction"]);
     requireNonZero(light.direction, at + "/direction");
+    // Scaled by its largest component first: [1e-300, 0, 0] normalises without underflow.
+    const glm::dvec3 a = glm::abs(light.direction);
+    light.direction = glm::normalize(light.direction / std::max({a.x, a.y, a.z}));
     if (l.contains("color")) light.color = toVec3(l["color"]);
     light.intensity = l.value("intensity", light.intensity);
     light.sizeDegrees = l.value("sizeDegrees", light.sizeDegrees);
@@ -90,10 +93,16 @@ std::vector<bb::Light> parseLights(const json& body, const std::string& pointer)
   return out;
 }
 
-bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const Config& config,
-                                    const std::string& pointer) {
+json thicknessRange(const json& body, const bb::Features& f, const bb::ThicknessOptions& film) {
   const json tf = body.value("thinFilm", json::object());
-  const json range = tf.value("thicknessRange", json{0, 1000});
+  if (tf.contains("thicknessRange")) return tf["thicknessRange"];
+  if (f.shading == bb::Shading::kPaper) return json{0, 1000};
+  return json{0, std::max({1000.0, film.bottomStartNm, film.bottomEndNm})};  // the film's thickest
+}
+
+bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const json& range,
+                                    const Config& config, const std::string& pointer) {
+  const json tf = body.value("thinFilm", json::object());
   bb::ThinFilmOptions o;
   o.ior = params.n2;
   o.wavelengths = tf.value("wavelengths", 16);
@@ -182,7 +191,7 @@ json meshJson(bb::Mesh mesh, bool topLeft) {
 // The physical thin-film table over thickness x cos(theta), as JSON numbers or RGBA16F base64.
 json thinFilmJson(const json& body, const bb::Params& params, const json& tf, const json& range,
                   const RequestContext& ctx, effects::Stats& stats) {
-  const bb::ThinFilmOptions o = thinFilmOptions(body, params, ctx.config, ctx.at);
+  const bb::ThinFilmOptions o = thinFilmOptions(body, params, range, ctx.config, ctx.at);
   auto r = bb::thinFilmTable(o);
   if (!r.ok()) {
     effects::Error e = r.error();
@@ -277,8 +286,7 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
     s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
   if (include.has("uniforms")) {
     const double radius = body.value("mesh", json::object()).value("radius", 1.0);
-    const json range = body.value("thinFilm", json::object()).value("thicknessRange", json{0, 1000});
-    out["uniforms"] = uniforms(params, film, lights, s.uniforms, t, radius, range);
+    out["uniforms"] = uniforms(params, film, lights, s.uniforms, t, radius, thicknessRange(body, features, film));
   }
   if (include.has("uniforms") && features.shading == bb::Shading::kPaper && features.textureFlow) {
     const glm::dvec2 off = bb::flowOffset(params, t);  // eqn 9, for clients that offset on the CPU
@@ -292,8 +300,8 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
                  {"entryPoints", {{"vertex", "main"}, {"fragment", "main"}}},
                  {"uniforms", s.uniforms},
                  {"attributes", s.attributes},
-                 {"blend", filmModel ? "uPass 0: ZERO, SRC_COLOR; uPass 1: ONE, ONE (or uPass 2 alone: ONE, "
-                                       "ONE_MINUS_SRC_ALPHA, grey transmission)"
+                 {"blend", filmModel ? "uPass 0: colour ZERO, SRC_COLOR, alpha ZERO, SRC_ALPHA; uPass 1: ONE, ONE (or "
+                                       "uPass 2 alone: ONE, ONE_MINUS_SRC_ALPHA, grey transmission)"
                                      : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
                  {"draw", std::string(filmModel && features.backFace ? "back faces (cull front), then front faces "
                                                                        "(cull back)"
@@ -364,7 +372,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   const std::vector<bb::Light> lights = parseLights(body, ctx.at);
   const double t = body.value("time", 0.0);
   const json tf = body.value("thinFilm", json::object());
-  const json range = tf.value("thicknessRange", json{0, 1000});
+  const json range = thicknessRange(body, features, filmOptions);
   // glTF: the film model's own thickness (the field's texture over [0, its thickest], or one
   // thickness); the paper's iridescence the thin-film range (glTF's default 100-400 nm unless given).
   GltfFilm gltf;
@@ -425,9 +433,11 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
                 {"iridescenceIor", params.n2},
                 {"iridescenceThicknessMinimum", gltf.minNm},
                 {"iridescenceThicknessMaximum", gltf.maxNm}};
-    if (film && features.thickness)
-      ext["iridescenceThicknessTexture"] = "the thickness texture (include thickness) as G = nm / maximum";
     out["gltf"] = {{"KHR_materials_iridescence", ext}};
+    if (film && features.thickness)
+      out["gltf"]["thicknessTexture"] =
+          "iridescenceThicknessTexture: the thickness texture (include thickness) with G = nm / "
+          "iridescenceThicknessMaximum (format glb embeds it)";
   }
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);

@@ -24,9 +24,14 @@ effects::bubble::Features parseBubbleFeatures(const nlohmann::json& body);
 effects::bubble::ThicknessOptions parseFilm(const nlohmann::json& body, const Config& config, const std::string& pointer);
 // The body's "lights" (the default sun when absent).
 std::vector<effects::bubble::Light> parseLights(const nlohmann::json& body, const std::string& pointer);
+// The thin-film table's thickness axis, nm: the body's thinFilm.thicknessRange, else [0, 1000],
+// or up to the film's thickest for the film model.
+nlohmann::json thicknessRange(const nlohmann::json& body, const effects::bubble::Features& f,
+                              const effects::bubble::ThicknessOptions& film);
+// Throws 413 over --max-thin-film-texels.
 effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
-                                                 const Config& config,
-                                                 const std::string& pointer);  // throws 413 over --max-thin-film-texels
+                                                 const nlohmann::json& range, const Config& config,
+                                                 const std::string& pointer);
 // Icosphere subdivisions: the most a request may ask for (327 680 triangles), and the default
 // of a rendered bubble (a /v1/bubble mesh defaults to MeshOptions{}.level).
 inline constexpr int kMaxIcosphereLevel = 7;

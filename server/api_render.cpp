@@ -177,19 +177,19 @@ rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at,
     if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, at + "/mesh");
   b.mesh = std::move(mesh.value());
   b.radius = o.radius;
+  if (film) {
+    b.film = parseFilm(bj, config, at);
+    // The scene's lights light every effect; a bubble's own serve when the scene has none.
+    b.lights = scene.contains("lights") ? parseLights(scene, "") : parseLights(bj, at);
+  }
   if (film || b.features.iridescence) {
-    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, config, at);
+    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, thicknessRange(bj, b.features, b.film), config, at);
     tf.measureError = false;
     auto table = cachedThinFilm(tf, at);
     b.thinFilm = table->rgb;
     b.thinFilmWidth = table->width;
     b.thinFilmHeight = table->height;
     b.thinFilmRangeNm = {tf.thicknessMinNm, tf.thicknessMaxNm};
-  }
-  if (film) {
-    b.film = parseFilm(bj, config, at);
-    // The scene's lights light every effect; a bubble's own serve when the scene has none.
-    b.lights = scene.contains("lights") ? parseLights(scene, "") : parseLights(bj, at);
   }
   if (bj.contains("motion")) {
     const json& mo = bj["motion"];
@@ -294,12 +294,17 @@ JsonReply handleScene(const json& body, const RequestContext& ctx) {
   };
   add("lightning", handleLightning);
   add("fog", handleFog);
-  add("bubble", handleBubble);
+  // A bubble's uniforms as the render lights it: the scene's lights first.
+  auto lit = [&](json bubble) {
+    if (body.contains("lights")) bubble["lights"] = body["lights"];
+    return bubble;
+  };
+  if (body.contains("bubble")) out["bubble"] = answer(lit(body["bubble"]), "/bubble", "bubble", handleBubble);
   if (body.contains("bubbles")) {
     out["bubbles"] = json::array();
     for (size_t i = 0; i < body["bubbles"].size(); ++i)
-      out["bubbles"].push_back(
-          answer(body["bubbles"][i]["bubble"], "/bubbles/" + std::to_string(i) + "/bubble", "bubble", handleBubble));
+      out["bubbles"].push_back(answer(lit(body["bubbles"][i]["bubble"]), "/bubbles/" + std::to_string(i) + "/bubble",
+                                      "bubble", handleBubble));
   }
   reply.body = std::move(out);
   return reply;
@@ -318,7 +323,11 @@ JsonReply referenceReply(const json& body, const RequestContext& ctx) {
   reply.method = "reference";
   rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
   auto r = rd::referenceRender(scene, ctx.parallel);
-  if (!r.ok()) throwError(r.error());
+  if (!r.ok()) {
+    effects::Error e = r.error();  // its one bubble may be the first of "bubbles"
+    if (!body.contains("bubble") && e.field.rfind("/bubble/", 0) == 0) e.field = "/bubbles/0" + e.field;
+    throwError(e);
+  }
   auto png = rd::encodePng(r.value().image, scene.bitDepth);
   if (!png.ok()) throwError(png.error());
   reply.binary = std::move(png.value());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "api_bubble.h"
 #include "api_common.h"
@@ -135,6 +136,26 @@ Cost renderCost(const json& body, const Config& config) {
   if (body.contains("background") && body["background"].contains("image"))
     c.bytes += config.limits.maxRenderPixels * 16;
   c.heavy = c.heavy || pixels >= (2048u * 2048u);
+  // Each bubble's thin-film table (float RGB, then 16F on the GPU) and, for the film, its
+  // thickness texture rebuilt every frame on the render thread (~1 us per texel).
+  std::vector<json> bubbles;
+  if (body.contains("bubble")) bubbles.push_back(body["bubble"]);
+  if (body.contains("bubbles"))
+    for (const json& item : body["bubbles"]) bubbles.push_back(item.value("bubble", json::object()));
+  const size_t frames = body.contains("frames") ? std::max<size_t>(1, body["frames"].value("count", 1)) : 1;
+  size_t thicknessWork = 0;
+  for (const json& b : bubbles) {
+    const json tf = b.value("thinFilm", json::object());
+    c.bytes += std::min(size_t(tf.value("width", 256)) * size_t(tf.value("height", 256)), config.limits.maxThinFilmTexels) * 18;
+    if (b.value("shading", "film") != "film") continue;
+    const json f = b.value("film", json::object());
+    const effects::bubble::ThicknessOptions d;
+    const size_t texels = std::min(size_t(f.value("width", d.width)) * size_t(f.value("height", d.height)),
+                                   config.limits.maxThinFilmTexels);
+    c.bytes += texels * 8;
+    thicknessWork += texels * frames;
+  }
+  c.heavy = c.heavy || thicknessWork >= (size_t(1) << 22);  // seconds of thickness tracing
   return c;
 }
 

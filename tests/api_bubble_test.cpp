@@ -189,7 +189,8 @@ TEST(BubbleApi, ThicknessTextureAndGlbCarryTheField) {
   for (double v : t["nm"]) lo = std::min(lo, v), hi = std::max(hi, v);
   EXPECT_LT(lo, 100.0);  // a thin top
   EXPECT_GT(hi, 600.0);  // a thick bottom
-  EXPECT_TRUE(j["gltf"]["KHR_materials_iridescence"].contains("iridescenceThicknessTexture"));
+  EXPECT_TRUE(j["gltf"].contains("thicknessTexture"));
+  EXPECT_EQ(j["gltf"]["KHR_materials_iridescence"]["iridescenceThicknessMaximum"], 1000.0);
   EXPECT_EQ(j["stats"][0]["method"], "drainage+swirl");
   req["film"]["encoding"] = "r32f";
   json b = json::parse(s.postJson("/v1/bubble", req)->body);

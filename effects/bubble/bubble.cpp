@@ -35,6 +35,8 @@ std::optional<Error> validate(const Params& p) {
   if (!in(p.wobbleFrequency, 0, kMaxWobbleFrequency))
     return invalid("/wobbleFrequency", "must be in [0, " + std::to_string(int(kMaxWobbleFrequency)) + "]");
   if (!in(p.wobbleAmplitude, 0, 1e6)) return invalid("/wobbleAmplitude", "must be in [0, 1e6]");
+  if (p.wobbleVariant == WobbleVariant::kRelative && p.wobbleAmplitude > 1)
+    return unsatisfiable("/wobbleAmplitude", "a fraction of the radius in the relative wobble: at most 1");
   // Eqn 11's Jacobian is 1 + a k cos(...): at a k = 1 the surface creases, beyond it folds.
   if (p.wobbleAmplitude * p.wobbleFrequency > kMaxWobbleStretch)
     return unsatisfiable("/wobbleAmplitude",

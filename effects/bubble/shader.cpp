@@ -27,7 +27,9 @@ struct Builder {
 
 std::string header(Glsl v, bool fragment) {
   if (v == Glsl::kCore330) return "#version 330 core\n";
-  return fragment ? "#version 300 es\nprecision highp float;\n" : "#version 300 es\n";
+  // Samplers default to lowp in ES fragment shaders: the thickness texture holds nanometres.
+  return fragment ? "#version 300 es\nprecision highp float;\nprecision highp sampler2D;\nprecision highp samplerCube;\n"
+                  : "#version 300 es\n";
 }
 
 bool film(const Features& f) { return f.shading == Shading::kFilm; }
@@ -40,7 +42,7 @@ std::string vertexShader(const Features& f, Glsl version, ShaderSource& out) {
   out.attributes = {"aPosition", "aNormal"};
   vs << header(version, false) << "layout(location = 0) in vec3 aPosition;\nlayout(location = 1) in vec3 aNormal;\n";
   if (usesUv(f)) vs << "layout(location = 2) in vec2 aUv;\n", out.attributes.push_back("aUv");
-  vs.uniform("mat4", "uModel", "object -> world (translation and uniform scale)");
+  vs.uniform("mat4", "uModel", "object -> world");
   vs.uniform("mat4", "uViewProjection", "world -> clip");
   if (f.wobble) {
     vs.uniform("float", "uWobblePhase", "deltaSpeed * t mod 2 pi, reduced on the CPU (eqn 11)");
@@ -107,8 +109,8 @@ std::string paperFragment(const Features& f, Builder& fs) {
 // The soap film's fragment shader: reflectance per fragment, premultiplied output.
 std::string filmFragment(const Features& f, Builder& fs) {
   fs.uniform("int", "uPass",
-             "0: the film's transmittance (blend ZERO, SRC_COLOR), then 1: its reflection (ONE, ONE); 2: both in "
-             "one pass, premultiplied, transmission grey (ONE, ONE_MINUS_SRC_ALPHA)");
+             "0: the film's transmittance (blend ZERO, SRC_COLOR; alpha ZERO, SRC_ALPHA), then 1: its reflection "
+             "(ONE, ONE); 2: both in one pass, premultiplied, transmission grey (ONE, ONE_MINUS_SRC_ALPHA)");
   fs.uniform("vec3", "uCameraPosition", "world space");
   fs.uniform("samplerCube", "uEnvironment", "what the mirror direction sees");
   fs.uniform("sampler2D", "uThinFilm", "film reflectance: u = thickness over uThicknessRange, v = cos(theta)");
@@ -142,9 +144,10 @@ std::string filmFragment(const Features& f, Builder& fs) {
     body << "  for (int i = 0; i < uLightCount; ++i)\n"
             "    seen += uLightRadiance[i] * pow(max(dot(r, uLightDirection[i]), 0.0), uLightSharpness[i]);\n";
   body << "  vec4 color;\n"
-          "  if (uPass == 0) color = vec4(1.0 - R, 1.0);  // blend (ZERO, SRC_COLOR): what passes through\n"
-          "  else if (uPass == 1) color = vec4(R * seen, 0.0);  // blend (ONE, ONE): what the film reflects\n"
-          "  else color = vec4(R * seen, dot(R, vec3(0.2126, 0.7152, 0.0722)));  // one pass, grey transmission\n";
+          "  float opacity = dot(R, vec3(0.2126, 0.7152, 0.0722));\n"
+          "  if (uPass == 0) color = vec4(1.0 - R, 1.0 - opacity);  // (ZERO, SRC_COLOR; ZERO, SRC_ALPHA): what passes\n"
+          "  else if (uPass == 1) color = vec4(R * seen, opacity);  // (ONE, ONE): what the film reflects\n"
+          "  else color = vec4(R * seen, opacity);  // one pass (ONE, ONE_MINUS_SRC_ALPHA), grey transmission\n";
   return body.str();
 }
 

@@ -154,9 +154,10 @@ glm::dvec3 filmColorAnalytic(double n, double d, double cosTheta) {
   const double Rs = T121 * T121 * R23 / (1 - R12 * R23);
   glm::dvec3 I(R12 + Rs);
   double C = Rs - T121;
+  const glm::dvec3 white = sensitivity(0, 0);  // the fits' flat spectrum: balanced to (1, 1, 1) as the table is
   for (int m = 1; m <= 2; ++m) {
     C *= r123;
-    I += C * 2.0 * sensitivity(m * opd, 0.0);
+    I += C * 2.0 * sensitivity(m * opd, 0.0) / white;
   }
   return glm::max(I, glm::dvec3(0));
 }

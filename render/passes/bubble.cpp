@@ -118,7 +118,7 @@ void drawMesh(Program& p, const bubble::Features& f, GLsizei indexCount) {
       return;
     }
     p.set("uPass", 0);
-    glBlendFunc(GL_ZERO, GL_SRC_COLOR);
+    glBlendFuncSeparate(GL_ZERO, GL_SRC_COLOR, GL_ZERO, GL_SRC_ALPHA);
     glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
     p.set("uPass", 1);
     glBlendFunc(GL_ONE, GL_ONE);
@@ -127,6 +127,7 @@ void drawMesh(Program& p, const bubble::Features& f, GLsizei indexCount) {
   if (f.shading == bubble::Shading::kFilm && f.backFace) draw(GL_FRONT);
   draw(GL_BACK);  // eqns 4-10 are written for the surface facing the viewer
   glDisable(GL_CULL_FACE);
+  glBlendFunc(GL_ONE, GL_ZERO);
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
   glDisable(GL_DEPTH_TEST);
@@ -155,12 +156,13 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   Program& p = *program.value();
   glUseProgram(p.id);
   setUniforms(p, b, f);
+  if (f.scene.fog) setFog(p, *f.scene.fog, f.view.eye);
   // Made first, bound after: making a texture binds it to the active unit.
   Texture flowOwned, thinFilm, thickness;
   if (film || features.iridescence)
     thinFilm =
-        texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB32F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
-  if (film && features.thickness) {  // R16F filters everywhere (R32F needs an extension)
+        texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB16F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
+  if (film && features.thickness) {  // 16F filters everywhere (32F needs an extension)
     bubble::ThicknessOptions o = b.film;
     o.measureError = false;  // the request's answer measures it; a frame only draws
     auto field = bubble::thicknessField(b.params, o, b.time);

@@ -59,7 +59,8 @@ struct Params {
   double wobbleFrequency = kRelativeWobble.frequency;
 };
 // Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; wobble amplitude
-// >= 0, frequency in [0, kMaxWobbleFrequency], amplitude x frequency <= kMaxWobbleStretch.
+// >= 0 (relative: <= 1 radius), frequency in [0, kMaxWobbleFrequency], amplitude x frequency
+// <= kMaxWobbleStretch.
 std::optional<Error> validate(const Params& p);
 // The defaults of a wobble variant (what a request that names the variant alone gets).
 WobbleShape wobbleDefaults(WobbleVariant v);
@@ -114,7 +115,7 @@ struct ThicknessOptions {
   int width = 128, height = 64;  // texture: u = atan2(z, x) / 2 pi + 0.5 (REPEAT), v = 0 at y = -1
   bool measureError = true;      // the bilinear lookup against thicknessAt between texels
 };
-// Fields "/seed", "/bottomStartNm", "/bottomEndNm" in [0, 1e5], "/swirl" in [0, 10],
+// Fields "/bottomStartNm", "/bottomEndNm" in [0, 1e5], "/swirl" in [0, 10],
 // "/swirlSpeed" in [0, 1e6], "/width" in [4, 4096], "/height" in [2, 4096].
 std::optional<Error> validate(const ThicknessOptions& o);
 // The exact thickness in nm at a point of the unit sphere (normalised; zero -> +y) at time t.
@@ -157,8 +158,8 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 //     at the fragment's thickness and |cos theta|: Airy, s and p, CIE) weights what the mirror
 //     direction sees (the environment, plus each light's highlight); the light behind passes
 //     through weighted 1 - R per channel (the film absorbs nothing). Two draws per face set:
-//     uPass 0 writes 1 - R blended with (ZERO, SRC_COLOR), uPass 1 writes R * seen blended with
-//     (ONE, ONE); uPass 2 is one draw, premultiplied (R * seen, luminance of R) with (ONE,
+//     uPass 0 writes (1 - R, 1 - opacity) blended with (ZERO, SRC_COLOR; ZERO, SRC_ALPHA), uPass 1
+//     writes (R * seen, opacity) with (ONE, ONE), opacity the luminance of R; uPass 2 is one draw, premultiplied (R * seen, luminance of R) with (ONE,
 //     ONE_MINUS_SRC_ALPHA), for engines that cannot draw twice (its transmission is grey). Back
 //     faces see the film from inside (normal flipped by gl_FrontFacing): draw them first.
 //   kPaper: seed 000's eqns 3-10 (final vector lookup, rim alpha, texture flow), straight alpha

@@ -68,7 +68,8 @@ struct Environment {
   glm::dvec3 zenith{0.25, 0.5, 0.95}, horizon{0.9, 0.93, 1.0}, ground{0.25, 0.22, 0.2};
 };
 // The sky in direction d (unit): y >= 0 mix(horizon, zenith, sqrt(y)), below mix(horizon,
-// ground, sqrt(min(-4 y, 1))); the environment pass evaluates the same in GLSL (skyGlsl).
+// ground, sqrt(min(-4 y, 1))); the environment pass evaluates the same in GLSL
+// (environmentFragment).
 glm::dvec3 skyAt(const Environment& e, const glm::dvec3& d);
 
 // Seed 000 section 2.2: a quad in front of the backdrop with two normal maps scrolling in
