@@ -249,29 +249,6 @@ std::shared_ptr<const TranslatedShader> translated(const bb::Features& f, Shader
   return cached = false, shared;
 }
 
-// A translated stage's code: text, or SPIR-V words as little-endian base64.
-json stageCode(const ShaderStage& s) {
-  if (s.spirv.empty()) return s.source;
-  return base64Encode(std::string(reinterpret_cast<const char*>(s.spirv.data()), s.spirv.size() * 4));
-}
-
-json resourcesJson(const std::vector<ShaderResource>& resources) {
-  json out = json::array();
-  for (const ShaderResource& r : resources) {
-    json j = {{"name", r.name}, {"kind", r.kind}, {"stage", r.stage}};
-    if (r.set >= 0) j["set"] = r.set;
-    if (r.binding >= 0) j["binding"] = r.binding;
-    if (r.location >= 0) j["location"] = r.location;
-    if (r.mslIndex >= 0) j["mslIndex"] = r.mslIndex;
-    if (!r.members.empty()) {
-      j["members"] = json::array();
-      for (const auto& [name, offset] : r.members) j["members"].push_back({{"name", name}, {"offset", offset}});
-    }
-    out.push_back(std::move(j));
-  }
-  return out;
-}
-
 // `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks; a
 // translation's cache state and compile time go to `reply`.
 void addShaderParts(const json& body, const Includes& include, const bb::Params& params, const bb::Features& features,
@@ -307,10 +284,7 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
                                                                        "(cull back)"
                                                                      : "front faces (cull back)") +
                               (filmModel ? ", each with uPass 0 then 1" : "") + "; depth test, no depth write"}};
-  if (language == "spirv" || language == "hlsl" || language == "msl") {
-    const ShaderTarget target = language == "spirv"  ? ShaderTarget::kSpirv
-                                : language == "hlsl" ? ShaderTarget::kHlsl
-                                                     : ShaderTarget::kMsl;
+  if (ShaderTarget target; shaderTarget(language, target)) {
     bool cached = false;
     const auto t = translated(features, target, s, cached);
     shader["vertex"] = stageCode(t->vertex);

@@ -2,11 +2,13 @@
 #include <cmath>
 
 #include <effects/fog.h>
+#include <render/render.h>
 
 #include "api_common.h"
 #include "api_fog.h"
 #include "codec.h"
 #include "costs.h"
+#include "shader_targets.h"
 
 namespace effectd {
 
@@ -121,6 +123,40 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
   return opt;
 }
 
+// The fog function an engine pastes into its own fragment shader (render::fogShader, the
+// renderer's own), in the asked language, with its uniforms' values for the asked camera.
+json fogShaderJson(const fog::Fog& global, const std::vector<fog::Region>& regions, const json& body,
+                   const RequestContext& ctx, JsonReply& reply) {
+  if (regions.size() > effects::render::kMaxFogRegions)
+    throw fieldError(422, ctx.at + "/regions",
+                     "the fog shader takes at most " + std::to_string(effects::render::kMaxFogRegions) + " regions");
+  const json opts = body.value("shader", json::object());
+  const std::string language = opts.value("language", "glsl-es-300");
+  const glm::dvec3 camera = opts.contains("camera") ? toVec3(opts["camera"]) : glm::dvec3(0);
+  effects::Stopwatch watch;
+  const effects::render::FogShader fs = effects::render::fogShader({global, regions}, camera);
+  json uniforms = json::object();
+  for (const auto& u : fs.uniforms) uniforms[u.name] = {{"type", u.type}, {"values", u.values}};
+  json out = {{"language", language},
+              {"function", "vec3 applyFog(vec3 rgb, vec3 world): rgb seen at world position world, fogged"},
+              {"code", fs.glsl},
+              {"uniforms", std::move(uniforms)}};
+  if (ShaderTarget target; shaderTarget(language, target)) {
+    // The snippet inside a fragment shader that calls it, so that every target keeps it.
+    const std::string wrapper = "#version 330 core\nin vec3 vWorld;\nin vec3 vColor;\nout vec4 fragColor;\n" +
+                                fs.glsl + "void main() { fragColor = vec4(applyFog(vColor, vWorld), 1.0); }\n";
+    auto t = translateShader("", wrapper, target);
+    if (!t.ok()) throwError(t.error());
+    out["code"] = stageCode(t.value().fragment);
+    out["entryPoint"] = t.value().fragment.entryPoint;
+    out["resources"] = resourcesJson(t.value().resources);
+    out["note"] = "a whole fragment shader (in vWorld, vColor; out the fogged colour) around applyFog, as the "
+                  "target language has it: take applyFog and its uniforms into your own shader";
+  }
+  reply.computeMs += watch.ms();
+  return out;
+}
+
 }  // namespace
 
 JsonReply handleFog(const json& body, const RequestContext& ctx) {
@@ -179,6 +215,7 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
     reply.computeMs += watch.ms();
     out["samples"] = std::move(list);
   }
+  if (include.has("shader")) out["shader"] = fogShaderJson(global, regions, body, ctx, reply);
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);
   return reply;

@@ -1,8 +1,11 @@
 // GLSL -> SPIR-V (glslang) -> HLSL / MSL (SPIRV-Cross), with the resources each declares.
 #include "shader_targets.h"
 
+#include "codec.h"
+
 #include <memory>
 #include <mutex>
+#include <tuple>
 
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
@@ -77,18 +80,22 @@ effects::Result<TranslatedShader> translateShader(const std::string& vertexGlsl,
   initialise();
   effects::Stopwatch watch;
   std::string log;
-  auto vs = parse(EShLangVertex, vertexGlsl, log);
-  if (!vs) return effects::unsatisfiable("/shader", "glslang refused the vertex shader: " + log);
+  std::unique_ptr<glslang::TShader> vs;
+  if (!vertexGlsl.empty()) {
+    vs = parse(EShLangVertex, vertexGlsl, log);
+    if (!vs) return effects::unsatisfiable("/shader", "glslang refused the vertex shader: " + log);
+  }
   auto fs = parse(EShLangFragment, fragmentGlsl, log);
   if (!fs) return effects::unsatisfiable("/shader", "glslang refused the fragment shader: " + log);
   glslang::TProgram program;
-  program.addShader(vs.get());
+  if (vs) program.addShader(vs.get());
   program.addShader(fs.get());
   if (!program.link(EShMsgDefault) || !program.mapIO())
     return effects::unsatisfiable("/shader", std::string("glslang could not link the stages: ") + program.getInfoLog());
   TranslatedShader out;
   for (auto [stage, name, dst] : {std::tuple{EShLangVertex, "vertex", &out.vertex},
                                   std::tuple{EShLangFragment, "fragment", &out.fragment}}) {
+    if (!program.getIntermediate(stage)) continue;  // a fragment-only translation
     std::vector<uint32_t> words;
     glslang::GlslangToSpv(*program.getIntermediate(stage), words);
     try {
@@ -121,6 +128,36 @@ effects::Result<TranslatedShader> translateShader(const std::string& vertexGlsl,
     }
   }
   out.compileMs = watch.ms();
+  return out;
+}
+
+bool shaderTarget(const std::string& language, ShaderTarget& target) {
+  if (language == "spirv") return target = ShaderTarget::kSpirv, true;
+  if (language == "hlsl") return target = ShaderTarget::kHlsl, true;
+  if (language == "msl") return target = ShaderTarget::kMsl, true;
+  return false;
+}
+
+// A translated stage's code: text, or SPIR-V words as little-endian base64.
+nlohmann::json stageCode(const ShaderStage& s) {
+  if (s.spirv.empty()) return s.source;
+  return base64Encode(std::string(reinterpret_cast<const char*>(s.spirv.data()), s.spirv.size() * 4));
+}
+
+nlohmann::json resourcesJson(const std::vector<ShaderResource>& resources) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ShaderResource& r : resources) {
+    nlohmann::json j = {{"name", r.name}, {"kind", r.kind}, {"stage", r.stage}};
+    if (r.set >= 0) j["set"] = r.set;
+    if (r.binding >= 0) j["binding"] = r.binding;
+    if (r.location >= 0) j["location"] = r.location;
+    if (r.mslIndex >= 0) j["mslIndex"] = r.mslIndex;
+    if (!r.members.empty()) {
+      j["members"] = nlohmann::json::array();
+      for (const auto& [name, offset] : r.members) j["members"].push_back({{"name", name}, {"offset", offset}});
+    }
+    out.push_back(std::move(j));
+  }
   return out;
 }
 

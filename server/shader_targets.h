@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include <effects/common.h>
 
 namespace effectd {
@@ -39,8 +41,15 @@ struct TranslatedShader {
 };
 
 // Throws nothing: a source glslang or SPIRV-Cross refuses is kUnsatisfiable with its log (a bug
-// of effectd's, as the GLSL is its own).
+// of effectd's, as the GLSL is its own). An empty vertexGlsl translates the fragment stage alone.
 effects::Result<TranslatedShader> translateShader(const std::string& vertexGlsl, const std::string& fragmentGlsl,
                                                   ShaderTarget target);
+
+// "spirv", "hlsl", "msl" -> the target; false for the GLSL languages.
+bool shaderTarget(const std::string& language, ShaderTarget& target);
+// A translated stage's code as the answer carries it: text, or SPIR-V words as little-endian
+// base64; and the resources as JSON (proto/schemas/common.json#/$defs/shaderResource).
+nlohmann::json stageCode(const ShaderStage& s);
+nlohmann::json resourcesJson(const std::vector<ShaderResource>& resources);
 
 }  // namespace effectd

@@ -1,5 +1,10 @@
 // POST /v1/fog over HTTP.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
 
 #include "codec.h"
 #include "test_server.h"
@@ -124,6 +129,50 @@ TEST(FogApi, TableOverTheLimitIs413) {
   auto p =
       expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"size", 1001}}}}), 413);
   EXPECT_TRUE(hasPointer(p, "/table/size")) << p;
+}
+
+
+// The fog function for an engine's own shader, per fog type and with regions, in every
+// language: the GLSL snippet holds only the used type's formula; SPIR-V passes spirv-val; HLSL
+// compiles in glslang's HLSL front end.
+bool toolAccepts(const std::string& command, const std::string& bytes, const std::string& suffix) {
+  const std::string path = "/tmp/effectd_fog_" + std::to_string(::getpid()) + suffix;
+  std::ofstream(path, std::ios::binary) << bytes;
+  const bool ok = std::system((command + " " + path + " > /dev/null 2>&1").c_str()) == 0;
+  std::remove(path.c_str());
+  return ok;
+}
+
+TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
+  TestServer s;
+  for (const char* type : {"LINEAR", "EXPONENTIAL", "GL_LINEAR", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2",
+                           "DISTANCE_GAUSSIAN", "HEIGHT"}) {
+    for (bool withRegions : {false, true}) {
+      json body = {{"fog", {{"fogType", type}, {"density", 0.05}, {"visibilityRange", 30}}},
+                   {"include", {"shader"}},
+                   {"shader", {{"camera", {0, 1.7, 0}}}}};
+      if (withRegions)
+        body["regions"] = {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "GL_EXP"}}}}};
+      auto r = s.postJson("/v1/fog", body);
+      ASSERT_EQ(r->status, 200) << r->body;
+      json j = json::parse(r->body);
+      const std::string glsl = j["shader"]["code"];
+      EXPECT_NE(glsl.find("vec3 applyFog(vec3 rgb, vec3 world)"), std::string::npos);
+      EXPECT_EQ(glsl.find("fogLogG") != std::string::npos, std::string(type) == "HEIGHT") << type;
+      EXPECT_EQ(j["shader"]["uniforms"].contains("uRegionLo"), withRegions);
+      EXPECT_EQ(j["shader"]["uniforms"]["uFogCamera"]["values"], json({0, 1.7, 0}));
+      body["shader"]["language"] = "spirv";
+      json spirv = json::parse(s.postJson("/v1/fog", body)->body);
+      auto words = base64Decode(spirv["shader"]["code"].get<std::string>());
+      ASSERT_TRUE(words);
+      EXPECT_TRUE(toolAccepts("spirv-val --target-env vulkan1.0", *words, ".spv")) << type;
+      body["shader"]["language"] = "hlsl";
+      json hlsl = json::parse(s.postJson("/v1/fog", body)->body);
+      EXPECT_NE(hlsl["shader"]["code"].get<std::string>().find("applyFog"), std::string::npos);
+      EXPECT_TRUE(toolAccepts("glslangValidator -V -o /dev/null -D -e main -S frag", hlsl["shader"]["code"], ".hlsl"))
+          << type << hlsl["shader"]["code"].get<std::string>();
+    }
+  }
 }
 
 }  // namespace

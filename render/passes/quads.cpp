@@ -8,17 +8,16 @@
 
 #include "../gpu.h"
 
-namespace effects::render::detail {
+namespace effects::render {
 
 // Slot 0 = global fog; slots 1.. = regions by increasing volume (stable: ties keep their
 // order), so that the shader's first containing region is regionAt()'s choice.
-void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
+FogShader fogShader(const Fog& f, const glm::dvec3& eye) {
   std::vector<size_t> order(f.regions.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
-  std::vector<int> types;
-  std::vector<float> params, colors, lo, hi;
+  std::vector<double> types, params, colors, lo, hi;
   auto add = [&](const fog::Fog& g) {
     types.push_back(int(g.type));
     glm::dvec4 q(0);
@@ -34,8 +33,8 @@ void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
         q = {g.density > 0 ? std::log(g.density) : 0.0, g.heightFalloff, g.baseHeight, g.density > 0 ? 1.0 : 0.0};
         break;
     }
-    for (int i = 0; i < 4; ++i) params.push_back(float(q[i]));
-    for (int i = 0; i < 3; ++i) colors.push_back(float(g.color[i]));
+    for (int i = 0; i < 4; ++i) params.push_back(q[i]);
+    for (int i = 0; i < 3; ++i) colors.push_back(g.color[i]);
   };
   add(f.global);
   for (size_t i : order) {
@@ -43,16 +42,36 @@ void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
     add(r.fog);
     glm::dvec4 a = r.shape == fog::Region::Shape::kBox ? glm::dvec4(r.min, 0) : glm::dvec4(r.center, 1);
     glm::dvec4 b = r.shape == fog::Region::Shape::kBox ? glm::dvec4(r.max, 0) : glm::dvec4(r.radius, 0, 0, 0);
-    for (int k = 0; k < 4; ++k) lo.push_back(float(a[k])), hi.push_back(float(b[k]));
+    for (int k = 0; k < 4; ++k) lo.push_back(a[k]), hi.push_back(b[k]);
   }
-  const GLsizei n = GLsizei(types.size());
-  p.set("uFogCamera", eye);
-  glUniform1iv(p.at("uFogType[0]"), n, types.data());
-  glUniform4fv(p.at("uFogParams[0]"), n, params.data());
-  glUniform3fv(p.at("uFogColor[0]"), n, colors.data());
-  if (!lo.empty()) {
-    glUniform4fv(p.at("uRegionLo[0]"), n - 1, lo.data());
-    glUniform4fv(p.at("uRegionHi[0]"), n - 1, hi.data());
+  const std::string slots = "[" + std::to_string(types.size()) + "]", regions = "[" + std::to_string(order.size()) + "]";
+  FogShader out;
+  out.glsl = detail::fogGlsl(detail::fogVariant(f));
+  out.uniforms = {{"uFogCamera", "vec3", {eye.x, eye.y, eye.z}},
+                  {"uFogType", "int" + slots, types},
+                  {"uFogParams", "vec4" + slots, params},
+                  {"uFogColor", "vec3" + slots, colors}};
+  if (!order.empty()) {
+    out.uniforms.push_back({"uRegionLo", "vec4" + regions, lo});
+    out.uniforms.push_back({"uRegionHi", "vec4" + regions, hi});
+  }
+  return out;
+}
+
+namespace detail {
+
+void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
+  for (const FogShader::Uniform& u : fogShader(f, glm::dvec3(eye)).uniforms) {
+    const std::vector<float> v(u.values.begin(), u.values.end());
+    const GLint at = p.at(u.name == "uFogCamera" ? u.name : u.name + "[0]");
+    if (u.type.rfind("int", 0) == 0) {
+      const std::vector<GLint> ints(u.values.begin(), u.values.end());
+      glUniform1iv(at, GLsizei(ints.size()), ints.data());
+    } else if (u.type.rfind("vec4", 0) == 0) {
+      glUniform4fv(at, GLsizei(v.size() / 4), v.data());
+    } else {
+      glUniform3fv(at, GLsizei(v.size() / 3), v.data());
+    }
   }
 }
 
@@ -86,4 +105,5 @@ std::optional<Error> quadsPass(Gpu& gpu, FrameState& f) {
   return std::nullopt;
 }
 
-}  // namespace effects::render::detail
+}  // namespace detail
+}  // namespace effects::render
