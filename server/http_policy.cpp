@@ -28,6 +28,7 @@ constexpr size_t kTrimAfterBytes = 32u << 20;
 // Headers a browser on another origin may read (CORS), and may send.
 constexpr const char* kExposedHeaders =
     "ETag, Server-Timing, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, X-Render-Passes, "
+    "X-Shader-Cache, X-Shader-Compile-Ms, "
     "X-Render-Ms, X-Shader-Variants-Compiled, Retry-After";
 constexpr const char* kAllowedRequestHeaders = "Content-Type, If-None-Match, X-Request-ID";
 

@@ -318,7 +318,10 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
     const double computeMs = binary != route.binary.end() ? answerBinary(binary->second.handler, req.body, ctx, *answer)
                                                           : answerJson(route.json, body, ctx, *answer, res);
     encodeAnswer(coding, *answer);
-    res.set_header("Server-Timing", "compute;dur=" + std::to_string(computeMs));
+    std::string timing = "compute;dur=" + std::to_string(computeMs);
+    if (res.has_header("X-Shader-Compile-Ms"))  // a shader translated for this answer (its part of compute)
+      timing += ", shader;dur=" + res.get_header_value("X-Shader-Compile-Ms");
+    res.set_header("Server-Timing", timing);
     sendAnswer(*answer, inm, res);
     if (!tag.empty()) cache_.put(std::move(answer), requestKey);
   } catch (const ApiError& e) {

@@ -159,6 +159,9 @@ TEST(BubbleApi, ShadersForEveryEngine) {
   for (const json& res : j["shader"]["resources"]) block |= res["kind"] == "uniformBlock" && res["name"] == "Uniforms";
   EXPECT_TRUE(block);
   EXPECT_FALSE(r->get_header_value("X-Shader-Cache").empty());
+  if (r->get_header_value("X-Shader-Cache") == "miss") {
+    EXPECT_NE(r->get_header_value("Server-Timing").find("shader;dur="), std::string::npos);
+  }
   // A disabled feature leaves no trace in HLSL or MSL either; the same variant again is cached.
   for (const char* language : {"hlsl", "msl"}) {
     json q = {{"shader", {{"language", language}}},
