@@ -206,6 +206,29 @@ try {
         }
       diffs.sort((p, q) => p - q);
       out.picture = canvas.toDataURL('image/png');
+
+      // Every GLSL ES 3.00 variant the service hands out compiles and links in this browser:
+      // the paper model's 64 feature sets and the film's 16.
+      const sets = [];
+      const paper = ['reflection', 'refraction', 'rim', 'textureFlow', 'wobble', 'iridescence'];
+      for (let m = 0; m < 64; ++m) sets.push({ shading: 'paper', features: Object.fromEntries(paper.map((k, i) => [k, !!(m & (1 << i))])) });
+      const film = ['wobble', 'thickness', 'backFace', 'highlight'];
+      for (let m = 0; m < 16; ++m) sets.push({ shading: 'film', features: Object.fromEntries(film.map((k, i) => [k, !!(m & (1 << i))])) });
+      out.variants = 0;
+      out.variantFailures = [];
+      for (const set of sets) {
+        const v = await (await post('/v1/bubble', { ...set, include: ['shader'] })).json();
+        const p = gl.createProgram();
+        try {
+          gl.attachShader(p, compile(gl.VERTEX_SHADER, v.shader.vertex));
+          gl.attachShader(p, compile(gl.FRAGMENT_SHADER, v.shader.fragment));
+          gl.linkProgram(p);
+          if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
+          ++out.variants;
+        } catch (e) {
+          out.variantFailures.push(`${JSON.stringify(set)}: ${e.message}`);
+        }
+      }
       Object.assign(out, { pixels: count, mean: sum / Math.max(1, count), p99: diffs[Math.floor(0.99 * (diffs.length - 1))],
                            worst, over, changed });
     } catch (e) {
@@ -218,6 +241,7 @@ try {
   check(r.render === 200 && r.bubble === 200, '/v1/render and /v1/bubble answered', [r.render, r.bubble]);
   check(/SwiftShader|swiftshader/i.test(r.renderer ?? ''), `WebGL2 on ${r.renderer}`, r.renderer);
   check(r.glError === 0, 'no GL error', r.glError);
+  check(r.variants === 80, `${r.variants} of 80 GLSL ES variants compile and link in the browser`, r.variantFailures);
   check(r.pixels > 3000, `the bubble covers ${r.pixels} pixels of the preview`, r.pixels);
   check(r.mean < 2.0, `mean difference ${r.mean?.toFixed(2)}/255 over the bubble (tolerance 2)`, r);
   check(r.p99 <= 12, `99th percentile ${r.p99}/255 (tolerance 12)`, r);
