@@ -4,6 +4,7 @@
 // validated SPIR-V, checked here for its entry points and resources only.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -76,10 +77,12 @@ TEST(ShaderTargets, SpirvValidatesAndHlslCompilesForEveryFeatureSet) {
     }
     // No trace of a disabled feature in any language: the uniform block holds exactly the
     // GLSL's uniforms (samplers aside, which are textures).
-    for (const ShaderResource& r : spirv.value().resources)
-      if (r.kind == "uniformBlock")
-        for (const auto& [member, offset] : r.members)
-          EXPECT_NE(std::find(glsl.uniforms.begin(), glsl.uniforms.end(), member), glsl.uniforms.end()) << member;
+    for (const ShaderResource& r : spirv.value().resources) {
+      if (r.kind != "uniformBlock") continue;
+      for (const auto& [member, offset] : r.members) {
+        EXPECT_NE(std::find(glsl.uniforms.begin(), glsl.uniforms.end(), member), glsl.uniforms.end()) << member;
+      }
+    }
   }
   EXPECT_EQ(checked, 2 * (64 + 16));
 }
