@@ -233,10 +233,7 @@ std::shared_ptr<const TranslatedShader> translated(const bb::Features& f, Shader
                                                    const bb::ShaderSource& glsl, bool& cached) {
   static std::mutex mu;
   static std::map<std::string, std::shared_ptr<const TranslatedShader>> cache;
-  std::string key = std::to_string(int(target)) + (f.shading == bb::Shading::kFilm ? "film:" : "paper:");
-  for (bool on : {f.reflection, f.refraction, f.rim, f.textureFlow, f.wobble, f.iridescence, f.thickness, f.backFace,
-                  f.highlight})
-    key += on ? '1' : '0';
+  const std::string key = std::to_string(int(target)) + ":" + bb::variantKey(f);
   {
     std::lock_guard<std::mutex> lock(mu);
     if (auto it = cache.find(key); it != cache.end()) return cached = true, it->second;

@@ -284,6 +284,10 @@ TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
   EXPECT_FALSE(json::parse(ready->body)["info"].value("renderer", "").empty()) << ready->body;
 }
 
+// The on-screen radius in pixels of the unit sphere seen from 4 units with a 45-degree field
+// of view, in an n x n frame.
+double discRadius(int n) { return std::tan(std::asin(0.25)) / std::tan(22.5 * M_PI / 180) * n / 2; }
+
 // The default bubble is a soap film: reflecting a sky in front of a dark backdrop it changes
 // most of its disc, in many hues (the paper's shader with the old example changed 6 % of it, in
 // one or two); it only reflects and transmits: with nothing to reflect it leaves the backdrop as
@@ -303,8 +307,7 @@ TEST(Render, FilmBubbleShowsBandsOfColourOverItsFace) {
   ASSERT_EQ(r->status, 200) << r->body;
   EXPECT_NE(r->get_header_value("X-Render-Passes").find("bubble-film"), std::string::npos);
   const rd::Image img = decode(r->body);
-  // The unit sphere seen from 4 units: its disc's radius on screen.
-  const double disc = std::tan(std::asin(0.25)) / std::tan(22.5 * M_PI / 180) * n / 2;
+  const double disc = discRadius(n);
   int inside = 0, changed = 0;
   std::array<int, 6> hues{};
   for (int y = 0; y < n; ++y)
@@ -366,7 +369,7 @@ TEST(Render, ReferenceRenderAgreesWithTheFilmShader) {
   ASSERT_EQ(a.rgba.size(), b.rgba.size());
   double sum = 0, outside = 0;
   int count = 0;
-  const double disc = std::tan(std::asin(0.25)) / std::tan(22.5 * M_PI / 180) * n / 2;
+  const double disc = discRadius(n);
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
       const glm::vec4 p = pixel(a, x, y), q = pixel(b, x, y);

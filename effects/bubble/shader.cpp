@@ -158,6 +158,14 @@ double highlightSharpness(const Light& l) {
   return std::log(0.5) / std::log(c);  // c^n = 1/2
 }
 
+std::string variantKey(const Features& f) {
+  std::string key = film(f) ? "film:" : "paper:";
+  for (bool on : {f.reflection, f.refraction, f.rim, f.textureFlow, f.wobble, f.iridescence, f.thickness, f.backFace,
+                  f.highlight})
+    key += on ? '1' : '0';
+  return key;
+}
+
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude,
                     const std::string& fragmentFinish) {
   ShaderSource out;

@@ -49,15 +49,6 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   return std::nullopt;
 }
 
-// The program's cache key: the model, then one bit per feature in the order of bubble::Features.
-std::string programKey(const bubble::Features& f) {
-  std::string key = f.shading == bubble::Shading::kFilm ? "bubble:film:" : "bubble:paper:";
-  for (bool on : {f.reflection, f.refraction, f.rim, f.textureFlow, f.wobble, f.iridescence, f.thickness, f.backFace,
-                  f.highlight})
-    key += on ? '1' : '0';
-  return key;
-}
-
 // Every uniform of the bubble's program but the textures (a disabled feature's is ignored).
 void setUniforms(Program& p, const Bubble& b, const FrameState& f) {
   const bubble::Params& bp = b.params;
@@ -151,7 +142,7 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   const bool film = features.shading == bubble::Shading::kFilm;
   bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
                                             f.fog ? fogFinish(features) : "");
-  auto program = gpu.program(programKey(features) + f.fogKey, src.vertex, src.fragment);
+  auto program = gpu.program("bubble:" + bubble::variantKey(features) + f.fogKey, src.vertex, src.fragment);
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

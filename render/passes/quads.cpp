@@ -10,9 +10,11 @@
 
 namespace effects::render {
 
+namespace {
+
 // Slot 0 = global fog; slots 1.. = regions by increasing volume (stable: ties keep their
 // order), so that the shader's first containing region is regionAt()'s choice.
-FogShader fogShader(const Fog& f, const glm::dvec3& eye) {
+std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye) {
   std::vector<size_t> order(f.regions.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
@@ -45,23 +47,27 @@ FogShader fogShader(const Fog& f, const glm::dvec3& eye) {
     for (int k = 0; k < 4; ++k) lo.push_back(a[k]), hi.push_back(b[k]);
   }
   const std::string slots = "[" + std::to_string(types.size()) + "]", regions = "[" + std::to_string(order.size()) + "]";
-  FogShader out;
-  out.glsl = detail::fogGlsl(detail::fogVariant(f));
-  out.uniforms = {{"uFogCamera", "vec3", {eye.x, eye.y, eye.z}},
-                  {"uFogType", "int" + slots, types},
-                  {"uFogParams", "vec4" + slots, params},
-                  {"uFogColor", "vec3" + slots, colors}};
+  std::vector<FogShader::Uniform> out = {{"uFogCamera", "vec3", {eye.x, eye.y, eye.z}},
+                                         {"uFogType", "int" + slots, types},
+                                         {"uFogParams", "vec4" + slots, params},
+                                         {"uFogColor", "vec3" + slots, colors}};
   if (!order.empty()) {
-    out.uniforms.push_back({"uRegionLo", "vec4" + regions, lo});
-    out.uniforms.push_back({"uRegionHi", "vec4" + regions, hi});
+    out.push_back({"uRegionLo", "vec4" + regions, lo});
+    out.push_back({"uRegionHi", "vec4" + regions, hi});
   }
   return out;
+}
+
+}  // namespace
+
+FogShader fogShader(const Fog& f, const glm::dvec3& eye) {
+  return {detail::fogGlsl(detail::fogVariant(f)), fogUniforms(f, eye)};
 }
 
 namespace detail {
 
 void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
-  for (const FogShader::Uniform& u : fogShader(f, glm::dvec3(eye)).uniforms) {
+  for (const FogShader::Uniform& u : fogUniforms(f, glm::dvec3(eye))) {
     const std::vector<float> v(u.values.begin(), u.values.end());
     const GLint at = p.at(u.name == "uFogCamera" ? u.name : u.name + "[0]");
     if (u.type.rfind("int", 0) == 0) {

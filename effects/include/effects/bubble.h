@@ -186,6 +186,9 @@ struct ShaderSource {
 // in scope); both see vWorld.
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
                     const std::string& fragmentFinish = "");
+// What tells shader variants apart: the model and one bit per feature ("film:101101111"), for
+// the caches of compiled or translated variants.
+std::string variantKey(const Features& f);
 
 // A directional light for the film's highlights: towards the light, its radiance, and the
 // angular radius (degrees) at which its highlight falls to half.
