@@ -9,7 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
-#include <unordered_map>
+#include <array>
 
 #include "steps.h"
 #include "weld.h"
@@ -21,34 +21,33 @@ constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not z
 
 struct TriInfo {
   dvec3 os{0}, ot{0};  // unit first-order derivatives, sign-adjusted by orientation
+  int neighbor[3] = {-1, -1, -1};  // across edge (i, i+1)
   bool orientPreserving = false;
   bool groupWithAny = true;  // UV area or a derivative is zero: joins any group, adds nothing
   bool zeroUvArea = false;
-  int neighbor[3] = {-1, -1, -1};  // across edge (i, i+1)
-  int group[3] = {-1, -1, -1};
+  uint8_t grouped = 0;  // bit i: corner i has its group
 };
 
 struct Group {
   uint32_t vertex;  // welded vertex index
+  uint32_t first;   // into the member buffer; the group ends where the next begins
   bool orientPreserving;
-  size_t first = 0, count = 0;  // into the face buffer
 };
 
-struct Corners {
-  std::vector<dvec3> tangent;  // per corner, zero where no frame
-  std::vector<uint8_t> orient;
-  size_t degenerateTriangles = 0, zeroUvArea = 0, groups = 0;
+struct Member {  // a good triangle and which of its corners is the group's vertex
+  uint32_t face : 30;
+  uint32_t corner : 2;
 };
 
 class Mikk {
  public:
-  Mikk(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel)
-      : mesh_(mesh), normals_(normals), parallel_(parallel) {}
+  Mikk(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel, CornerTangents& out)
+      : mesh_(mesh), normals_(normals), parallel_(parallel), out_(out) {}
 
-  Corners run() {
+  MikkStats run() {
     const size_t triCount = mesh_.indices.size() / 3;
-    out_.tangent.assign(triCount * 3, dvec3(0));
-    out_.orient.assign(triCount * 3, false);
+    out_.tangent.resize(triCount * 3);
+    out_.fellBack.assign(triCount * 3, 1);  // until a group gives the corner a frame
     std::vector<uint32_t> rep = weld<8>(mesh_.positions.size(), [&](size_t i, float* k) {
       const glm::vec3& p = mesh_.positions[i];
       glm::vec3 n = glm::vec3(normals_[i]);
@@ -56,34 +55,43 @@ class Mikk {
       float v[8] = {p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y};
       std::memcpy(k, v, sizeof v);
     });
-    vert_.resize(triCount * 3);
-    for (size_t c = 0; c < vert_.size(); ++c) vert_[c] = rep[mesh_.indices[c]];
 
     // Triangles with two coincident corners are set aside (reference: MARK_DEGENERATE).
     std::vector<uint32_t> degenerate;
+    good_.reserve(triCount);
+    tri_.reserve(triCount);
     for (uint32_t t = 0; t < triCount; ++t) {
-      const glm::vec3 &a = mesh_.positions[vert_[3 * t]], &b = mesh_.positions[vert_[3 * t + 1]],
-                      &c = mesh_.positions[vert_[3 * t + 2]];
-      (a == b || a == c || b == c ? degenerate : good_).push_back(t);
+      const std::array<uint32_t, 3> v = {rep[mesh_.indices[3 * t]], rep[mesh_.indices[3 * t + 1]],
+                                         rep[mesh_.indices[3 * t + 2]]};
+      const glm::vec3 &a = mesh_.positions[v[0]], &b = mesh_.positions[v[1]], &c = mesh_.positions[v[2]];
+      if (a == b || a == c || b == c) {
+        degenerate.push_back(t);
+      } else {
+        good_.push_back(t);
+        tri_.push_back(v);
+      }
     }
-    out_.degenerateTriangles = degenerate.size();
     info_.resize(good_.size());
     initTriInfo();
     buildNeighbors();
     buildGroups();
     generateTSpaces();
-    degenerateEpilogue(degenerate);
-    return std::move(out_);
+    degenerateEpilogue(degenerate, rep);
+    fallbacks();
+    MikkStats stats;
+    stats.degenerateTriangles = degenerate.size();
+    for (const TriInfo& ti : info_) stats.zeroUvArea += ti.zeroUvArea;
+    stats.groups = groups_.size();
+    return stats;
   }
 
  private:
   dvec3 pos(uint32_t v) const { return dvec3(mesh_.positions[v]); }
   dvec2 uv(uint32_t v) const { return dvec2(mesh_.uvs[v]); }
-  uint32_t corner(size_t g, int i) const { return vert_[3 * size_t(good_[g]) + size_t(i)]; }
+  uint32_t corner(size_t g, uint32_t i) const { return tri_[g][i]; }
 
   void initTriInfo() {
     forRange(parallel_, good_.size(), kParallelGrain, [this](size_t begin, size_t end) { initTriInfo(begin, end); });
-    for (const TriInfo& ti : info_) out_.zeroUvArea += ti.zeroUvArea;
   }
   void initTriInfo(size_t begin, size_t end) {
     for (size_t g = begin; g < end; ++g) {
@@ -108,81 +116,84 @@ class Mikk {
   }
 
   // Edges sorted by (min vertex, max vertex, face); each edge pairs with the first later one
-  // of reverse direction whose slot is still free (reference: BuildNeighborsFast).
+  // of reverse direction whose slot is still free (reference: BuildNeighborsFast). An edge
+  // only ever pairs inside its min-vertex bucket, so buckets are sorted and paired in parallel.
   void buildNeighbors() {
-    struct Edge {
-      uint32_t i0, i1, face;
-      uint8_t num;
-    };
     const size_t m = good_.size() * 3;
-    size_t vcount = mesh_.positions.size();
+    const size_t vcount = mesh_.positions.size();
     std::vector<uint32_t> start(vcount + 1, 0);
     for (size_t g = 0; g < good_.size(); ++g)
-      for (int i = 0; i < 3; ++i) ++start[std::min(corner(g, i), corner(g, (i + 1) % 3)) + 1];
+      for (uint32_t i = 0; i < 3; ++i) ++start[std::min(corner(g, i), corner(g, (i + 1) % 3)) + 1];
     for (size_t v = 0; v < vcount; ++v) start[v + 1] += start[v];
     std::vector<Edge> edges(m);
     std::vector<uint32_t> fill(start.begin(), start.end() - 1);
     for (size_t g = 0; g < good_.size(); ++g)  // stable by face within each i0 bucket
-      for (int i = 0; i < 3; ++i) {
+      for (uint32_t i = 0; i < 3; ++i) {
         uint32_t a = corner(g, i), b = corner(g, (i + 1) % 3);
-        edges[fill[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), uint32_t(g), uint8_t(i)};
+        edges[fill[std::min(a, b)]++] = {std::max(a, b), uint32_t(g), i & 3u};
       }
-    for (size_t v = 0; v < vcount; ++v)  // buckets are small: stable insertion sort by i1
-      for (size_t k = start[v] + 1; k < start[v + 1]; ++k)
-        for (size_t j = k; j > start[v] && edges[j - 1].i1 > edges[j].i1; --j) std::swap(edges[j - 1], edges[j]);
-    for (size_t i = 0; i < m; ++i) {
-      const Edge& a = edges[i];
-      if (info_[a.face].neighbor[a.num] != -1) continue;
-      uint32_t fromA = corner(a.face, a.num);
-      for (size_t j = i + 1; j < m && edges[j].i0 == a.i0 && edges[j].i1 == a.i1; ++j) {
-        const Edge& b = edges[j];
-        if (corner(b.face, b.num) != fromA && info_[b.face].neighbor[b.num] == -1) {
-          info_[a.face].neighbor[a.num] = int(b.face);
-          info_[b.face].neighbor[b.num] = int(a.face);
+    forRange(parallel_, vcount, kParallelGrain, [&](size_t begin, size_t end) {
+      for (size_t v = begin; v < end; ++v) pairBucket(edges.data() + start[v], edges.data() + start[v + 1]);
+    });
+  }
+  struct Edge {  // i0 is the bucket's vertex
+    uint32_t i1;
+    uint32_t face : 30;
+    uint32_t num : 2;
+  };
+  void pairBucket(Edge* first, Edge* last) {
+    for (Edge* k = first + 1; k < last; ++k)  // buckets are small: stable insertion sort by i1
+      for (Edge* j = k; j > first && (j - 1)->i1 > j->i1; --j) std::swap(*(j - 1), *j);
+    for (Edge* a = first; a < last; ++a) {
+      if (info_[a->face].neighbor[a->num] != -1) continue;
+      uint32_t fromA = corner(a->face, a->num);
+      for (Edge* b = a + 1; b < last && b->i1 == a->i1; ++b)
+        if (corner(b->face, b->num) != fromA && info_[b->face].neighbor[b->num] == -1) {
+          info_[a->face].neighbor[a->num] = int(b->face);
+          info_[b->face].neighbor[b->num] = int(a->face);
           break;
         }
-      }
     }
   }
 
   int cornerOf(size_t g, uint32_t vertex) const {
-    for (int i = 0; i < 3; ++i)
-      if (corner(g, i) == vertex) return i;
+    for (uint32_t i = 0; i < 3; ++i)
+      if (corner(g, i) == vertex) return int(i);
     return -1;
   }
 
   // Reference: Build4RuleGroups + AssignRecur (depth-first, left neighbour first).
   void buildGroups() {
     std::vector<uint32_t> stack;
+    members_.reserve(good_.size() * 3);
     for (size_t g = 0; g < good_.size(); ++g) {
-      for (int i = 0; i < 3; ++i) {
-        if (info_[g].groupWithAny || info_[g].group[i] != -1) continue;
-        const int gid = int(groups_.size());
-        groups_.push_back({corner(g, i), info_[g].orientPreserving, faces_.size(), 0});
-        info_[g].group[i] = gid;
-        faces_.push_back(uint32_t(g));
+      for (uint32_t i = 0; i < 3; ++i) {
+        if (info_[g].groupWithAny || (info_[g].grouped >> i & 1)) continue;
+        const uint32_t vertex = corner(g, i);
+        const bool orient = info_[g].orientPreserving;
+        const size_t first = members_.size();
+        info_[g].grouped |= uint8_t(1u << i);
+        members_.push_back({uint32_t(g), i & 3u});
         stack.clear();
         pushNeighbors(g, i, stack);
         while (!stack.empty()) {
           uint32_t f = stack.back();
           stack.pop_back();
-          Group& grp = groups_[size_t(gid)];
-          int k = cornerOf(f, grp.vertex);
+          int k = cornerOf(f, vertex);
           TriInfo& ti = info_[f];
-          if (k < 0 || ti.group[k] != -1) continue;
-          if (ti.groupWithAny && ti.group[0] == -1 && ti.group[1] == -1 && ti.group[2] == -1)
-            ti.orientPreserving = grp.orientPreserving;  // the reference's one order dependency
-          if (ti.orientPreserving != grp.orientPreserving) continue;
-          ti.group[k] = gid;
-          faces_.push_back(f);
-          pushNeighbors(f, k, stack);
+          if (k < 0 || (ti.grouped >> k & 1)) continue;
+          if (ti.groupWithAny && ti.grouped == 0)
+            ti.orientPreserving = orient;  // the reference's one order dependency
+          if (ti.orientPreserving != orient) continue;
+          ti.grouped |= uint8_t(1u << k);
+          members_.push_back({f, uint32_t(k) & 3u});
+          pushNeighbors(f, uint32_t(k), stack);
         }
-        groups_[size_t(gid)].count = faces_.size() - groups_[size_t(gid)].first;
+        groups_.push_back({vertex, uint32_t(first), orient});
       }
     }
-    out_.groups = groups_.size();
   }
-  void pushNeighbors(size_t f, int i, std::vector<uint32_t>& stack) const {
+  void pushNeighbors(size_t f, uint32_t i, std::vector<uint32_t>& stack) const {
     int left = info_[f].neighbor[i], right = info_[f].neighbor[(i + 2) % 3];
     if (right >= 0) stack.push_back(uint32_t(right));  // popped after the left subtree
     if (left >= 0) stack.push_back(uint32_t(left));
@@ -191,64 +202,89 @@ class Mikk {
   dvec3 projected(const dvec3& v, const dvec3& n) const { return normalizeOrZero(projectToPlane(v, n)); }
 
   // Reference: GenerateTSpaces + EvalTspace. A face's sub-group is the set of group faces
-  // whose projected frames are not opposite to its own; nearly always the whole group, so
-  // that case is evaluated once per group and other sets are compared as sorted lists.
+  // whose projected frames are not opposite to its own (the unit vectors' dot > -1 for both
+  // derivatives). Nearly always that is the whole group for every face, which one pass over
+  // the pairs shows (a projected derivative pair with dot >= 0 before normalising cannot reach
+  // -1 after); then the group is evaluated once. Otherwise each face's set is built and sets
+  // are compared as sorted lists.
   void generateTSpaces() {
     forRange(parallel_, groups_.size(), kParallelGrain,
              [this](size_t begin, size_t end) { generateTSpaces(begin, end); });
   }
   void generateTSpaces(size_t begin, size_t end) {
     std::vector<dvec3> os, ot;
-    std::vector<uint32_t> members;
-    std::vector<std::pair<std::vector<uint32_t>, dvec3>> subgroups;
+    std::vector<Member> subset;
+    std::vector<std::pair<std::vector<Member>, dvec3>> subgroups;
     for (size_t g = begin; g < end; ++g) {
       const Group& grp = groups_[g];
       const dvec3 n = normals_[grp.vertex];
-      const uint32_t* faces = faces_.data() + grp.first;
-      const size_t k = grp.count;
+      const Member* faces = members_.data() + grp.first;
+      const size_t k = (g + 1 < groups_.size() ? groups_[g + 1].first : members_.size()) - grp.first;
       os.resize(k);
       ot.resize(k);
-      for (size_t a = 0; a < k; ++a) os[a] = projected(info_[faces[a]].os, n), ot[a] = projected(info_[faces[a]].ot, n);
-      subgroups.clear();
-      std::optional<dvec3> whole;
       for (size_t a = 0; a < k; ++a) {
-        const uint32_t f = faces[a];
-        members.clear();
-        for (size_t b = 0; b < k; ++b) {
-          bool any = info_[f].groupWithAny || info_[faces[b]].groupWithAny;
-          if (any || a == b || (glm::dot(os[a], os[b]) > -1.0 && glm::dot(ot[a], ot[b]) > -1.0))
-            members.push_back(faces[b]);
-        }
+        os[a] = projected(info_[faces[a].face].os, n);
+        ot[a] = projectToPlane(info_[faces[a].face].ot, n);  // normalised below only if needed
+      }
+      auto agree = [&](size_t a, size_t b, bool otUnit) {
+        if (a == b || info_[faces[a].face].groupWithAny || info_[faces[b].face].groupWithAny) return true;
+        return glm::dot(os[a], os[b]) > -1.0 && (otUnit ? glm::dot(ot[a], ot[b]) > -1.0 : glm::dot(ot[a], ot[b]) >= 0.0);
+      };
+      bool whole = true;
+      for (size_t a = 0; a < k && whole; ++a)
+        for (size_t b = a + 1; b < k && whole; ++b) whole = agree(a, b, false);
+      if (whole) {
+        store(grp, faces, k, evalTSpace(faces, k, os.data(), n));
+        continue;
+      }
+      for (size_t a = 0; a < k; ++a) ot[a] = normalizeOrZero(ot[a]);
+      subgroups.clear();
+      std::optional<dvec3> wholeTangent;
+      for (size_t a = 0; a < k; ++a) {
+        subset.clear();
+        for (size_t b = 0; b < k; ++b)
+          if (agree(a, b, true)) subset.push_back(faces[b]);
         dvec3 tangent;
-        if (members.size() == k) {
-          if (!whole) whole = evalTSpace(faces, k, os.data(), grp.vertex, n);
-          tangent = *whole;
+        if (subset.size() == k) {
+          if (!wholeTangent) wholeTangent = evalTSpace(faces, k, os.data(), n);
+          tangent = *wholeTangent;
         } else {
-          std::sort(members.begin(), members.end());
-          auto it =
-              std::find_if(subgroups.begin(), subgroups.end(), [&](const auto& sg) { return sg.first == members; });
+          std::sort(subset.begin(), subset.end(), [](const Member& x, const Member& y) { return x.face < y.face; });
+          auto same = [&](const auto& sg) {
+            return std::equal(sg.first.begin(), sg.first.end(), subset.begin(), subset.end(),
+                              [](const Member& x, const Member& y) { return x.face == y.face; });
+          };
+          auto it = std::find_if(subgroups.begin(), subgroups.end(), same);
           if (it == subgroups.end()) {
-            std::vector<dvec3> memberOs(members.size());
-            for (size_t i = 0; i < members.size(); ++i) memberOs[i] = projected(info_[members[i]].os, n);
-            subgroups.emplace_back(members, evalTSpace(members.data(), members.size(), memberOs.data(), grp.vertex, n));
+            std::vector<dvec3> subsetOs(subset.size());
+            for (size_t i = 0; i < subset.size(); ++i) subsetOs[i] = projected(info_[subset[i].face].os, n);
+            subgroups.emplace_back(subset, evalTSpace(subset.data(), subset.size(), subsetOs.data(), n));
             it = subgroups.end() - 1;
           }
           tangent = it->second;
         }
-        size_t c = 3 * size_t(good_[f]) + size_t(cornerOf(f, grp.vertex));
-        out_.tangent[c] = tangent;
-        out_.orient[c] = grp.orientPreserving;
+        store(grp, faces + a, 1, tangent);
       }
     }
   }
 
+  // The corners `faces` of a group get `tangent` (unit, in the normal's plane) unless it is zero.
+  void store(const Group& grp, const Member* faces, size_t count, const dvec3& tangent) {
+    if (!notZero(tangent)) return;
+    const glm::vec4 t(glm::vec3(tangent), grp.orientPreserving ? 1.0f : -1.0f);
+    for (size_t a = 0; a < count; ++a) {
+      const size_t c = 3 * size_t(good_[faces[a].face]) + faces[a].corner;
+      out_.tangent[c] = t;
+      out_.fellBack[c] = 0;
+    }
+  }
+
   // Angle-weighted average of the faces' tangents `os` (already projected into n's plane).
-  dvec3 evalTSpace(const uint32_t* faces, size_t count, const dvec3* os, uint32_t vertex, const dvec3& n) const {
+  dvec3 evalTSpace(const Member* faces, size_t count, const dvec3* os, const dvec3& n) const {
     dvec3 sum(0);
     for (size_t a = 0; a < count; ++a) {
-      const uint32_t f = faces[a];
+      const uint32_t f = faces[a].face, i = faces[a].corner;
       if (info_[f].groupWithAny) continue;
-      int i = cornerOf(f, vertex);
       dvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
       dvec3 v1 = projected(p0 - p1, n), v2 = projected(p2 - p1, n);
       double angle = std::acos(std::clamp(glm::dot(v1, v2), -1.0, 1.0));
@@ -259,50 +295,43 @@ class Mikk {
 
   // Corners of coincident-corner triangles take the frame of the first healthy corner at the
   // same welded vertex (reference: DegenEpilogue).
-  void degenerateEpilogue(const std::vector<uint32_t>& degenerate) {
+  void degenerateEpilogue(const std::vector<uint32_t>& degenerate, const std::vector<uint32_t>& rep) {
     if (degenerate.empty()) return;
-    std::unordered_map<uint32_t, size_t> firstCorner;
-    for (size_t g = 0; g < good_.size(); ++g)
-      for (int i = 0; i < 3; ++i) firstCorner.emplace(corner(g, i), 3 * size_t(good_[g]) + size_t(i));
+    std::vector<uint32_t> firstCorner(mesh_.positions.size(), UINT32_MAX);
+    for (size_t g = good_.size(); g-- > 0;)
+      for (uint32_t i = 3; i-- > 0;) firstCorner[corner(g, i)] = uint32_t(3 * size_t(good_[g]) + i);
     for (uint32_t t : degenerate)
       for (size_t i = 0; i < 3; ++i)
-        if (auto it = firstCorner.find(vert_[3 * t + i]); it != firstCorner.end()) {
-          out_.tangent[3 * t + i] = out_.tangent[it->second];
-          out_.orient[3 * t + i] = out_.orient[it->second];
+        if (uint32_t from = firstCorner[rep[mesh_.indices[3 * t + i]]]; from != UINT32_MAX && !out_.fellBack[from]) {
+          out_.tangent[3 * t + i] = out_.tangent[from];
+          out_.fellBack[3 * t + i] = 0;
         }
+  }
+
+  // Corners with no frame: the default, in the plane of the corner's own normal.
+  void fallbacks() {
+    forRange(parallel_, out_.tangent.size(), kParallelGrain, [this](size_t begin, size_t end) {
+      for (size_t c = begin; c < end; ++c)
+        if (out_.fellBack[c]) out_.tangent[c] = fallbackTangent(normals_[mesh_.indices[c]]);
+    });
   }
 
   const Mesh& mesh_;
   const std::vector<dvec3>& normals_;
   Parallel* parallel_;
-  std::vector<uint32_t> vert_;  // welded vertex per corner
-  std::vector<uint32_t> good_;  // triangles that take part, in input order
-  std::vector<TriInfo> info_;   // per good triangle
+  CornerTangents& out_;
+  std::vector<uint32_t> good_;                // triangles that take part, in input order
+  std::vector<std::array<uint32_t, 3>> tri_;  // their welded corners
+  std::vector<TriInfo> info_;                 // per good triangle
   std::vector<Group> groups_;
-  std::vector<uint32_t> faces_;  // group face lists, contiguous
-  Corners out_;
+  std::vector<Member> members_;  // group member lists, contiguous
 };
 
 }  // namespace
 
 CornerTangents mikktspace(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel, MikkStats& stats) {
-  Corners mikk = Mikk(mesh, normals, parallel).run();
-  stats = {mikk.degenerateTriangles, mikk.zeroUvArea, mikk.groups};
   CornerTangents out;
-  out.tangent.resize(mikk.tangent.size());
-  out.fellBack.assign(mikk.tangent.size(), 0);
-  forRange(parallel, out.tangent.size(), kParallelGrain, [&](size_t begin, size_t end) {
-    for (size_t c = begin; c < end; ++c) {
-      // Mikk's tangent is already unit and in the plane of this corner's normal.
-      const dvec3& t = mikk.tangent[c];
-      if (notZero(t)) {
-        out.tangent[c] = {glm::vec3(t), mikk.orient[c] ? 1.0f : -1.0f};
-      } else {  // no frame at this corner: the default, in N's plane
-        out.tangent[c] = fallbackTangent(normals[mesh.indices[c]]);
-        out.fellBack[c] = 1;
-      }
-    }
-  });
+  stats = Mikk(mesh, normals, parallel, out).run();
   return out;
 }
 
