@@ -158,6 +158,38 @@ TEST(Fog, HeightFogStiffCases) {
   EXPECT_EQ(heightOpticalDepth(0.5, 100, 0, -1e4, 0, 1), kInf);  // deep below: overflow -> inf, not NaN
 }
 
+// Height fog tables fill their rows by a recurrence (one exp per entry); every entry must equal
+// the closed form at its distance and elevation to within float rounding, stiff rows included.
+TEST(Fog, HeightTableEntriesEqualTheClosedForm) {
+  for (double a : {1e-6, 0.02, 3.0})
+    for (double b : {0.0, 1e-4, 0.1, 2.0, 100.0})
+      for (double cam : {-50.0, 0.0, 3.0, 400.0})
+        for (double end : {1.0, 250.0, 1e5}) {
+          Fog f = make(FogType::kHeight);
+          f.density = a;
+          f.heightFalloff = b;
+          f.baseHeight = 1.0;
+          TableOptions o;
+          o.size = 513;
+          o.elevations = 65;
+          o.cameraHeight = cam;
+          o.rangeStart = end / 1000;
+          o.rangeEnd = end;
+          o.measureError = false;
+          auto t = buildTable(f, o);
+          ASSERT_TRUE(t.ok()) << t.error().message;
+          double worst = 0;
+          for (size_t j = 0; j < t.value().height; ++j)
+            for (size_t i = 0; i < t.value().width; ++i) {
+              double dy = -1.0 + 2.0 * double(j) / double(t.value().height - 1);
+              double d = *o.rangeStart + (end - *o.rangeStart) * double(i) / double(t.value().width - 1);
+              double want = float(std::exp(-heightOpticalDepth(a, b, 1.0, cam, dy, d)));
+              worst = std::max(worst, std::fabs(double(t.value().factor[j * t.value().width + i]) - want));
+            }
+          EXPECT_LE(worst, 2.4e-7) << a << " " << b << " " << cam << " " << end;  // 2 float ulps at 1
+        }
+}
+
 TEST(Fog, Validation) {
   Fog f = make(FogType::kX3dLinear);
   f.visibilityRange = -1;

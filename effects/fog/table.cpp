@@ -17,12 +17,37 @@ double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
   return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, cameraHeight, dirY, d));
 }
 
+// One row of a height fog table (fixed ray elevation) without a logarithm per entry. Along the
+// ray the optical depth is tau(t) = c (1 - e^{-k t}) / k with c the density at the camera and
+// k = falloff * dirY, and e^{-k t} - 1 over evenly spaced t follows the recurrence
+// M' = M + rho (M + 1), rho = e^{-k dt} - 1, which keeps its relative precision for small k t
+// (no 1 - e^{-x} cancellation). That leaves one exp per entry. Rows where c or e^{|k| t}
+// could overflow take the closed form per entry (heightOpticalDepth's log-space evaluation).
+bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table& t, float* row) {
+  const double a = fog.density, b = fog.heightFalloff;
+  const double k = b * dirY;
+  const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
+  if (a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * t.rangeEnd > 700.0) return false;
+  const double c = std::exp(logC);
+  const double dt = (t.rangeEnd - t.rangeStart) / double(t.width - 1);
+  const double rho = std::expm1(-k * dt);
+  double m = std::expm1(-k * t.rangeStart);  // e^{-k t} - 1 at the first distance
+  for (size_t i = 0; i < t.width; ++i) {
+    const double d = t.rangeStart + dt * double(i);
+    const double tau = k == 0.0 ? c * d : c * (-m / k);
+    row[i] = static_cast<float>(std::exp(-tau));
+    m += rho * (m + 1.0);
+  }
+  return true;
+}
+
 void fill(const Fog& fog, double cameraHeight, Table& t) {
   t.factor.resize(t.width * t.height);
   for (size_t j = 0; j < t.height; ++j) {
     double dirY = dirYAt(t, double(j));
-    for (size_t i = 0; i < t.width; ++i)
-      t.factor[j * t.width + i] = static_cast<float>(exact(fog, cameraHeight, distAt(t, double(i)), dirY));
+    float* row = t.factor.data() + j * t.width;
+    if (fog.type == FogType::kHeight && fillHeightRow(fog, cameraHeight, dirY, t, row)) continue;
+    for (size_t i = 0; i < t.width; ++i) row[i] = static_cast<float>(exact(fog, cameraHeight, distAt(t, double(i)), dirY));
   }
 }
 
