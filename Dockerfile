@@ -1,4 +1,10 @@
-# Multi-stage: build with the same setup script as developers and CI; run as a non-root user.
+# Multi-stage: build with the same setup script as developers and CI; run as a non-root user
+# from an image that holds effectd, the libraries it loads and Mesa's software renderer only.
+#   podman build --isolation=chroot -t effectd .       (or docker build -t effectd .)
+# scripts/test-image.sh builds it with a binary built on the host instead of the build stage:
+#   --build-arg BINARY_FROM=prebuilt (the binary staged at build/image/effectd).
+ARG BINARY_FROM=build
+
 FROM debian:bookworm AS build
 WORKDIR /src
 COPY scripts/setup.sh scripts/setup.sh
@@ -6,16 +12,32 @@ RUN scripts/setup.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
 RUN BUILD_DIR=/build scripts/build.sh -DEFFECTD_TESTS=OFF -DEFFECTD_BENCH=OFF
 
-FROM debian:bookworm-slim AS runtime
+FROM debian:bookworm-slim AS prebuilt
+COPY build/image/effectd /build/server/effectd
+
+FROM ${BINARY_FROM} AS binary
+
+# Every package effectd's libraries come from (OpenImageIO alone pulls GDAL, OpenVDB,
+# FFmpeg ...): a complete system to collect the runtime from, and `--target full` for
+# debugging with a shell and apt.
+FROM debian:bookworm-slim AS full
 RUN apt-get update -qq \
  && apt-get install -y -qq --no-install-recommends \
       libcpp-httplib0.11 libopenimageio2.4 libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri curl ca-certificates \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --no-create-home effectd
-COPY --from=build /build/server/effectd /usr/local/bin/effectd
+COPY --from=binary /build/server/effectd /usr/local/bin/effectd
+
+FROM full AS closure
+COPY deploy/image/closure.sh /usr/local/bin/closure.sh
+RUN closure.sh /runtime /usr/local/bin/effectd /usr/bin/curl
+
+FROM scratch AS runtime
+COPY --from=closure /runtime /
 USER 10001
 EXPOSE 8080
-ENV EFFECTD_HOST=0.0.0.0 EFFECTD_PORT=8080 LP_NUM_THREADS=2
-HEALTHCHECK --interval=10s --timeout=3s --retries=3 CMD curl -fsS http://127.0.0.1:8080/healthz || exit 1
+# XDG_CACHE_HOME: Mesa's shader cache on the writable /tmp (the root filesystem is read-only).
+ENV EFFECTD_HOST=0.0.0.0 EFFECTD_PORT=8080 LP_NUM_THREADS=2 XDG_CACHE_HOME=/tmp/cache
+HEALTHCHECK --interval=10s --timeout=3s --retries=3 CMD ["/usr/bin/curl", "-fsS", "http://127.0.0.1:8080/healthz"]
 ENTRYPOINT ["/usr/local/bin/effectd"]
 CMD ["serve"]

@@ -18,6 +18,7 @@ PACKAGES=(
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
   json-schema-test-suite  # the official JSON-Schema tests run against server/schema.cpp
   python3-jsonschema # tests/sweep_test.py checks answers against proto/schemas/*-answer.json
+  podman debootstrap # scripts/test-image.sh builds the container image and serves from it
 )
 # Node.js runs test-only tooling (the MikkTSpace oracle). Machines that already have a node
 # (e.g. from NodeSource) keep it; otherwise Debian's.

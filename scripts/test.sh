@@ -2,11 +2,13 @@
 # Installs what is missing, builds everything in Release and runs the whole suite via ctest;
 # then the same suite built with clang under ASan+UBSan, plus every libFuzzer target for a
 # bounded time on its committed seeds (build-fuzz/). EFFECTD_SANITIZE_SUITE=0 skips the second.
+# Between the two, scripts/test-image.sh builds the container image and serves from it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh -DEFFECTD_TESTS=ON -DEFFECTD_BENCH=ON
 ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "$(nproc)" "$@"
+scripts/test-image.sh  # the container image, served from (skips, saying why, where podman cannot run)
 
 if [ "${EFFECTD_SANITIZE_SUITE:-1}" = 1 ]; then
   CC=clang-14 CXX=clang++-14 BUILD_DIR=build-fuzz BUILD_TYPE=RelWithDebInfo \

@@ -53,6 +53,15 @@ check(pod.securityContext.runAsNonRoot === true, "runAsNonRoot");
 
 // Bounded resources; wiring of Service and HPA.
 check(container.resources?.limits?.cpu && container.resources?.limits?.memory, "CPU and memory limits are required");
+// The memory budget (what requests may reserve at their estimated peaks) is derived from the
+// container's memory limit: below it, with room for what the budget does not count.
+const mib = (q) => { const m = /^(\d+)(Mi|Gi)$/.exec(String(q)); return m ? Number(m[1]) * (m[2] === "Gi" ? 1024 : 1) : NaN; };
+const limitMb = mib(container.resources?.limits?.memory);
+const budgetMb = Number(flagValue("memory-budget-mb"));
+check(budgetMb >= 0.4 * limitMb && budgetMb <= 0.75 * limitMb,
+      `--memory-budget-mb=${flagValue("memory-budget-mb")} must be 40-75 % of limits.memory (${limitMb} MiB)`);
+check(new RegExp(`HEALTHCHECK .*127\\.0\\.0\\.1:${port.containerPort}/healthz`).test(dockerfile),
+      "Dockerfile HEALTHCHECK must call /healthz on the container port");
 check(container.resources?.requests?.cpu, "a CPU request is required for the HPA's utilisation target");
 const labels = deployment.spec.template.metadata.labels;
 for (const [k, v] of Object.entries(deployment.spec.selector.matchLabels)) check(labels[k] === v, `selector ${k} does not match the pod`);
@@ -90,4 +99,4 @@ if (failures.length) {
   console.error("deploy/k8s disagrees with the server:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`deploy/k8s ok: port ${port.containerPort}, probes /readyz /healthz, ${args.length - 1} flags, user ${user}`);
+console.log(`deploy/k8s ok: port ${port.containerPort}, probes /readyz /healthz, ${args.length - 1} flags, user ${user}, memory budget ${budgetMb} of ${limitMb} MiB`);
