@@ -1,7 +1,9 @@
 // Tangent figures of issue 5: a 100k-triangle mesh (UV sphere 250 x 200 segments, seam and
 // poles included, normals given) in each mode (target: MikkTSpace <= 30 ms), and the
 // per-triangle mode's angle error against MikkTSpace on the same mesh, printed as counters
-// (meanAngleDeg, maxAngleDeg) for the error-against-run-time report.
+// (meanAngleDeg, maxAngleDeg) for the error-against-run-time report. Its peer, the reference
+// algorithm as npm's WebAssembly build, is bench/mikktspace_peer.mjs (scripts/bench-table.py
+// runs both).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -27,11 +29,11 @@ effects::ThreadPool& pool() {
   return p;
 }
 
-void run(benchmark::State& state, Mode mode, bool measure) {
+void run(benchmark::State& state, Mode mode, bool measure, bool oneThread = false) {
   Options o;
   o.mode = mode;
   o.measureError = measure;
-  o.parallel = &pool();
+  o.parallel = oneThread ? nullptr : &pool();
   effects::Stats last;
   for (auto _ : state) {
     auto r = generate(mesh100k(), o);
@@ -44,7 +46,7 @@ void run(benchmark::State& state, Mode mode, bool measure) {
   }
   double tris = double(mesh100k().indices.size() / 3);
   state.counters["triangles"] = tris;
-  state.counters["threads"] = double(pool().threads() + 1);
+  state.counters["threads"] = oneThread ? 1.0 : double(pool().threads() + 1);
   state.counters["tris_per_s"] = benchmark::Counter(tris * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["outVertices"] = last.counters["outputVertices"];
   if (last.error) {
@@ -54,10 +56,12 @@ void run(benchmark::State& state, Mode mode, bool measure) {
 }
 
 void BM_MikkTSpace100k(benchmark::State& s) { run(s, Mode::kMikkTSpace, false); }
+void BM_MikkTSpace100kOneThread(benchmark::State& s) { run(s, Mode::kMikkTSpace, false, true); }
 void BM_PerTriangle100k(benchmark::State& s) { run(s, Mode::kPerTriangle, false); }
 void BM_PerTriangleErrorVsMikk100k(benchmark::State& s) { run(s, Mode::kPerTriangle, true); }
 
 BENCHMARK(BM_MikkTSpace100k)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MikkTSpace100kOneThread)->Unit(benchmark::kMillisecond);  // as the peer runs
 BENCHMARK(BM_PerTriangle100k)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PerTriangleErrorVsMikk100k)->Unit(benchmark::kMillisecond)->Iterations(3);
 
