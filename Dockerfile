@@ -1,21 +1,16 @@
 # Multi-stage: build with the same setup script as developers and CI; run as a non-root user
 # from an image that holds effectd, the libraries it loads and Mesa's software renderer only.
 #   podman build --isolation=chroot -t effectd .       (or docker build -t effectd .)
-# scripts/test-image.sh builds it with a binary built on the host instead of the build stage:
-#   --build-arg BINARY_FROM=prebuilt (the binary staged at build/image/effectd).
-ARG BINARY_FROM=build
-
+# scripts/test-image.sh builds it with a binary built on the host instead (--build-arg
+# PREBUILT=1: the binary staged at build/image/effectd; nothing is installed or compiled).
 FROM debian:bookworm AS build
+ARG PREBUILT=0
 WORKDIR /src
 COPY scripts/setup.sh scripts/setup.sh
-RUN scripts/setup.sh && rm -rf /var/lib/apt/lists/*
+RUN [ "$PREBUILT" = 1 ] || { scripts/setup.sh && rm -rf /var/lib/apt/lists/*; }
 COPY . .
-RUN BUILD_DIR=/build scripts/build.sh -DEFFECTD_TESTS=OFF -DEFFECTD_BENCH=OFF
-
-FROM debian:bookworm-slim AS prebuilt
-COPY build/image/effectd /build/server/effectd
-
-FROM ${BINARY_FROM} AS binary
+RUN if [ "$PREBUILT" = 1 ]; then install -D -m 755 build/image/effectd /build/server/effectd; \
+    else BUILD_DIR=/build scripts/build.sh -DEFFECTD_TESTS=OFF -DEFFECTD_BENCH=OFF; fi
 
 # Every package effectd's libraries come from (OpenImageIO alone pulls GDAL, OpenVDB,
 # FFmpeg ...): a complete system to collect the runtime from, and `--target full` for
@@ -26,7 +21,7 @@ RUN apt-get update -qq \
       libcpp-httplib0.11 libopenimageio2.4 libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri curl ca-certificates \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --no-create-home effectd
-COPY --from=binary /build/server/effectd /usr/local/bin/effectd
+COPY --from=build /build/server/effectd /usr/local/bin/effectd
 
 FROM full AS closure
 COPY deploy/image/closure.sh /usr/local/bin/closure.sh

@@ -52,7 +52,7 @@ if [ $from_source = 0 ]; then
   [ -x "$bin" ] || skip "no $bin: run scripts/build.sh first (or --from-source)"
   mkdir -p build/image
   cp "$bin" build/image/effectd
-  args+=(--build-arg BINARY_FROM=prebuilt)
+  args+=(--build-arg PREBUILT=1)
 fi
 start=$(date +%s)
 blog=$(mktemp)
