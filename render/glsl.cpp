@@ -1,6 +1,7 @@
 // GLSL ES 3.00 for the render passes. Every function returns only the code its variant
 // needs: a fog variant holds the formulas of the fog types the scene uses and nothing else.
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "internal.h"
@@ -10,13 +11,25 @@ namespace effects::render::detail {
 std::string FogVariant::key() const {
   std::string k = "fog";
   for (fog::FogType t : types) k += std::string(":") + fog::toString(t);
-  return k + ":r" + std::to_string(regions);
+  k += ":r" + std::to_string(regions);
+  if (start) k += ":start";
+  if (cutoff) k += ":cutoff";
+  if (opacity) k += ":maxOpacity";
+  if (secondLayer) k += ":secondLayer";
+  return k;
 }
 
 FogVariant fogVariant(const Fog& f) {
   FogVariant v;
-  v.types.push_back(f.global.type);
-  for (const auto& r : f.regions) v.types.push_back(r.fog.type);
+  auto add = [&v](const fog::Fog& g) {
+    v.types.push_back(g.type);
+    v.start |= g.startDistance > 0.0;
+    v.cutoff |= std::isfinite(g.cutoffDistance);
+    v.opacity |= g.maxOpacity < 1.0;
+    v.secondLayer |= g.secondLayer.has_value();
+  };
+  add(f.global);
+  for (const auto& r : f.regions) add(r.fog);
   std::sort(v.types.begin(), v.types.end());
   v.types.erase(std::unique(v.types.begin(), v.types.end()), v.types.end());
   v.regions = f.regions.size();
@@ -36,6 +49,11 @@ std::string fogGlsl(const FogVariant& v) {
   if (v.regions)
     s << "uniform vec4 uRegionLo[" << v.regions << "];  // box min | sphere centre; w: 0 box, 1 sphere\n"
       << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
+  if (v.engine()) s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity\n";
+  if (v.secondLayer) s << "uniform vec4 uFogLayer2[" << slots << "];  // HEIGHT's second layer: log a, b, h, a > 0\n";
+  // With a start distance or a second layer, height fog sums layers along the ray's part
+  // [start, d] (fogHeightTau); otherwise the one-layer form below it.
+  const bool layered = v.start || v.secondLayer;
   if (has(T::kHeight))
     s << "float fogLogG(float x) {  // log((1 - e^-x) / x), stable for every x\n"
          "  if (abs(x) < 1e-3) return -0.5 * x + x * x / 24.0;\n"
@@ -43,9 +61,19 @@ std::string fogGlsl(const FogVariant& v) {
          "  if (x > -80.0) return log(exp(-x) - 1.0) - log(-x);\n"
          "  return -x - log(-x);\n"
          "}\n";
-  s << "float fogFactor(int slot, vec3 world) {\n"
-       "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
-       "  vec4 q = uFogParams[slot];\n  int type = uFogType[slot];\n";
+  if (has(T::kHeight) && layered)
+    s << "float fogHeightTau(vec4 q, float y0, float dirY, float t) {  // one layer over [0, t] from height y0\n"
+         "  if (q.w < 0.5 || t == 0.0) return 0.0;\n"
+         "  if (q.y == 0.0) return exp(min(q.x + log(t), 80.0));\n"
+         "  return exp(min(q.x - q.y * (y0 - q.z) + log(t) + fogLogG(q.y * dirY * t), 80.0));\n"
+         "}\n";
+  s << (v.engine() ? "float fogMode(int slot, vec3 ray, float d) {\n" : "float fogFactor(int slot, vec3 world) {\n"
+                                                                       "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n")
+    << "  vec4 q = uFogParams[slot];\n  int type = uFogType[slot];\n";
+  if (layered)
+    s << "  float dirY = d > 0.0 ? ray.y / d : 0.0;\n"
+      << (v.start ? "  float s = min(uFogEngine[slot].x, d);\n  float y0 = uFogCamera.y + dirY * s;\n  d -= s;\n"
+                  : "  float y0 = uFogCamera.y;\n");
   for (T t : v.types) {
     s << "  if (type == " << int(t) << ") {  // " << fog::toString(t) << "\n";
     switch (t) {
@@ -57,6 +85,12 @@ std::string fogGlsl(const FogVariant& v) {
       case T::kDistanceExp2: s << "    return exp(-q.x * d * d);  // seed 003 eqn 1\n"; break;
       case T::kDistanceGaussian: s << "    return q.y * exp(-q.x * d * d);  // seed 003 eqn 2\n"; break;
       case T::kHeight:
+        if (layered) {
+          s << "    float tau = fogHeightTau(q, y0, dirY, d);\n"
+            << (v.secondLayer ? "    tau += fogHeightTau(uFogLayer2[slot], y0, dirY, d);\n" : "")
+            << "    return exp(-tau);\n";
+          break;
+        }
         // q = (log a, b, h, a > 0): tau = a e^{-b(oy-h)} t g(b dirY t) in log space.
         s << "    if (q.w < 0.5 || d == 0.0) return 1.0;\n"
              "    if (q.y == 0.0) return exp(-exp(min(q.x + log(d), 80.0)));\n"
@@ -67,6 +101,13 @@ std::string fogGlsl(const FogVariant& v) {
     s << "  }\n";
   }
   s << "  return 1.0;\n}\n";
+  if (v.engine()) {  // fog.h's order: start (above), maxOpacity, cutoff
+    s << "float fogFactor(int slot, vec3 world) {\n"
+         "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
+         "  vec4 e = uFogEngine[slot];\n";
+    if (v.cutoff) s << "  if (e.y > 0.0 && d > e.y) return 1.0;\n";
+    s << (v.opacity ? "  return max(fogMode(slot, ray, d), e.z);\n" : "  return fogMode(slot, ray, d);\n") << "}\n";
+  }
   s << "int fogSlot(vec3 p) {\n";
   if (v.regions)
     s << "  for (int i = 0; i < " << v.regions << "; ++i) {\n"

@@ -28,6 +28,9 @@ inline constexpr const char* kVertexHeader = "#version 300 es\n";
 struct FogVariant {
   std::vector<fog::FogType> types;  // distinct, sorted
   size_t regions = 0;
+  // The engine terms some slot uses (fog.h): only those are compiled in.
+  bool start = false, cutoff = false, opacity = false, secondLayer = false;
+  bool engine() const { return start || cutoff || opacity; }
   std::string key() const;
 };
 FogVariant fogVariant(const Fog& fog);

@@ -27,6 +27,17 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
   f.peak = j.value("peak", f.peak);
   f.heightFalloff = j.value("heightFalloff", f.heightFalloff);
   f.baseHeight = j.value("baseHeight", f.baseHeight);
+  f.startDistance = j.value("startDistance", f.startDistance);
+  f.maxOpacity = j.value("maxOpacity", f.maxOpacity);
+  f.cutoffDistance = j.value("cutoffDistance", f.cutoffDistance);
+  if (j.contains("secondLayer")) {
+    const json& l = j["secondLayer"];
+    fog::HeightLayer layer;
+    layer.density = l.value("density", layer.density);
+    layer.heightFalloff = l.value("heightFalloff", layer.heightFalloff);
+    layer.baseHeight = l.value("baseHeight", layer.baseHeight);
+    f.secondLayer = layer;
+  }
   if (auto e = fog::validate(f)) throwError(*e, pointer);
   return f;
 }
@@ -75,6 +86,7 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
               {"range", {t.rangeStart, t.rangeEnd}},
               {"maxError", t.maxError},
               {"errorAtDistance", t.errorAtDistance}};
+  if (std::isfinite(f.cutoffDistance)) out["cutoffDistance"] = f.cutoffDistance;
   if (t.height > 1) {
     out["elevations"] = t.height;
     out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";

@@ -122,6 +122,35 @@ TEST(FogApi, BadFieldsAre400WithPointers) {
   EXPECT_TRUE(hasPointer(p, "/table/range/1")) << p;
 }
 
+TEST(FogApi, EngineTermsInTablesAndErrors) {
+  TestServer s;
+  json req = {{"fog",
+               {{"fogType", "HEIGHT"},
+                {"density", 0.01},
+                {"startDistance", 4},
+                {"maxOpacity", 0.8},
+                {"cutoffDistance", 40},
+                {"secondLayer", {{"density", 0.002}, {"heightFalloff", 0.05}, {"baseHeight", 3}}}}},
+              {"table", {{"size", 33}, {"elevations", 5}}}};
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json t = json::parse(r->body)["table"];
+  EXPECT_EQ(t["cutoffDistance"], 40);
+  EXPECT_EQ(t["range"][1], 40);
+  for (const auto& w : t["factor"]) EXPECT_GE(w.get<double>(), 0.2 - 1e-6);
+  EXPECT_EQ(t["factor"][0], 1.0);  // within the start distance: clear
+  json plain = json::parse(s.postJson("/v1/fog", json{{"fog", {{"fogType", "GL_EXP"}}}})->body)["table"];
+  EXPECT_FALSE(plain.contains("cutoffDistance"));
+  auto p = expectProblem(
+      s.postJson("/v1/fog", json{{"fog", {{"fogType", "GL_EXP"}, {"secondLayer", {{"density", 1}}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/secondLayer")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"maxOpacity", 2}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/maxOpacity")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"cutoffDistance", 0}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/cutoffDistance")) << p;
+}
+
 TEST(FogApi, TableOverTheLimitIs413) {
   Config c = TestServer::quietConfig();
   c.limits.maxTableSize = 1000;
@@ -151,6 +180,12 @@ TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
       json body = {{"fog", {{"fogType", type}, {"density", 0.05}, {"visibilityRange", 30}}},
                    {"include", {"shader"}},
                    {"shader", {{"camera", {0, 1.7, 0}}}}};
+      if (withRegions) {  // and the engine terms, so that every language compiles them too
+        body["fog"]["startDistance"] = 2;
+        body["fog"]["maxOpacity"] = 0.9;
+        body["fog"]["cutoffDistance"] = 500;
+        if (std::string(type) == "HEIGHT") body["fog"]["secondLayer"] = {{"density", 0.01}};
+      }
       if (withRegions)
         body["regions"] = {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "GL_EXP"}}}}};
       auto r = s.postJson("/v1/fog", body);
@@ -160,6 +195,8 @@ TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
       EXPECT_NE(glsl.find("vec3 applyFog(vec3 rgb, vec3 world)"), std::string::npos);
       EXPECT_EQ(glsl.find("fogLogG") != std::string::npos, std::string(type) == "HEIGHT") << type;
       EXPECT_EQ(j["shader"]["uniforms"].contains("uRegionLo"), withRegions);
+      EXPECT_EQ(j["shader"]["uniforms"].contains("uFogEngine"), withRegions);  // only what the fog uses
+      EXPECT_EQ(j["shader"]["uniforms"].contains("uFogLayer2"), withRegions && std::string(type) == "HEIGHT");
       EXPECT_EQ(j["shader"]["uniforms"]["uFogCamera"]["values"], json({0, 1.7, 0}));
       body["shader"]["language"] = "spirv";
       json spirv = json::parse(s.postJson("/v1/fog", body)->body);

@@ -190,6 +190,165 @@ TEST(Fog, HeightTableEntriesEqualTheClosedForm) {
         }
 }
 
+// Engine terms (fog.h): startDistance shifts distance modes, maxOpacity floors f, the cutoff
+// leaves far points unfogged; completeDistance lands where f meets its floor.
+TEST(Fog, EngineTermsFollowTheirDefinitions) {
+  Fog f = make(FogType::kGlExp);
+  f.density = 0.1;
+  f.startDistance = 5;
+  EXPECT_EQ(factor(f, 3.0), 1.0);
+  EXPECT_NEAR(factor(f, 15.0), std::exp(-1.0), 1e-15);
+  f.maxOpacity = 0.6;
+  EXPECT_NEAR(factor(f, 1e3), 0.4, 1e-15);
+  EXPECT_NEAR(factor(f, 10.0), std::exp(-0.5), 1e-15);  // above the floor: untouched
+  f.cutoffDistance = 50;
+  EXPECT_NEAR(factor(f, 49.0), 0.4, 1e-15);
+  EXPECT_EQ(factor(f, 51.0), 1.0);
+  EXPECT_EQ(factor(f, kInf), 1.0);
+  for (FogType t : kAll) {
+    Fog g = make(t);
+    g.startDistance = 3;
+    g.maxOpacity = 0.8;
+    g.cutoffDistance = 70;
+    ASSERT_FALSE(validate(g)) << toString(t);
+    double prev = 1.0;
+    for (double d = 0; d <= 70; d += 0.25) {
+      double w = factor(g, d);
+      EXPECT_TRUE(w >= 1.0 - 0.8 - 1e-15 && w <= 1.0) << toString(t) << " " << d;
+      EXPECT_LE(w, prev + 1e-15) << toString(t) << " " << d;
+      if (d <= 3) EXPECT_EQ(w, t == FogType::kDistanceGaussian ? g.peak : 1.0) << toString(t) << " " << d;
+      prev = w;
+    }
+    EXPECT_EQ(factor(g, 70.5), 1.0) << toString(t);
+  }
+  // Where f meets its floor (or 1/255), for the modes with a continuous inverse.
+  for (FogType t : {FogType::kGlExp, FogType::kGlExp2, FogType::kDistanceExp2, FogType::kDistanceGaussian,
+                    FogType::kHeight, FogType::kX3dExponential, FogType::kGlLinear, FogType::kX3dLinear}) {
+    for (double m : {1.0, 0.9, 0.5}) {
+      Fog g = make(t);
+      g.startDistance = 4;
+      g.maxOpacity = m;
+      if (m == 1.0 && (t == FogType::kX3dLinear || t == FogType::kX3dExponential || t == FogType::kGlLinear)) continue;
+      const double d = completeDistance(g, g.baseHeight);
+      ASSERT_TRUE(std::isfinite(d)) << toString(t) << " " << m;
+      Fog raw = g;
+      raw.maxOpacity = 1.0;
+      const double level = std::min(std::max(1.0 / 255, 1.0 - m), factor(raw, g.startDistance));  // the Gaussian's peak
+      EXPECT_NEAR(factor(raw, d), level, 1e-9) << toString(t) << " " << m;
+      g.cutoffDistance = d / 2;
+      EXPECT_EQ(completeDistance(g, g.baseHeight), d / 2);
+    }
+  }
+  Fog invisible = make(FogType::kGlExp);
+  invisible.maxOpacity = 0;
+  EXPECT_EQ(factor(invisible, 1e9), 1.0);
+}
+
+// Height fog with a start distance and a second layer against ray marching of both layers
+// over the ray's part [start, d] (an independent evaluation of the same integral).
+TEST(Fog, HeightStartAndSecondLayerMatchRayMarching) {
+  Fog f = make(FogType::kHeight);
+  f.density = 0.3;
+  f.heightFalloff = 0.5;
+  f.baseHeight = 1.0;
+  f.startDistance = 7;
+  f.secondLayer = HeightLayer{0.05, 0.08, 4.0};
+  for (double oy : {0.0, 2.0, 9.0})
+    for (double dy : {-0.7, -0.1, 0.0, 0.3, 0.9})
+      for (double d : {3.0, 10.0, 60.0}) {
+        double want = 1.0;
+        if (d > f.startDistance) {
+          const double y = oy + dy * f.startDistance, t = d - f.startDistance;
+          want = std::exp(-(heightOpticalDepthMarched(0.3, 0.5, 1.0, y, dy, t, 200000) +
+                            heightOpticalDepthMarched(0.05, 0.08, 4.0, y, dy, t, 200000)));
+        }
+        EXPECT_NEAR(factorAtElevation(f, oy, dy, d), want, 1e-7) << oy << " " << dy << " " << d;
+      }
+}
+
+TEST(Fog, EngineTermsStiffCases) {
+  for (double b2 : {0.0, 1e-9, 100.0})
+    for (double oy : {-1e4, 0.0, 1.0, 1e4})
+      for (double dy : {-1.0, -1e-9, 0.0, 1e-9, 1.0})
+        for (double d : {0.0, 1e-300, 1.0, 1e30, kInf})
+          for (double start : {0.0, 0.5, 1e30})
+            for (double m : {0.0, 0.37, 1.0}) {
+              Fog f = make(FogType::kHeight);
+              f.heightFalloff = 100.0;
+              f.secondLayer = HeightLayer{2.0, b2, -3.0};
+              f.startDistance = start;
+              f.maxOpacity = m;
+              f.cutoffDistance = 1e-300 < d && d < 1e30 ? 1e20 : kInf;
+              ASSERT_FALSE(validate(f));
+              const double w = factorAtElevation(f, oy, dy, d);
+              EXPECT_TRUE(w >= 1.0 - m && w <= 1.0) << b2 << " " << oy << " " << dy << " " << d << " " << start << " " << m;
+              const double c = completeDistance(f, oy);
+              EXPECT_FALSE(std::isnan(c)) << b2 << " " << oy;
+            }
+}
+
+TEST(Fog, EngineTermsValidation) {
+  auto field = [](Fog f) { return validate(f) ? validate(f)->field : std::string("ok"); };
+  Fog f = make(FogType::kGlExp);
+  f.startDistance = -1;
+  EXPECT_EQ(field(f), "/startDistance");
+  f = make(FogType::kGlExp);
+  f.maxOpacity = 1.5;
+  EXPECT_EQ(field(f), "/maxOpacity");
+  f.maxOpacity = std::nan("");
+  EXPECT_EQ(field(f), "/maxOpacity");
+  f = make(FogType::kGlExp);
+  f.cutoffDistance = 0;
+  EXPECT_EQ(field(f), "/cutoffDistance");
+  f = make(FogType::kGlExp);
+  f.secondLayer = HeightLayer{};
+  EXPECT_EQ(field(f), "/secondLayer");
+  f = make(FogType::kHeight);
+  f.secondLayer = HeightLayer{-1, 0.1, 0};
+  EXPECT_EQ(field(f), "/secondLayer/density");
+  f.secondLayer = HeightLayer{1, kInf, 0};
+  EXPECT_EQ(field(f), "/secondLayer/heightFalloff");
+  f.secondLayer = HeightLayer{1, 0.1, std::nan("")};
+  EXPECT_EQ(field(f), "/secondLayer/baseHeight");
+}
+
+// Tables end at the cutoff by default, reach the opacity floor, and hold exact values.
+TEST(Fog, EngineTermsInTables) {
+  Fog f = make(FogType::kHeight);
+  f.density = 0.2;
+  f.startDistance = 3;
+  f.maxOpacity = 0.75;
+  f.cutoffDistance = 30;
+  f.secondLayer = HeightLayer{0.01, 0.02, 5};
+  TableOptions o;
+  o.size = 65;
+  o.elevations = 9;
+  o.cameraHeight = 1;
+  auto t = buildTable(f, o);
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  EXPECT_EQ(t.value().rangeEnd, completeDistance(f, 1));  // where the floor is reached: before the cutoff
+  EXPECT_LT(t.value().rangeEnd, 30.0);
+  f.cutoffDistance = 8;
+  t = buildTable(f, o);
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  EXPECT_EQ(t.value().rangeEnd, 8.0);  // the cutoff comes first
+  for (size_t j = 0; j < t.value().height; ++j)
+    for (size_t i = 0; i < t.value().width; ++i) {
+      const double dy = -1.0 + 2.0 * double(j) / double(t.value().height - 1);
+      const double d = 8.0 * double(i) / double(t.value().width - 1);
+      EXPECT_NEAR(t.value().factor[j * t.value().width + i], factorAtElevation(f, 1, dy, d), 1e-7) << i << " " << j;
+    }
+  Fog g = make(FogType::kGlExp);
+  g.maxOpacity = 0.5;
+  o = TableOptions{};
+  o.maxError = 1e-3;
+  auto s = buildTable(g, o);
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  EXPECT_LE(s.value().maxError, 1e-3);
+  EXPECT_NEAR(s.value().factor.back(), 0.5, 1e-6);
+  EXPECT_NEAR(s.value().rangeEnd, std::log(2.0) / g.density, 1e-9);
+}
+
 TEST(Fog, Validation) {
   Fog f = make(FogType::kX3dLinear);
   f.visibilityRange = -1;

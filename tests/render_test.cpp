@@ -178,6 +178,25 @@ TEST(Render, FogInARenderMatchesTheFogTableColours) {
       s,
       {{"fogType", "HEIGHT"}, {"color", {0.6, 0.6, 0.7}}, {"density", 0.08}, {"heightFalloff", 0.5}, {"baseHeight", 0}},
       3, 1.5);
+  // Engine terms: a clear first stretch, a ceiling on opacity, nothing fogged past the cutoff
+  // (the last three quads), and height fog's second layer.
+  expectFogMatchesTable(s,
+                        {{"fogType", "GL_EXP"},
+                         {"color", {0.7, 0.75, 0.8}},
+                         {"density", 0.08},
+                         {"startDistance", 8},
+                         {"maxOpacity", 0.7},
+                         {"cutoffDistance", 27}},
+                        0, 0);
+  expectFogMatchesTable(s,
+                        {{"fogType", "HEIGHT"},
+                         {"color", {0.6, 0.6, 0.7}},
+                         {"density", 0.08},
+                         {"heightFalloff", 0.5},
+                         {"startDistance", 6},
+                         {"maxOpacity", 0.9},
+                         {"secondLayer", {{"density", 0.03}, {"heightFalloff", 0.1}, {"baseHeight", 2}}}},
+                        3, 1.5);
 }
 
 double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {

@@ -220,12 +220,21 @@ def check_bubble(body, answer, server):
 
 
 def check_fog(body, answer, server):
-    """A 1-D table's factors never rise with distance: fog only accumulates along a ray."""
+    """A 1-D table's factors never rise with distance: fog only accumulates along a ray, up to
+    the cutoff distance (beyond it f = 1); and never fall below 1 - maxOpacity."""
     table = answer.get("table") or {}
     f = table.get("factor")
     if not f or table.get("elevations"):
         return []
+    floor = 1 - ((body.get("fog") or {}).get("maxOpacity", 1) if isinstance(body.get("fog"), dict) else 1)
+    start, end = table["range"]
+    cutoff = table.get("cutoffDistance", float("inf"))
+    for i in range(len(f)):
+        if f[i] < floor - 1e-6:
+            return [f"table factor {f[i]} at entry {i} is below 1 - maxOpacity = {floor}"]
     for i in range(1, len(f)):
+        if start + (end - start) * i / (len(f) - 1) > cutoff:
+            break
         if f[i] > f[i - 1] + 1e-6:
             return [f"table factor rises with distance at entry {i}: {f[i - 1]} -> {f[i]}"]
     return []

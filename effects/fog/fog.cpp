@@ -10,7 +10,7 @@ namespace effects::fog {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-const double kLn255 = std::log(255.0);
+const double kLn255 = std::log(255.0);  // -ln(1/255): complete to 8 bits
 
 bool finite(double v) { return std::isfinite(v); }
 
@@ -58,24 +58,35 @@ std::optional<Error> validate(const Fog& fog) {
     if (!(v >= 0.0) || !finite(v)) return invalid(field, "must be a finite number >= 0");
     return std::nullopt;
   };
+  std::optional<Error> mode;  // the mode's own parameters
   switch (fog.type) {
     case FogType::kX3dLinear:
-    case FogType::kX3dExponential: return nonNegative(fog.visibilityRange, "/visibilityRange");
+    case FogType::kX3dExponential: mode = nonNegative(fog.visibilityRange, "/visibilityRange"); break;
     case FogType::kGlLinear:
       if (!finite(fog.start) || fog.start < 0.0) return invalid("/start", "must be a finite number >= 0");
       if (!finite(fog.end) || !(fog.end > fog.start)) return invalid("/end", "must be finite and greater than start");
-      return std::nullopt;
+      break;
     case FogType::kGlExp:
-    case FogType::kGlExp2: return nonNegative(fog.density, "/density");
+    case FogType::kGlExp2: mode = nonNegative(fog.density, "/density"); break;
     case FogType::kDistanceGaussian:
       if (!(fog.peak > 0.0 && fog.peak <= 1.0)) return invalid("/peak", "must be in (0, 1]");
       [[fallthrough]];
-    case FogType::kDistanceExp2: return nonNegative(fog.distanceCoefficient, "/distanceCoefficient");
+    case FogType::kDistanceExp2: mode = nonNegative(fog.distanceCoefficient, "/distanceCoefficient"); break;
     case FogType::kHeight:
       if (auto e = nonNegative(fog.density, "/density")) return e;
       if (auto e = nonNegative(fog.heightFalloff, "/heightFalloff")) return e;
       if (!finite(fog.baseHeight)) return invalid("/baseHeight", "must be finite");
-      return std::nullopt;
+      break;
+  }
+  if (mode) return mode;
+  if (auto e = nonNegative(fog.startDistance, "/startDistance")) return e;
+  if (!(fog.maxOpacity >= 0.0 && fog.maxOpacity <= 1.0)) return invalid("/maxOpacity", "must be in [0, 1]");
+  if (!(fog.cutoffDistance > 0.0)) return invalid("/cutoffDistance", "must be > 0 (absent: no cutoff)");
+  if (fog.secondLayer) {
+    if (fog.type != FogType::kHeight) return invalid("/secondLayer", "only HEIGHT fog has a second layer");
+    if (auto e = nonNegative(fog.secondLayer->density, "/secondLayer/density")) return e;
+    if (auto e = nonNegative(fog.secondLayer->heightFalloff, "/secondLayer/heightFalloff")) return e;
+    if (!finite(fog.secondLayer->baseHeight)) return invalid("/secondLayer/baseHeight", "must be finite");
   }
   return std::nullopt;
 }
@@ -104,7 +115,10 @@ double heightOpticalDepthMarched(double a, double b, double h, double originY, d
   return sum * dt;
 }
 
-double factor(const Fog& fog, double d) {
+namespace {
+
+// The weight of the mode itself at distance d (start distance already taken off).
+double modeFactor(const Fog& fog, double d) {
   switch (fog.type) {
     case FogType::kX3dLinear: {
       const double v = fog.visibilityRange;
@@ -125,42 +139,90 @@ double factor(const Fog& fog, double d) {
     case FogType::kDistanceExp2: return std::exp(-mulZero(fog.distanceCoefficient, d * d));  // seed 003 eqn 1
     case FogType::kDistanceGaussian:  // seed 003 eqn 2, parameterised (see header)
       return fog.peak * std::exp(-mulZero(fog.distanceCoefficient, d * d));
-    case FogType::kHeight:
-      return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, fog.baseHeight, 0.0, d));
+    case FogType::kHeight: break;  // along a ray: factorAtElevation
   }
   return 1.0;
 }
 
+// Optical depth of the height layers over the part [startDistance, distance] of the ray.
+double heightDepth(const Fog& fog, double originY, double dirY, double distance) {
+  const double s = std::min(fog.startDistance, distance);
+  const double y = s > 0.0 ? originY + dirY * s : originY;
+  const double t = distance - s;
+  double tau = heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, y, dirY, t);
+  if (const auto& l = fog.secondLayer) tau += heightOpticalDepth(l->density, l->heightFalloff, l->baseHeight, y, dirY, t);
+  return tau;
+}
+
+}  // namespace
+
+double engineLimits(const Fog& fog, double distance, double f) {
+  if (distance > fog.cutoffDistance) return 1.0;
+  return std::max(f, 1.0 - fog.maxOpacity);
+}
+
+double factorAtElevation(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.type != FogType::kHeight)
+    return engineLimits(fog, distance, modeFactor(fog, std::max(0.0, distance - fog.startDistance)));
+  return engineLimits(fog, distance, std::exp(-heightDepth(fog, originY, dirY, distance)));
+}
+
+double factor(const Fog& fog, double d) { return factorAtElevation(fog, fog.baseHeight, 0.0, d); }
+
 double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance) {
   if (fog.type != FogType::kHeight) return factor(fog, distance);
   double len = glm::length(direction);
-  if (!(len > 0.0) || !finite(len)) return 1.0;
+  if (!(len > 0.0) || !finite(len)) return engineLimits(fog, distance, 1.0);
   double dirY = std::clamp(direction.y / len, -1.0, 1.0);
-  return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, origin.y, dirY, distance));
+  return factorAtElevation(fog, origin.y, dirY, distance);
 }
 
-double completeDistance(const Fog& fog, double cameraHeight) {
+namespace {
+
+// Distance (from where the fog starts) at which the mode's own weight falls to `level`.
+double modeDistanceTo(const Fog& fog, double level, double cameraHeight) {
+  const bool byte = level <= 1.0 / 255.0;  // complete to 8 bits: where X3D and GL_LINEAR reach 0
+  const double q = byte ? kLn255 : -std::log(level);  // e^-q = level
   switch (fog.type) {
     case FogType::kX3dLinear:
-    case FogType::kX3dExponential: return fog.visibilityRange > 0.0 ? fog.visibilityRange : kInf;
-    case FogType::kGlLinear: return fog.end;
-    case FogType::kGlExp: return fog.density > 0.0 ? kLn255 / fog.density : kInf;
-    case FogType::kGlExp2: return fog.density > 0.0 ? std::sqrt(kLn255) / fog.density : kInf;
-    case FogType::kDistanceExp2:
-      return fog.distanceCoefficient > 0.0 ? std::sqrt(kLn255 / fog.distanceCoefficient) : kInf;
+      if (!(fog.visibilityRange > 0.0)) return kInf;
+      return byte ? fog.visibilityRange : fog.visibilityRange * (1.0 - level);
+    case FogType::kX3dExponential:
+      if (!(fog.visibilityRange > 0.0)) return kInf;
+      return byte ? fog.visibilityRange : fog.visibilityRange * q / (1.0 + q);  // d / (V - d) = q
+    case FogType::kGlLinear: return byte ? fog.end : fog.end - level * (fog.end - fog.start);
+    case FogType::kGlExp: return fog.density > 0.0 ? q / fog.density : kInf;
+    case FogType::kGlExp2: return fog.density > 0.0 ? std::sqrt(q) / fog.density : kInf;
+    case FogType::kDistanceExp2: return fog.distanceCoefficient > 0.0 ? std::sqrt(q / fog.distanceCoefficient) : kInf;
     case FogType::kDistanceGaussian: {
-      double l = std::log(255.0 * fog.peak);
+      double l = std::log(fog.peak / level);
       if (l <= 0.0) return 0.0;
       return fog.distanceCoefficient > 0.0 ? std::sqrt(l / fog.distanceCoefficient) : kInf;
     }
     case FogType::kHeight: {
-      // Horizontal ray: tau = a e^{-b(y-h)} t  ->  t = ln 255 / (a e^{-b(y-h)}), in log space.
-      if (fog.density == 0.0) return kInf;
-      double logT = std::log(kLn255) - std::log(fog.density) + fog.heightFalloff * (cameraHeight - fog.baseHeight);
+      // Horizontal ray: tau = (sum of a e^{-b(y-h)}) t, so t = q / that sum, in log space.
+      auto logDensity = [&](double a, double b, double h) {
+        return a > 0.0 ? std::log(a) - b * (cameraHeight - h) : -kInf;
+      };
+      double l1 = logDensity(fog.density, fog.heightFalloff, fog.baseHeight), l = l1;
+      if (const auto& s = fog.secondLayer) {
+        double l2 = logDensity(s->density, s->heightFalloff, s->baseHeight), hi = std::max(l1, l2);
+        l = hi == -kInf ? -kInf : hi + std::log1p(std::exp(std::min(l1, l2) - hi));
+      }
+      if (l == -kInf) return kInf;
+      double logT = std::log(q) - l;
       return logT > 709.0 ? kInf : std::exp(logT);
     }
   }
   return kInf;
+}
+
+}  // namespace
+
+double completeDistance(const Fog& fog, double cameraHeight) {
+  const double level = std::max(1.0 / 255.0, 1.0 - fog.maxOpacity);
+  const double d = level >= 1.0 ? 0.0 : fog.startDistance + modeDistanceTo(fog, level, cameraHeight);
+  return std::min(d, fog.cutoffDistance);
 }
 
 std::optional<Error> validate(const Region& r) {

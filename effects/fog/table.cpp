@@ -13,8 +13,7 @@ double distAt(const Table& t, double col) {
 }
 
 double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
-  if (fog.type != FogType::kHeight) return factor(fog, d);
-  return std::exp(-heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, cameraHeight, dirY, d));
+  return factorAtElevation(fog, cameraHeight, dirY, d);
 }
 
 // One row of a height fog table (fixed ray elevation) without a logarithm per entry. Along the
@@ -22,12 +21,14 @@ double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
 // k = falloff * dirY, and e^{-k t} - 1 over evenly spaced t follows the recurrence
 // M' = M + rho (M + 1), rho = e^{-k dt} - 1, which keeps its relative precision for small k t
 // (no 1 - e^{-x} cancellation). That leaves one exp per entry. Rows where c or e^{|k| t}
-// could overflow take the closed form per entry (heightOpticalDepth's log-space evaluation).
+// could overflow take the closed form per entry (heightOpticalDepth's log-space evaluation),
+// as do fogs with a start distance or a second layer.
 bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table& t, float* row) {
   const double a = fog.density, b = fog.heightFalloff;
   const double k = b * dirY;
   const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
   if (a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * t.rangeEnd > 700.0) return false;
+  if (fog.startDistance > 0.0 || fog.secondLayer) return false;
   const double c = std::exp(logC);
   const double dt = (t.rangeEnd - t.rangeStart) / double(t.width - 1);
   const double rho = std::expm1(-k * dt);
@@ -35,7 +36,7 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
   for (size_t i = 0; i < t.width; ++i) {
     const double d = t.rangeStart + dt * double(i);
     const double tau = k == 0.0 ? c * d : c * (-m / k);
-    row[i] = static_cast<float>(std::exp(-tau));
+    row[i] = static_cast<float>(engineLimits(fog, d, std::exp(-tau)));
     m += rho * (m + 1.0);
   }
   return true;
@@ -176,7 +177,8 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   double end = o.rangeEnd ? *o.rangeEnd : completeDistance(fog, o.cameraHeight);
   if (!std::isfinite(start) || start < 0.0) return invalid("/range/0", "must be a finite distance >= 0");
   if (!o.rangeEnd && !(std::isfinite(end) && end > start))
-    return unsatisfiable("/range", "this fog never reaches 1/255 within a finite distance; give range explicitly");
+    return unsatisfiable("/range", "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) at a finite "
+                                   "distance beyond range[0]; give range explicitly");
   if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
 
   constexpr int kSub1D = 8, kSub2D = 4;

@@ -19,9 +19,15 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
-  std::vector<double> types, params, colors, lo, hi;
+  const detail::FogVariant variant = detail::fogVariant(f);
+  std::vector<double> types, params, colors, lo, hi, engine, layer2;
   auto add = [&](const fog::Fog& g) {
     types.push_back(int(g.type));
+    const double cutoff = std::isfinite(g.cutoffDistance) ? g.cutoffDistance : 0.0;
+    for (double x : {g.startDistance, cutoff, 1.0 - g.maxOpacity, 0.0}) engine.push_back(x);
+    const fog::HeightLayer l = g.secondLayer.value_or(fog::HeightLayer{});
+    for (double x : {l.density > 0 ? std::log(l.density) : 0.0, l.heightFalloff, l.baseHeight, l.density > 0 ? 1.0 : 0.0})
+      layer2.push_back(x);
     glm::dvec4 q(0);
     switch (g.type) {
       case fog::FogType::kX3dLinear:
@@ -51,6 +57,8 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
                                          {"uFogType", "int" + slots, types},
                                          {"uFogParams", "vec4" + slots, params},
                                          {"uFogColor", "vec3" + slots, colors}};
+  if (variant.engine()) out.push_back({"uFogEngine", "vec4" + slots, engine});
+  if (variant.secondLayer) out.push_back({"uFogLayer2", "vec4" + slots, layer2});
   if (!order.empty()) {
     out.push_back({"uRegionLo", "vec4" + regions, lo});
     out.push_back({"uRegionHi", "vec4" + regions, hi});

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,6 +41,14 @@ enum class FogType {
 // full colour (the paper's curve starts at 0.399); peak = 1 makes it identical to eqn 1.
 inline constexpr double kPaperGaussianPeak = 0.3989422804014327;  // 1/sqrt(2*pi)
 
+// Height fog's second layer (Unreal's Second Fog Data): density a2 * e^(-b2 (y - h2)), its
+// optical depth added to the first layer's, exactly.
+struct HeightLayer {
+  double density = 0.0;        // a2 >= 0 at baseHeight
+  double heightFalloff = 0.1;  // b2 >= 0
+  double baseHeight = 0.0;     // h2
+};
+
 struct Fog {
   FogType type = FogType::kX3dLinear;
   glm::dvec3 color{1.0, 1.0, 1.0};    // X3D default 1 1 1; each component in [0, 1]
@@ -50,6 +59,16 @@ struct Fog {
   double peak = kPaperGaussianPeak;   // kDistanceGaussian only, in (0, 1]
   double heightFalloff = 0.1;         // height fog b >= 0: density a * e^(-b (y - h))
   double baseHeight = 0.0;            // height fog h
+  // What engines add on top of every mode (Unreal ExponentialHeightFog, Filament FogOptions;
+  // docs/effects.md), applied in this order:
+  double startDistance = 0.0;  // >= 0: the first part of every ray is clear (Unreal StartDistance,
+                               // Filament distance): distance modes see max(0, d - start), height
+                               // fog integrates from start to d
+  double maxOpacity = 1.0;     // in [0, 1]: fog never hides more than this, f >= 1 - maxOpacity
+                               // (Unreal FogMaxOpacity, Filament maximumOpacity)
+  double cutoffDistance = std::numeric_limits<double>::infinity();  // > 0: beyond it f = 1, unfogged
+                               // (Unreal FogCutoffDistance, Filament cutOffDistance: the skybox)
+  std::optional<HeightLayer> secondLayer;  // kHeight only
 };
 
 // Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT").
@@ -67,6 +86,12 @@ double factor(const Fog& fog, double distance);
 // length (a zero direction means distance 0). Distance-based modes use `distance` only.
 double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance);
 
+// The same for a ray from height originY whose unit direction has y component dirY.
+double factorAtElevation(const Fog& fog, double originY, double dirY, double distance);
+
+// maxOpacity and cutoffDistance applied to the weight f of a point at `distance`.
+double engineLimits(const Fog& fog, double distance, double f);
+
 // Exact optical depth of density a * e^(-b (y - h)) along the ray from height originY with
 // unit-vector y component dirY over length t (t may be +infinity):
 //   tau = a * e^(-b (originY - h)) * t * g(b * dirY * t),  g(x) = (1 - e^(-x)) / x,
@@ -78,8 +103,9 @@ double heightOpticalDepth(double a, double b, double h, double originY, double d
 // the closed form is measured against; t must be finite).
 double heightOpticalDepthMarched(double a, double b, double h, double originY, double dirY, double t, int steps);
 
-// Distance where f first reaches 1/255 ("complete to 8 bits"); infinity if never.
-// For kHeight: along a horizontal ray from cameraHeight.
+// Distance where f first reaches 1/255 ("complete to 8 bits"), or its floor 1 - maxOpacity
+// when that is higher; infinity if never; cutoffDistance when that is nearer (beyond it the
+// fog is gone). For kHeight: along a horizontal ray from cameraHeight.
 double completeDistance(const Fog& fog, double cameraHeight = 0.0);
 
 // X3D LocalFog generalised: a region with its own fog. Regions are closed sets (a point on
