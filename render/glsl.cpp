@@ -16,6 +16,7 @@ std::string FogVariant::key() const {
   if (cutoff) k += ":cutoff";
   if (opacity) k += ":maxOpacity";
   if (secondLayer) k += ":secondLayer";
+  if (directional) k += ":directional";
   return k;
 }
 
@@ -27,6 +28,7 @@ FogVariant fogVariant(const Fog& f) {
     v.cutoff |= std::isfinite(g.cutoffDistance);
     v.opacity |= g.maxOpacity < 1.0;
     v.secondLayer |= g.secondLayer.has_value();
+    v.directional |= g.directional.has_value();
   };
   add(f.global);
   for (const auto& r : f.regions) add(r.fog);
@@ -51,9 +53,14 @@ std::string fogGlsl(const FogVariant& v) {
       << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
   if (v.engine()) s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity\n";
   if (v.secondLayer) s << "uniform vec4 uFogLayer2[" << slots << "];  // HEIGHT's second layer: log a, b, h, a > 0\n";
-  // With a start distance or a second layer, height fog sums layers along the ray's part
-  // [start, d] (fogHeightTau); otherwise the one-layer form below it.
-  const bool layered = v.start || v.secondLayer;
+  if (v.directional)
+    s << "uniform vec4 uFogSun[" << slots << "];       // unit direction to the sun; w: HG g in (-1, 1), or 2 + exponent\n"
+      << "uniform vec4 uFogSunColor[" << slots << "];  // rgb (0: no glow in this slot); w: the glow's start distance\n";
+  // With a start distance (the fog's or the glow's) the mode is evaluated over the ray's part
+  // [s, d], s a parameter; with that or a second layer, height fog sums layers along it
+  // (fogHeightTau); otherwise the one-layer form below it.
+  const bool startParam = v.start || v.directional;
+  const bool layered = startParam || v.secondLayer;
   if (has(T::kHeight))
     s << "float fogLogG(float x) {  // log((1 - e^-x) / x), stable for every x\n"
          "  if (abs(x) < 1e-3) return -0.5 * x + x * x / 24.0;\n"
@@ -67,13 +74,14 @@ std::string fogGlsl(const FogVariant& v) {
          "  if (q.y == 0.0) return exp(min(q.x + log(t), 80.0));\n"
          "  return exp(min(q.x - q.y * (y0 - q.z) + log(t) + fogLogG(q.y * dirY * t), 80.0));\n"
          "}\n";
-  s << (v.engine() ? "float fogMode(int slot, vec3 ray, float d) {\n" : "float fogFactor(int slot, vec3 world) {\n"
-                                                                       "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n")
+  s << (startParam   ? "float fogMode(int slot, vec3 ray, float d, float start) {\n"
+        : v.engine() ? "float fogMode(int slot, vec3 ray, float d) {\n"
+                     : "float fogFactor(int slot, vec3 world) {\n  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n")
     << "  vec4 q = uFogParams[slot];\n  int type = uFogType[slot];\n";
   if (layered)
     s << "  float dirY = d > 0.0 ? ray.y / d : 0.0;\n"
-      << (v.start ? "  float s = min(uFogEngine[slot].x, d);\n  float y0 = uFogCamera.y + dirY * s;\n  d -= s;\n"
-                  : "  float y0 = uFogCamera.y;\n");
+      << (startParam ? "  float s = min(start, d);\n  float y0 = uFogCamera.y + dirY * s;\n  d -= s;\n"
+                     : "  float y0 = uFogCamera.y;\n");
   for (T t : v.types) {
     s << "  if (type == " << int(t) << ") {  // " << fog::toString(t) << "\n";
     switch (t) {
@@ -101,13 +109,28 @@ std::string fogGlsl(const FogVariant& v) {
     s << "  }\n";
   }
   s << "  return 1.0;\n}\n";
-  if (v.engine()) {  // fog.h's order: start (above), maxOpacity, cutoff
+  if (v.engine()) {  // fog.h's order: start (fogMode), maxOpacity, cutoff
+    const std::string mode = startParam ? "fogMode(slot, ray, d, e.x)" : "fogMode(slot, ray, d)";
     s << "float fogFactor(int slot, vec3 world) {\n"
          "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
          "  vec4 e = uFogEngine[slot];\n";
     if (v.cutoff) s << "  if (e.y > 0.0 && d > e.y) return 1.0;\n";
-    s << (v.opacity ? "  return max(fogMode(slot, ray, d), e.z);\n" : "  return fogMode(slot, ray, d);\n") << "}\n";
+    s << (v.opacity ? "  return max(" + mode + ", e.z);\n" : "  return " + mode + ";\n") << "}\n";
   }
+  if (v.directional)  // fog::inscatterWeight * color * fog::lobe
+    s << "vec3 fogSunGlow(int slot, vec3 world) {\n"
+         "  vec4 sun = uFogSun[slot], sc = uFogSunColor[slot];\n"
+         "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
+         "  if (d == 0.0 || dot(sc.rgb, sc.rgb) == 0.0) return vec3(0.0);\n"
+         "  vec4 e = uFogEngine[slot];\n"
+         "  if (e.y > 0.0 && d > e.y) return vec3(0.0);\n"
+         "  float w = 1.0 - max(fogMode(slot, ray, d, max(e.x, sc.w)), e.z);\n"
+         "  float c = clamp(dot(ray / d, sun.xyz), -1.0, 1.0);\n"
+         "  float g = sun.w;\n"
+         "  float den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);\n"
+         "  float lobe = g < 1.5 ? (1.0 - g) * (1.0 + g) / (den * sqrt(den)) : (c > 0.0 ? pow(c, g - 2.0) : 0.0);\n"
+         "  return w * sc.rgb * lobe;\n"
+         "}\n";
   s << "int fogSlot(vec3 p) {\n";
   if (v.regions)
     s << "  for (int i = 0; i < " << v.regions << "; ++i) {\n"
@@ -118,7 +141,8 @@ std::string fogGlsl(const FogVariant& v) {
   s << "  return 0;\n}\n"
        "vec3 applyFog(vec3 rgb, vec3 world) {\n"
        "  int slot = fogSlot(world);\n"
-       "  return mix(uFogColor[slot], rgb, fogFactor(slot, world));\n}\n";
+    << (v.directional ? "  return mix(uFogColor[slot], rgb, fogFactor(slot, world)) + fogSunGlow(slot, world);\n}\n"
+                      : "  return mix(uFogColor[slot], rgb, fogFactor(slot, world));\n}\n");
   return s.str();
 }
 

@@ -29,8 +29,8 @@ struct FogVariant {
   std::vector<fog::FogType> types;  // distinct, sorted
   size_t regions = 0;
   // The engine terms some slot uses (fog.h): only those are compiled in.
-  bool start = false, cutoff = false, opacity = false, secondLayer = false;
-  bool engine() const { return start || cutoff || opacity; }
+  bool start = false, cutoff = false, opacity = false, secondLayer = false, directional = false;
+  bool engine() const { return start || cutoff || opacity || directional; }
   std::string key() const;
 };
 FogVariant fogVariant(const Fog& fog);

@@ -38,6 +38,16 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
     layer.baseHeight = l.value("baseHeight", layer.baseHeight);
     f.secondLayer = layer;
   }
+  if (j.contains("directional")) {
+    const json& d = j["directional"];
+    fog::Directional dir;
+    if (d.contains("color")) dir.color = toVec3(d["color"]);
+    if (d.contains("direction")) dir.direction = toVec3(d["direction"]);
+    dir.g = d.value("g", dir.g);
+    if (d.contains("exponent")) dir.exponent = d["exponent"].get<double>();
+    dir.startDistance = d.value("startDistance", dir.startDistance);
+    f.directional = dir;
+  }
   if (auto e = fog::validate(f)) throwError(*e, pointer);
   return f;
 }
@@ -61,21 +71,30 @@ fog::Region parseRegion(const json& j, const std::string& pointer) {
 
 namespace {
 
+void appendEncoded(std::string& bytes, float c, const std::string& encoding) {
+  if (encoding == "rgba8") {
+    bytes += char(static_cast<uint8_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)));
+  } else {
+    uint16_t h = floatToHalf(c);
+    bytes += char(h & 0xFF);
+    bytes += char(h >> 8);
+  }
+}
+
+// One channel per entry (the directional glow's weight), in the table's encoding.
+std::string encodeChannel(const std::vector<float>& values, const std::string& encoding) {
+  std::string bytes;
+  for (float v : values) appendEncoded(bytes, v, encoding);
+  return base64Encode(bytes);
+}
+
 std::string encodeTexels(const fog::Table& t, const fog::Fog& f, const std::string& encoding) {
   // Texel = ((1 - f) * fogColor, f): the shader computes objectColour * a + rgb.
   std::string bytes;
   bytes.reserve(t.factor.size() * (encoding == "rgba8" ? 4 : 8));
   for (float w : t.factor) {
     float texel[4] = {float((1 - w) * f.color.r), float((1 - w) * f.color.g), float((1 - w) * f.color.b), w};
-    for (float c : texel) {
-      if (encoding == "rgba8") {
-        bytes += char(static_cast<uint8_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)));
-      } else {
-        uint16_t h = floatToHalf(c);
-        bytes += char(h & 0xFF);
-        bytes += char(h >> 8);
-      }
-    }
+    for (float c : texel) appendEncoded(bytes, c, encoding);
   }
   return base64Encode(bytes);
 }
@@ -101,6 +120,7 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
     }
     out["factor"] = std::move(factor);
     out["fogContribution"] = std::move(contribution);
+    if (!t.inscatter.empty()) out["inscatter"] = json(t.inscatter);
     if (!objectColors.is_null()) {
       json finals = json::array();
       for (const auto& oc : objectColors) {
@@ -116,7 +136,10 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
     out["texelLayout"] = "RGBA = ((1-f)*fogColor, f), row-major, " +
                          std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
     out["data"] = encodeTexels(t, f, encoding);
+    if (!t.inscatter.empty()) out["inscatterData"] = encodeChannel(t.inscatter, encoding);
   }
+  if (!t.inscatter.empty())
+    out["inscatterLayout"] = "1 - f_dir per entry, as factor; colour += inscatter * directional.color * lobe(cos theta)";
   return out;
 }
 

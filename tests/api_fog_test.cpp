@@ -151,6 +151,26 @@ TEST(FogApi, EngineTermsInTablesAndErrors) {
   EXPECT_TRUE(hasPointer(p, "/fog/cutoffDistance")) << p;
 }
 
+TEST(FogApi, DirectionalGlowInTables) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "GL_EXP"}, {"density", 0.05}, {"directional", {{"g", 0.8}, {"startDistance", 5}}}}},
+              {"table", {{"size", 17}}}};
+  json t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
+  ASSERT_EQ(t["inscatter"].size(), 17u);
+  EXPECT_EQ(t["inscatter"][0], 0.0);
+  EXPECT_GT(t["inscatter"][16].get<double>(), 0.9);
+  req["table"]["encoding"] = "rgba16f";
+  t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
+  auto bytes = base64Decode(t["inscatterData"].get<std::string>());
+  ASSERT_TRUE(bytes);
+  EXPECT_EQ(bytes->size(), 17u * 2);
+  auto p = expectProblem(
+      s.postJson("/v1/fog", json{{"fog", {{"directional", {{"direction", {0, 0, 0}}}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/directional/direction")) << p;
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"directional", {{"g", 1}}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/directional/g")) << p;
+}
+
 TEST(FogApi, TableOverTheLimitIs413) {
   Config c = TestServer::quietConfig();
   c.limits.maxTableSize = 1000;
@@ -185,6 +205,7 @@ TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
         body["fog"]["maxOpacity"] = 0.9;
         body["fog"]["cutoffDistance"] = 500;
         if (std::string(type) == "HEIGHT") body["fog"]["secondLayer"] = {{"density", 0.01}};
+        body["fog"]["directional"] = {{"g", 0.6}};
       }
       if (withRegions)
         body["regions"] = {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "GL_EXP"}}}}};

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <limits>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include <effects/fog.h>
@@ -347,6 +348,97 @@ TEST(Fog, EngineTermsInTables) {
   EXPECT_LE(s.value().maxError, 1e-3);
   EXPECT_NEAR(s.value().factor.back(), 0.5, 1e-6);
   EXPECT_NEAR(s.value().rangeEnd, std::log(2.0) / g.density, 1e-9);
+}
+
+// The directional lobe: 4 pi HG averages 1 over the sphere for every g, g = 0 is flat, g near
+// +-1 stays finite; Unreal's form is the plain power.
+TEST(Fog, DirectionalLobe) {
+  for (double g : {-0.9, -0.3, 0.0, 0.5, 0.9, 0.99}) {
+    Directional d;
+    d.g = g;
+    double sum = 0;  // (1/4pi) * integral over the sphere = (1/2) * integral of lobe(c) dc on [-1, 1]
+    const int n = 400000;
+    for (int i = 0; i < n; ++i) sum += lobe(d, -1.0 + 2.0 * (i + 0.5) / n);
+    EXPECT_NEAR(sum / n, 1.0, 2e-3) << g;
+    if (g == 0.0) EXPECT_DOUBLE_EQ(lobe(d, 0.3), 1.0);
+  }
+  for (double g : {-0.999999999, 0.999999999}) {
+    Directional d;
+    d.g = g;
+    for (double c : {-1.0, -0.5, 0.0, 0.999999, 1.0}) {
+      double v = lobe(d, c);
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << g << " " << c << " " << v;
+    }
+  }
+  Directional u;
+  u.exponent = 8;
+  EXPECT_DOUBLE_EQ(lobe(u, 0.5), std::pow(0.5, 8));
+  EXPECT_EQ(lobe(u, -0.5), 0.0);
+}
+
+// The glow's weight is 1 - f over the ray's part beyond its start, under the fog's own rules,
+// and shade() adds it to the fog colour.
+TEST(Fog, DirectionalInscattering) {
+  Fog f = make(FogType::kHeight);
+  f.density = 0.2;
+  f.heightFalloff = 0.3;
+  f.startDistance = 2;
+  f.maxOpacity = 0.9;
+  f.cutoffDistance = 80;
+  EXPECT_EQ(inscatterWeight(f, 0, 0.1, 30), 0.0);  // no directional
+  Directional sun;
+  sun.direction = {0, 0.1, -1};
+  sun.startDistance = 10;
+  sun.g = 0.6;
+  sun.color = {4, 2, 1};
+  f.directional = sun;
+  ASSERT_FALSE(validate(f));
+  Fog beyond = f;
+  beyond.startDistance = 10;
+  for (double dy : {-0.5, 0.0, 0.2})
+    for (double d : {5.0, 10.0, 30.0, 79.0, 81.0}) {
+      double w = inscatterWeight(f, 1.0, dy, d);
+      EXPECT_DOUBLE_EQ(w, 1.0 - factorAtElevation(beyond, 1.0, dy, d)) << dy << " " << d;
+      EXPECT_TRUE(w >= 0 && w <= 0.9 + 1e-15) << dy << " " << d;
+      if (d <= 10 || d > 80) EXPECT_EQ(w, 0.0) << dy << " " << d;
+    }
+  const glm::dvec3 eye(0, 1, 0), obj(0.2, 0.4, 0.1);
+  for (glm::dvec3 p : {glm::dvec3(0, 1.5, -40), glm::dvec3(30, 0, -5), glm::dvec3(0, 1, 40)}) {
+    const glm::dvec3 ray = p - eye;
+    const double d = glm::length(ray), fw = factor(f, eye, ray, d);
+    const glm::dvec3 want = fw * obj + (1 - fw) * f.color + inscatterWeight(f, 1.0, ray.y / d, d) * sun.color *
+                                                                 lobe(sun, glm::dot(ray / d, glm::normalize(sun.direction)));
+    const glm::dvec3 got = shade(f, obj, eye, p);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-12);
+  }
+  EXPECT_GT(shade(f, obj, eye, {0, 1.5, -40}).r, shade(f, obj, eye, {0, 1.5, 40}).r);  // brighter towards the sun
+  // Tables carry 1 - f_dir beside f, exactly, and their error covers it.
+  TableOptions o;
+  o.size = 33;
+  o.elevations = 5;
+  o.cameraHeight = 1;
+  auto t = buildTable(f, o);
+  ASSERT_TRUE(t.ok());
+  ASSERT_EQ(t.value().inscatter.size(), t.value().factor.size());
+  for (size_t j = 0; j < 5; ++j)
+    for (size_t i = 0; i < 33; ++i) {
+      const double dy = -1.0 + 0.5 * double(j), d = t.value().rangeStart + (t.value().rangeEnd - t.value().rangeStart) * double(i) / 32;
+      EXPECT_NEAR(t.value().inscatter[j * 33 + i], inscatterWeight(f, 1, dy, d), 1e-7);
+    }
+  // Validation names the field.
+  auto field = [](Fog g) { return validate(g) ? validate(g)->field : std::string("ok"); };
+  Fog bad = f;
+  bad.directional->g = 1.0;
+  EXPECT_EQ(field(bad), "/directional/g");
+  bad = f;
+  bad.directional->direction = {0, 0, 0};
+  EXPECT_EQ(field(bad), "/directional/direction");
+  bad = f;
+  bad.directional->color = {1, -1, 0};
+  EXPECT_EQ(field(bad), "/directional/color/1");
+  bad = f;
+  bad.directional->exponent = 0;
+  EXPECT_EQ(field(bad), "/directional/exponent");
 }
 
 TEST(Fog, Validation) {

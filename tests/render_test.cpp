@@ -199,6 +199,55 @@ TEST(Render, FogInARenderMatchesTheFogTableColours) {
                         3, 1.5);
 }
 
+// A sun low ahead: each quad's centre pixel must be the fog's colour (the table's final colour)
+// plus the glow, inscatter * colour * lobe(angle to the sun), from the same answer.
+TEST(Render, FogGlowsTowardsTheSun) {
+  TestServer s;
+  const json fogDef = {{"fogType", "GL_EXP"},
+                       {"color", {0.25, 0.3, 0.4}},
+                       {"density", 0.04},
+                       {"startDistance", 3},
+                       {"directional", {{"color", {1.2, 0.6, 0.2}}, {"direction", {0.5, 0, -1}}, {"g", 0.5}, {"startDistance", 6}}}};
+  const double range = 40;
+  const int size = 9;
+  auto t = s.postJson("/v1/fog", json{{"fog", fogDef}, {"table", {{"size", size}, {"range", {0, range}}}},
+                                      {"objectColors", {{0.1, 0.1, 0.1}}}});
+  ASSERT_EQ(t->status, 200) << t->body;
+  const json table = json::parse(t->body)["table"];
+  const int W = 256, H = 128;
+  json scene = {{"width", W},
+                {"height", H},
+                {"camera", {{"position", {0, 0, 0}}, {"target", {0, 0, -1}}, {"fovY", 60}}},
+                {"background", {{"color", {0, 0, 0}}}},
+                {"fog", {{"fog", fogDef}}},
+                {"quads", json::array()}};
+  const double aspect = double(W) / H, tanHalf = std::tan(30.0 * M_PI / 180);
+  const glm::dvec3 toSun = glm::normalize(glm::dvec3(0.5, 0, -1));
+  std::vector<std::tuple<int, int, glm::dvec3>> expected;
+  for (int i = 1; i < size; ++i) {
+    const double d = range * i / (size - 1);
+    const double ndcX = -0.85 + 1.7 * (i - 1) / (size - 2);
+    const double angle = std::atan(ndcX * tanHalf * aspect);
+    const glm::dvec3 dir(std::sin(angle), 0, -std::cos(angle)), c = dir * d;
+    scene["quads"].push_back({{"center", {c.x, c.y, c.z}}, {"normal", {-dir.x, 0, -dir.z}}, {"size", {0.02 * d, 0.02 * d}},
+                              {"color", {0.1, 0.1, 0.1}}});
+    const double g = 0.5, cosT = glm::dot(dir, toSun), den = (1 - g) * (1 - g) + 2 * g * (1 - cosT);
+    const double lobe = (1 - g) * (1 + g) / (den * std::sqrt(den));
+    glm::dvec3 want;
+    for (int k = 0; k < 3; ++k)
+      want[k] = table["finalColors"][0][size_t(i) * 3 + size_t(k)].get<double>() +
+                table["inscatter"][size_t(i)].get<double>() * fogDef["directional"]["color"][size_t(k)].get<double>() * lobe;
+    expected.emplace_back(int(std::floor((ndcX * 0.5 + 0.5) * W)), H / 2, want);
+  }
+  auto r = render(s, scene);
+  ASSERT_EQ(r->status, 200) << r->body;
+  rd::Image img = decode(r->body);
+  for (const auto& [x, y, want] : expected) {
+    glm::vec4 got = pixel(img, x, y);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], std::min(want[c], 1.0), 2.0 / 255) << x << " channel " << c;
+  }
+}
+
 double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
   glm::dvec2 ab = b - a;
   double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;

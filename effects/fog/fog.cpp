@@ -82,6 +82,17 @@ std::optional<Error> validate(const Fog& fog) {
   if (auto e = nonNegative(fog.startDistance, "/startDistance")) return e;
   if (!(fog.maxOpacity >= 0.0 && fog.maxOpacity <= 1.0)) return invalid("/maxOpacity", "must be in [0, 1]");
   if (!(fog.cutoffDistance > 0.0)) return invalid("/cutoffDistance", "must be > 0 (absent: no cutoff)");
+  if (const auto& d = fog.directional) {
+    for (int i = 0; i < 3; ++i)
+      if (!(d->color[i] >= 0.0) || !finite(d->color[i]))
+        return invalid("/directional/color/" + std::to_string(i), "must be a finite number >= 0");
+    const double len = glm::length(d->direction);
+    if (!(len > 0.0) || !finite(len)) return invalid("/directional/direction", "must be a finite non-zero vector");
+    if (!(d->g > -1.0 && d->g < 1.0)) return invalid("/directional/g", "must be in (-1, 1)");
+    if (d->exponent && !(*d->exponent > 0.0 && finite(*d->exponent)))
+      return invalid("/directional/exponent", "must be a finite number > 0");
+    if (auto e = nonNegative(d->startDistance, "/directional/startDistance")) return e;
+  }
   if (fog.secondLayer) {
     if (fog.type != FogType::kHeight) return invalid("/secondLayer", "only HEIGHT fog has a second layer");
     if (auto e = nonNegative(fog.secondLayer->density, "/secondLayer/density")) return e;
@@ -168,6 +179,35 @@ double factorAtElevation(const Fog& fog, double originY, double dirY, double dis
 }
 
 double factor(const Fog& fog, double d) { return factorAtElevation(fog, fog.baseHeight, 0.0, d); }
+
+double inscatterWeight(const Fog& fog, double originY, double dirY, double distance) {
+  if (!fog.directional) return 0.0;
+  Fog beyond = fog;  // the same fog, over the ray's part where the glow starts
+  beyond.startDistance = std::max(fog.startDistance, fog.directional->startDistance);
+  return 1.0 - factorAtElevation(beyond, originY, dirY, distance);
+}
+
+double lobe(const Directional& d, double cosTheta) {
+  const double c = std::clamp(cosTheta, -1.0, 1.0);
+  if (d.exponent) return c > 0.0 ? std::pow(c, *d.exponent) : 0.0;
+  const double g = d.g;
+  // 1 + g^2 - 2gc as a sum of two non-negative terms (no cancellation as |g| -> 1)
+  const double den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);
+  return (1.0 - g) * (1.0 + g) / (den * std::sqrt(den));
+}
+
+glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point) {
+  const glm::dvec3 ray = point - eye;
+  const double d = glm::length(ray);
+  const double f = factor(fog, eye, ray, d);
+  glm::dvec3 c = f * object + (1.0 - f) * fog.color;
+  if (fog.directional && d > 0.0) {
+    const double dirY = std::clamp(ray.y / d, -1.0, 1.0);
+    c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color *
+         lobe(*fog.directional, glm::dot(ray / d, glm::normalize(fog.directional->direction)));
+  }
+  return c;
+}
 
 double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance) {
   if (fog.type != FogType::kHeight) return factor(fog, distance);

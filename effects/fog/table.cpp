@@ -44,8 +44,12 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
 
 void fill(const Fog& fog, double cameraHeight, Table& t) {
   t.factor.resize(t.width * t.height);
+  if (fog.directional) t.inscatter.resize(t.width * t.height);
   for (size_t j = 0; j < t.height; ++j) {
     double dirY = dirYAt(t, double(j));
+    if (fog.directional)
+      for (size_t i = 0; i < t.width; ++i)
+        t.inscatter[j * t.width + i] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, distAt(t, double(i))));
     float* row = t.factor.data() + j * t.width;
     if (fog.type == FogType::kHeight && fillHeightRow(fog, cameraHeight, dirY, t, row)) continue;
     for (size_t i = 0; i < t.width; ++i) row[i] = static_cast<float>(exact(fog, cameraHeight, distAt(t, double(i)), dirY));
@@ -70,6 +74,7 @@ Result<Table> sized(const Fog& fog, const TableOptions& o, size_t width, size_t 
 
 double measureTableError(const Fog& fog, const Table& t, double cameraHeight, int sub, double* where) {
   double worst = 0.0, worstAt = t.rangeStart;
+  const bool both = fog.directional && t.inscatter.size() == t.factor.size();
   const size_t rows = t.height == 1 ? 1 : (t.height - 1) * size_t(sub) + 1;
   const size_t cols = (t.width - 1) * size_t(sub) + 1;
   for (size_t r = 0; r < rows; ++r) {
@@ -80,12 +85,15 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
       double col = double(c) / sub;
       size_t i0 = std::min(size_t(col), t.width - 1), i1 = std::min(i0 + 1, t.width - 1);
       double fx = col - double(i0);
-      auto at = [&](size_t j, size_t i) { return double(t.factor[j * t.width + i]); };
-      double lerp0 = at(j0, i0) + (at(j0, i1) - at(j0, i0)) * fx;
-      double lerp1 = at(j1, i0) + (at(j1, i1) - at(j1, i0)) * fx;
-      double approx = lerp0 + (lerp1 - lerp0) * fy;
+      auto lerp = [&](const std::vector<float>& v) {
+        auto at = [&](size_t j, size_t i) { return double(v[j * t.width + i]); };
+        double lerp0 = at(j0, i0) + (at(j0, i1) - at(j0, i0)) * fx;
+        double lerp1 = at(j1, i0) + (at(j1, i1) - at(j1, i0)) * fx;
+        return lerp0 + (lerp1 - lerp0) * fy;
+      };
       double d = distAt(t, col);
-      double e = std::fabs(approx - exact(fog, cameraHeight, d, dirYAt(t, row)));
+      double e = std::fabs(lerp(t.factor) - exact(fog, cameraHeight, d, dirYAt(t, row)));
+      if (both) e = std::max(e, std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, dirYAt(t, row), d)));
       if (e > worst) {
         worst = e;
         worstAt = d;

@@ -20,7 +20,7 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
   const detail::FogVariant variant = detail::fogVariant(f);
-  std::vector<double> types, params, colors, lo, hi, engine, layer2;
+  std::vector<double> types, params, colors, lo, hi, engine, layer2, sun, sunColor;
   auto add = [&](const fog::Fog& g) {
     types.push_back(int(g.type));
     const double cutoff = std::isfinite(g.cutoffDistance) ? g.cutoffDistance : 0.0;
@@ -28,6 +28,11 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
     const fog::HeightLayer l = g.secondLayer.value_or(fog::HeightLayer{});
     for (double x : {l.density > 0 ? std::log(l.density) : 0.0, l.heightFalloff, l.baseHeight, l.density > 0 ? 1.0 : 0.0})
       layer2.push_back(x);
+    const fog::Directional dir = g.directional.value_or(fog::Directional{});
+    const glm::dvec3 toSun = glm::normalize(dir.direction);
+    const glm::dvec3 glow = g.directional ? dir.color : glm::dvec3(0);
+    for (double x : {toSun.x, toSun.y, toSun.z, dir.exponent ? 2.0 + *dir.exponent : dir.g}) sun.push_back(x);
+    for (double x : {glow.r, glow.g, glow.b, dir.startDistance}) sunColor.push_back(x);
     glm::dvec4 q(0);
     switch (g.type) {
       case fog::FogType::kX3dLinear:
@@ -59,6 +64,10 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
                                          {"uFogColor", "vec3" + slots, colors}};
   if (variant.engine()) out.push_back({"uFogEngine", "vec4" + slots, engine});
   if (variant.secondLayer) out.push_back({"uFogLayer2", "vec4" + slots, layer2});
+  if (variant.directional) {
+    out.push_back({"uFogSun", "vec4" + slots, sun});
+    out.push_back({"uFogSunColor", "vec4" + slots, sunColor});
+  }
   if (!order.empty()) {
     out.push_back({"uRegionLo", "vec4" + regions, lo});
     out.push_back({"uRegionHi", "vec4" + regions, hi});

@@ -49,6 +49,25 @@ struct HeightLayer {
   double baseHeight = 0.0;     // h2
 };
 
+// Directional in-scattering: light from a sun scattered towards the viewer (Unreal's
+// DirectionalInscattering*, the glow of fog towards a low sun). Over the part of the ray
+// beyond startDistance the fog scatters `color` with a phase lobe of the angle theta between
+// the view ray and `direction`:  C += (1 - f_dir) * color * lobe(cos theta), f_dir the fog's
+// weight over that part (fog.h's rules: start, maxOpacity, cutoff). Because the lobe is the
+// same all along a ray, the colour is separable: tables hold 1 - f_dir beside f, and the
+// lobe is a closed form per pixel.
+//   lobe = 4 pi p_HG(cos theta; g) = (1 - g^2) / (1 + g^2 - 2 g cos theta)^1.5  (Henyey-Greenstein,
+//          scaled so that g = 0 gives 1, the fog colour's scale; it averages 1 over the sphere)
+//   or Unreal's max(cos theta, 0)^exponent when `exponent` is given (a lobe of mean cosine
+//   (n+1)/(n+2) on the forward hemisphere: the HG g of the same mean cosine).
+struct Directional {
+  glm::dvec3 color{1.0, 0.8, 0.6};       // linear RGB, each >= 0 (HDR allowed)
+  glm::dvec3 direction{0.0, 0.0, -1.0};  // towards the light; non-zero, need not be unit
+  double g = 0.7;                        // Henyey-Greenstein asymmetry in (-1, 1)
+  std::optional<double> exponent;        // > 0: Unreal's form instead of HG
+  double startDistance = 0.0;            // >= 0; the glow starts at max(this, fog startDistance)
+};
+
 struct Fog {
   FogType type = FogType::kX3dLinear;
   glm::dvec3 color{1.0, 1.0, 1.0};    // X3D default 1 1 1; each component in [0, 1]
@@ -69,6 +88,7 @@ struct Fog {
   double cutoffDistance = std::numeric_limits<double>::infinity();  // > 0: beyond it f = 1, unfogged
                                // (Unreal FogCutoffDistance, Filament cutOffDistance: the skybox)
   std::optional<HeightLayer> secondLayer;  // kHeight only
+  std::optional<Directional> directional;  // every mode
 };
 
 // Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT").
@@ -91,6 +111,15 @@ double factorAtElevation(const Fog& fog, double originY, double dirY, double dis
 
 // maxOpacity and cutoffDistance applied to the weight f of a point at `distance`.
 double engineLimits(const Fog& fog, double distance, double f);
+
+// Directional in-scattering (see Directional): the weight 1 - f_dir of its colour along a ray
+// (0 without fog.directional), and its lobe for cos theta = dot(unit view ray, unit direction).
+double inscatterWeight(const Fog& fog, double originY, double dirY, double distance);
+double lobe(const Directional& d, double cosTheta);
+
+// The colour of an object at `point` seen from `eye` through this fog (one fog, no regions):
+// f * object + (1 - f) * color + inscatterWeight * directional.color * lobe.
+glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point);
 
 // Exact optical depth of density a * e^(-b (y - h)) along the ray from height originY with
 // unit-vector y component dirY over length t (t may be +infinity):
@@ -140,9 +169,10 @@ struct Table {
   size_t width = 0;   // distance samples
   size_t height = 1;  // elevation samples (1 for distance-only fogs)
   double rangeStart = 0.0, rangeEnd = 0.0;
+  std::vector<float> inscatter;  // with fog.directional: 1 - f_dir at the same samples (else empty)
   std::vector<float> factor;  // row-major [elevation][distance]; f at d_i = start + i*(end-start)/(width-1),
                               // dirY_j = -1 + 2j/(height-1)
-  double maxError = 0.0;      // max |lerp(table) - f_exact| by dense sampling (if measured)
+  double maxError = 0.0;      // max |lerp(table) - exact| by dense sampling, over f and inscatter (if measured)
   double errorAtDistance = 0.0;
   Stats stats;  // method, elapsedMs (table only), counters: entries, evaluations
 };
