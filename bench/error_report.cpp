@@ -260,6 +260,35 @@ void fog(bool quick, Section& tables, Section& march) {
                                table.ok() ? table.value().maxError : NAN, ""});
     }
   }
+  // The engine terms (fog.h): a start distance, an opacity cap, a cutoff, height fog's second
+  // layer and the sun's glow, whose weight 1 - f_dir is a second channel of the same table
+  // (the error is the worse of the two channels).
+  for (fg::FogType t : {fg::FogType::kGlExp, fg::FogType::kHeight}) {
+    fg::Fog f = fogOf(t);
+    f.startDistance = 5;
+    f.maxOpacity = 0.95;
+    if (t == fg::FogType::kHeight)
+      f.secondLayer = fg::HeightLayer{0.01, 0.05, 3};
+    else
+      f.cutoffDistance = 120;
+    fg::Directional sun;
+    sun.startDistance = 12;
+    f.directional = sun;
+    const std::string series = std::string(fg::toString(t)) + " + engine terms";
+    for (size_t n : sizes) {
+      if (t == fg::FogType::kHeight && n > 256) continue;
+      fg::TableOptions o;
+      o.size = n;
+      o.elevations = t == fg::FogType::kHeight ? n : 0;
+      o.cameraHeight = 5;
+      o.measureError = false;
+      const double ms = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
+      o.measureError = true;
+      auto table = fg::buildTable(f, o);
+      tables.points.push_back({series, std::to_string(n) + (t == fg::FogType::kHeight ? " × " + std::to_string(n) : ""),
+                               ms, table.ok() ? table.value().maxError : NAN, ""});
+    }
+  }
   march = {"fog-height-march",
            "Height fog: closed-form optical depth against ray marching",
            "the closed form tau = a e^(-b(o_y-h)) t (1-e^(-x))/x (exact; checked against 200 000-step marching in the "
