@@ -224,6 +224,8 @@ fg::Fog fogOf(fg::FogType t) {
   f.density = 0.03;
   f.distanceCoefficient = 0.0005;
   f.heightFalloff = 0.2;
+  f.extinction = {0.01, 0.02, 0.04};
+  f.inscattering = {0.005, 0.015, 0.03};
   return f;
 }
 
@@ -242,7 +244,8 @@ void fog(bool quick, Section& tables, Section& march) {
       quick ? std::vector<size_t>{16, 64, 256} : std::vector<size_t>{16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
   for (fg::FogType t :
        {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
-        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight}) {
+        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight,
+        fg::FogType::kAtmospheric}) {
     const fg::Fog f = fogOf(t);
     for (size_t n : sizes) {
       // Height fog tables are 2-D (distance x ray elevation): n x n, up to the 65 536-entry bound.

@@ -30,7 +30,7 @@ void BM_FogTable(benchmark::State& state) {
   state.SetLabel(toString(f.type));
 }
 BENCHMARK(BM_FogTable)
-    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7}, {16, 64, 256, 1024, 4096}})
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7, 8}, {16, 64, 256, 1024, 4096}})
     ->Unit(benchmark::kMicrosecond);
 
 // The baseline for height fog: the same 2048 x 2 table filled entry by entry from the closed

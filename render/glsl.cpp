@@ -53,6 +53,7 @@ std::string fogGlsl(const FogVariant& v) {
       << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
   if (v.engine()) s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity\n";
   if (v.secondLayer) s << "uniform vec4 uFogLayer2[" << slots << "];  // HEIGHT's second layer: log a, b, h, a > 0\n";
+  if (has(T::kAtmospheric)) s << "uniform vec3 uFogInscatter[" << slots << "];  // ATMOSPHERIC: inscattering per channel\n";
   if (v.directional)
     s << "uniform vec4 uFogSun[" << slots << "];       // unit direction to the sun; w: HG g in (-1, 1), or 2 + exponent\n"
       << "uniform vec4 uFogSunColor[" << slots << "];  // rgb (0: no glow in this slot); w: the glow's start distance\n";
@@ -92,6 +93,7 @@ std::string fogGlsl(const FogVariant& v) {
       case T::kGlExp2: s << "    return exp(-(q.x * d) * (q.x * d));\n"; break;
       case T::kDistanceExp2: s << "    return exp(-q.x * d * d);  // seed 003 eqn 1\n"; break;
       case T::kDistanceGaussian: s << "    return q.y * exp(-q.x * d * d);  // seed 003 eqn 2\n"; break;
+      case T::kAtmospheric: s << "    return dot(exp(-q.xyz * d), vec3(1.0 / 3.0));  // the channels' mean\n"; break;
       case T::kHeight:
         if (layered) {
           s << "    float tau = fogHeightTau(q, y0, dirY, d);\n"
@@ -138,11 +140,24 @@ std::string fogGlsl(const FogVariant& v) {
       << "    bool inside = lo.w < 0.5 ? all(greaterThanEqual(p, lo.xyz)) && all(lessThanEqual(p, hi.xyz))\n"
       << "                             : dot(p - lo.xyz, p - lo.xyz) <= hi.x * hi.x;\n"
       << "    if (inside) return i + 1;\n  }\n";
-  s << "  return 0;\n}\n"
-       "vec3 applyFog(vec3 rgb, vec3 world) {\n"
-       "  int slot = fogSlot(world);\n"
-    << (v.directional ? "  return mix(uFogColor[slot], rgb, fogFactor(slot, world)) + fogSunGlow(slot, world);\n}\n"
-                      : "  return mix(uFogColor[slot], rgb, fogFactor(slot, world));\n}\n");
+  s << "  return 0;\n}\n";
+  const std::string glow = v.directional ? " + fogSunGlow(slot, world)" : "";
+  if (has(T::kAtmospheric)) {  // per channel: object * T + S (fog::transmittance, fog::scattered)
+    s << "vec3 fogAtmospheric(int slot, vec3 world, vec3 rgb) {\n"
+         "  float d = length(world - uFogCamera);\n";
+    if (v.engine()) s << "  vec4 e = uFogEngine[slot];\n";
+    if (v.cutoff) s << "  if (e.y > 0.0 && d > e.y) return rgb;\n";
+    if (v.start) s << "  d = max(d - e.x, 0.0);\n";
+    s << "  vec3 t = exp(-uFogParams[slot].xyz * d);\n"
+         "  vec3 w = 1.0 - exp(-uFogInscatter[slot] * d);\n";
+    if (v.opacity) s << "  t = max(t, vec3(e.z));\n  w = min(w, vec3(1.0 - e.z));\n";
+    s << "  return rgb * t + w * uFogColor[slot];\n}\n";
+  }
+  s << "vec3 applyFog(vec3 rgb, vec3 world) {\n"
+       "  int slot = fogSlot(world);\n";
+  if (has(T::kAtmospheric))
+    s << "  if (uFogType[slot] == " << int(T::kAtmospheric) << ") return fogAtmospheric(slot, world, rgb)" << glow << ";\n";
+  s << "  return mix(uFogColor[slot], rgb, fogFactor(slot, world))" << glow << ";\n}\n";
   return s.str();
 }
 

@@ -27,6 +27,8 @@ fog::Fog parseFog(const json& j, const std::string& pointer) {
   f.peak = j.value("peak", f.peak);
   f.heightFalloff = j.value("heightFalloff", f.heightFalloff);
   f.baseHeight = j.value("baseHeight", f.baseHeight);
+  if (j.contains("extinction")) f.extinction = toVec3(j["extinction"]);
+  if (j.contains("inscattering")) f.inscattering = toVec3(j["inscattering"]);
   f.startDistance = j.value("startDistance", f.startDistance);
   f.maxOpacity = j.value("maxOpacity", f.maxOpacity);
   f.cutoffDistance = j.value("cutoffDistance", f.cutoffDistance);
@@ -88,12 +90,19 @@ std::string encodeChannel(const std::vector<float>& values, const std::string& e
   return base64Encode(bytes);
 }
 
+// The fog's own colour S reaching the eye at entry i: (1 - f) * colour, or ATMOSPHERIC's per channel.
+glm::dvec3 scatteredAt(const fog::Table& t, const fog::Fog& f, size_t i) {
+  if (t.scatteredRgb.empty()) return (1.0 - double(t.factor[i])) * f.color;
+  return {t.scatteredRgb[3 * i], t.scatteredRgb[3 * i + 1], t.scatteredRgb[3 * i + 2]};
+}
+
 std::string encodeTexels(const fog::Table& t, const fog::Fog& f, const std::string& encoding) {
-  // Texel = ((1 - f) * fogColor, f): the shader computes objectColour * a + rgb.
+  // Texel = (S, f), S = (1 - f) * fogColor: the shader computes objectColour * a + rgb.
   std::string bytes;
   bytes.reserve(t.factor.size() * (encoding == "rgba8" ? 4 : 8));
-  for (float w : t.factor) {
-    float texel[4] = {float((1 - w) * f.color.r), float((1 - w) * f.color.g), float((1 - w) * f.color.b), w};
+  for (size_t i = 0; i < t.factor.size(); ++i) {
+    const glm::dvec3 s = scatteredAt(t, f, i);
+    float texel[4] = {float(s.r), float(s.g), float(s.b), t.factor[i]};
     for (float c : texel) appendEncoded(bytes, c, encoding);
   }
   return base64Encode(bytes);
@@ -114,10 +123,12 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
   out["encoding"] = encoding;
   if (encoding == "json") {
     json factor = json::array(), contribution = json::array();
-    for (float w : t.factor) {
-      factor.push_back(w);
-      for (int c = 0; c < 3; ++c) contribution.push_back(wire((1.0 - w) * f.color[c]));
+    for (size_t i = 0; i < t.factor.size(); ++i) {
+      factor.push_back(t.factor[i]);
+      const glm::dvec3 s = scatteredAt(t, f, i);
+      for (int c = 0; c < 3; ++c) contribution.push_back(wire(s[c]));
     }
+    if (!t.transmittanceRgb.empty()) out["transmittance"] = json(t.transmittanceRgb);
     out["factor"] = std::move(factor);
     out["fogContribution"] = std::move(contribution);
     if (!t.inscatter.empty()) out["inscatter"] = json(t.inscatter);
@@ -126,8 +137,13 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
       for (const auto& oc : objectColors) {
         glm::dvec3 o = toVec3(oc);
         json row = json::array();
-        for (float w : t.factor)
-          for (int c = 0; c < 3; ++c) row.push_back(wire(w * o[c] + (1.0 - w) * f.color[c]));
+        for (size_t i = 0; i < t.factor.size(); ++i) {
+          const glm::dvec3 s = scatteredAt(t, f, i);
+          for (size_t c = 0; c < 3; ++c) {
+            const double tr = t.transmittanceRgb.empty() ? double(t.factor[i]) : double(t.transmittanceRgb[3 * i + c]);
+            row.push_back(wire(tr * o[int(c)] + s[int(c)]));
+          }
+        }
         finals.push_back(std::move(row));
       }
       out["finalColors"] = std::move(finals);
@@ -137,7 +153,16 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
                          std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
     out["data"] = encodeTexels(t, f, encoding);
     if (!t.inscatter.empty()) out["inscatterData"] = encodeChannel(t.inscatter, encoding);
+    if (!t.transmittanceRgb.empty()) {  // RGBA = (T, 1): the object's weight per channel
+      std::vector<float> rgba;
+      for (size_t i = 0; i < t.factor.size(); ++i)
+        rgba.insert(rgba.end(), {t.transmittanceRgb[3 * i], t.transmittanceRgb[3 * i + 1], t.transmittanceRgb[3 * i + 2], 1.0f});
+      out["transmittanceData"] = encodeChannel(rgba, encoding);
+    }
   }
+  if (!t.transmittanceRgb.empty())
+    out["transmittanceLayout"] =
+        "ATMOSPHERIC: colour = object * transmittance + fogContribution, per channel; factor is the channels' mean";
   if (!t.inscatter.empty())
     out["inscatterLayout"] = "1 - f_dir per entry, as factor; colour += inscatter * directional.color * lobe(cos theta)";
   return out;

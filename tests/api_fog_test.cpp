@@ -171,6 +171,25 @@ TEST(FogApi, DirectionalGlowInTables) {
   EXPECT_TRUE(hasPointer(p, "/fog/directional/g")) << p;
 }
 
+TEST(FogApi, AtmosphericTablesPerChannel) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "ATMOSPHERIC"}, {"color", {1, 0.5, 0.25}}, {"extinction", {0.1, 0.2, 0.3}},
+                       {"inscattering", {0.05, 0.1, 0.2}}}},
+              {"table", {{"size", 5}, {"range", {0, 10}}}},
+              {"objectColors", {{0.2, 0.4, 0.6}}}};
+  json t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
+  ASSERT_EQ(t["transmittance"].size(), 15u);
+  const double d = 10, tr = std::exp(-0.3 * d), sc = 0.25 * (1 - std::exp(-0.2 * d));
+  EXPECT_NEAR(t["transmittance"][14].get<double>(), tr, 1e-6);
+  EXPECT_NEAR(t["fogContribution"][14].get<double>(), sc, 1e-6);
+  EXPECT_NEAR(t["finalColors"][0][14].get<double>(), 0.6 * tr + sc, 1e-6);
+  req["table"]["encoding"] = "rgba16f";
+  t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
+  EXPECT_EQ(base64Decode(t["transmittanceData"].get<std::string>())->size(), 5u * 4 * 2);
+  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "ATMOSPHERIC"}, {"extinction", {0, -1, 0}}}}}), 400);
+  EXPECT_TRUE(hasPointer(p, "/fog/extinction/1")) << p;
+}
+
 TEST(FogApi, TableOverTheLimitIs413) {
   Config c = TestServer::quietConfig();
   c.limits.maxTableSize = 1000;
@@ -195,7 +214,7 @@ bool toolAccepts(const std::string& command, const std::string& bytes, const std
 TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
   TestServer s;
   for (const char* type : {"LINEAR", "EXPONENTIAL", "GL_LINEAR", "GL_EXP", "GL_EXP2", "DISTANCE_EXP2",
-                           "DISTANCE_GAUSSIAN", "HEIGHT"}) {
+                           "DISTANCE_GAUSSIAN", "HEIGHT", "ATMOSPHERIC"}) {
     for (bool withRegions : {false, true}) {
       json body = {{"fog", {{"fogType", type}, {"density", 0.05}, {"visibilityRange", 30}}},
                    {"include", {"shader"}},

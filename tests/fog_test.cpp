@@ -17,7 +17,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 Fog make(FogType t) { return fixtures::fogOf(t); }
 
 const FogType kAll[] = {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear,         FogType::kGlExp,
-                        FogType::kGlExp2,    FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight};
+                        FogType::kGlExp2,    FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight,
+                        FogType::kAtmospheric};
 
 TEST(Fog, PaperWorkedExample) {
   // Seed 003, Fig. 3: fog [0.8 0.8 0.8], object [0.7 0.2 0.1], d_c = 0.07: object colour at
@@ -439,6 +440,64 @@ TEST(Fog, DirectionalInscattering) {
   bad = f;
   bad.directional->exponent = 0;
   EXPECT_EQ(field(bad), "/directional/exponent");
+}
+
+// Bevy's atmospheric falloff: per channel, object * e^(-extinction d) + colour * (1 - e^(-inscattering d)),
+// under the engine terms; f is the channels' mean transmittance.
+TEST(Fog, AtmosphericPerChannel) {
+  Fog f = make(FogType::kAtmospheric);
+  f.color = {0.8, 0.7, 0.6};
+  f.extinction = {0.01, 0.02, 0.05};
+  f.inscattering = {0.005, 0.02, 0.04};
+  const glm::dvec3 obj(0.3, 0.5, 0.2);
+  for (double d : {0.0, 1.0, 30.0, 400.0}) {
+    const glm::dvec3 t = transmittance(f, 0, 0, d), s = scattered(f, 0, 0, d);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(t[c], std::exp(-f.extinction[c] * d), 1e-15);
+      EXPECT_NEAR(s[c], f.color[c] * (1 - std::exp(-f.inscattering[c] * d)), 1e-15);
+    }
+    EXPECT_NEAR(factor(f, d), (t.r + t.g + t.b) / 3, 1e-15);
+    const glm::dvec3 c = shade(f, obj, {0, 0, 0}, {0, 0, -d});
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], obj[k] * t[k] + s[k], 1e-15);
+  }
+  f.startDistance = 10;
+  f.maxOpacity = 0.5;
+  f.cutoffDistance = 300;
+  for (double d : {5.0, 50.0, 299.0, 301.0}) {
+    const glm::dvec3 t = transmittance(f, 0, 0, d), s = scattered(f, 0, 0, d);
+    for (int c = 0; c < 3; ++c) {
+      const double dd = std::max(0.0, d - 10);
+      const bool cut = d > 300;
+      EXPECT_NEAR(t[c], cut ? 1.0 : std::max(std::exp(-f.extinction[c] * dd), 0.5), 1e-15) << d;
+      EXPECT_NEAR(s[c], cut ? 0.0 : f.color[c] * std::min(1 - std::exp(-f.inscattering[c] * dd), 0.5), 1e-15) << d;
+    }
+  }
+  // Where the last varying channel completes: ln 255 over the smallest positive coefficient.
+  Fog g = make(FogType::kAtmospheric);
+  g.extinction = {0, 0.02, 0.1};
+  g.inscattering = {0, 0, 0.05};
+  EXPECT_NEAR(completeDistance(g), std::log(255.0) / 0.02, 1e-9);
+  g.extinction = g.inscattering = glm::dvec3(0);
+  EXPECT_EQ(completeDistance(g), kInf);
+  g.extinction = {1e300, 0, 0};
+  EXPECT_EQ(transmittance(g, 0, 0, kInf).r, 0.0);
+  EXPECT_EQ(transmittance(g, 0, 0, kInf).g, 1.0);  // no extinction: never dims, even at infinity
+  g.extinction = {0.1, -1, 0};
+  ASSERT_TRUE(validate(g));
+  EXPECT_EQ(validate(g)->field, "/extinction/1");
+  // Tables carry T and S per channel, exactly.
+  TableOptions o;
+  o.size = 33;
+  auto t = buildTable(f, o);
+  ASSERT_TRUE(t.ok());
+  ASSERT_EQ(t.value().transmittanceRgb.size(), 3u * 33);
+  for (size_t i = 0; i < 33; ++i) {
+    const double d = t.value().rangeEnd * double(i) / 32;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(t.value().transmittanceRgb[3 * i + size_t(c)], transmittance(f, 0, 0, d)[c], 1e-7);
+      EXPECT_NEAR(t.value().scatteredRgb[3 * i + size_t(c)], scattered(f, 0, 0, d)[c], 1e-7);
+    }
+  }
 }
 
 TEST(Fog, Validation) {

@@ -178,6 +178,12 @@ TEST(Render, FogInARenderMatchesTheFogTableColours) {
       s,
       {{"fogType", "HEIGHT"}, {"color", {0.6, 0.6, 0.7}}, {"density", 0.08}, {"heightFalloff", 0.5}, {"baseHeight", 0}},
       3, 1.5);
+  expectFogMatchesTable(s,
+                        {{"fogType", "ATMOSPHERIC"},
+                         {"color", {0.9, 0.7, 0.5}},
+                         {"extinction", {0.02, 0.05, 0.09}},
+                         {"inscattering", {0.01, 0.04, 0.08}}},
+                        0, 0);
   // Engine terms: a clear first stretch, a ceiling on opacity, nothing fogged past the cutoff
   // (the last three quads), and height fog's second layer.
   expectFogMatchesTable(s,

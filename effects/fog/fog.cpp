@@ -37,13 +37,15 @@ const char* toString(FogType type) {
     case FogType::kDistanceExp2: return "DISTANCE_EXP2";
     case FogType::kDistanceGaussian: return "DISTANCE_GAUSSIAN";
     case FogType::kHeight: return "HEIGHT";
+    case FogType::kAtmospheric: return "ATMOSPHERIC";
   }
   return "?";
 }
 
 std::optional<FogType> fogTypeFromString(const std::string& name) {
   for (FogType t : {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear, FogType::kGlExp,
-                    FogType::kGlExp2, FogType::kDistanceExp2, FogType::kDistanceGaussian, FogType::kHeight}) {
+                    FogType::kGlExp2, FogType::kDistanceExp2, FogType::kDistanceGaussian, FogType::kHeight,
+                    FogType::kAtmospheric}) {
     if (name == toString(t)) return t;
   }
   return std::nullopt;
@@ -76,6 +78,12 @@ std::optional<Error> validate(const Fog& fog) {
       if (auto e = nonNegative(fog.density, "/density")) return e;
       if (auto e = nonNegative(fog.heightFalloff, "/heightFalloff")) return e;
       if (!finite(fog.baseHeight)) return invalid("/baseHeight", "must be finite");
+      break;
+    case FogType::kAtmospheric:
+      for (int i = 0; i < 3; ++i) {
+        if (auto e = nonNegative(fog.extinction[i], ("/extinction/" + std::to_string(i)).c_str())) return e;
+        if (auto e = nonNegative(fog.inscattering[i], ("/inscattering/" + std::to_string(i)).c_str())) return e;
+      }
       break;
   }
   if (mode) return mode;
@@ -151,6 +159,7 @@ double modeFactor(const Fog& fog, double d) {
     case FogType::kDistanceGaussian:  // seed 003 eqn 2, parameterised (see header)
       return fog.peak * std::exp(-mulZero(fog.distanceCoefficient, d * d));
     case FogType::kHeight: break;  // along a ray: factorAtElevation
+    case FogType::kAtmospheric: break;  // per channel: transmittance
   }
   return 1.0;
 }
@@ -173,12 +182,33 @@ double engineLimits(const Fog& fog, double distance, double f) {
 }
 
 double factorAtElevation(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.type == FogType::kAtmospheric) {
+    const glm::dvec3 t = transmittance(fog, originY, dirY, distance);
+    return (t.r + t.g + t.b) / 3.0;
+  }
   if (fog.type != FogType::kHeight)
     return engineLimits(fog, distance, modeFactor(fog, std::max(0.0, distance - fog.startDistance)));
   return engineLimits(fog, distance, std::exp(-heightDepth(fog, originY, dirY, distance)));
 }
 
 double factor(const Fog& fog, double d) { return factorAtElevation(fog, fog.baseHeight, 0.0, d); }
+
+glm::dvec3 transmittance(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.type != FogType::kAtmospheric) return glm::dvec3(factorAtElevation(fog, originY, dirY, distance));
+  const double d = std::max(0.0, distance - fog.startDistance);
+  glm::dvec3 t;
+  for (int c = 0; c < 3; ++c) t[c] = engineLimits(fog, distance, std::exp(-mulZero(fog.extinction[c], d)));
+  return t;
+}
+
+glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.type != FogType::kAtmospheric) return (1.0 - factorAtElevation(fog, originY, dirY, distance)) * fog.color;
+  const double d = std::max(0.0, distance - fog.startDistance);
+  glm::dvec3 s;
+  for (int c = 0; c < 3; ++c)  // the in-scattered weight, capped like the opacity: 1 - engineLimits(1 - w)
+    s[c] = (1.0 - engineLimits(fog, distance, std::exp(-mulZero(fog.inscattering[c], d)))) * fog.color[c];
+  return s;
+}
 
 double inscatterWeight(const Fog& fog, double originY, double dirY, double distance) {
   if (!fog.directional) return 0.0;
@@ -199,10 +229,9 @@ double lobe(const Directional& d, double cosTheta) {
 glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point) {
   const glm::dvec3 ray = point - eye;
   const double d = glm::length(ray);
-  const double f = factor(fog, eye, ray, d);
-  glm::dvec3 c = f * object + (1.0 - f) * fog.color;
+  const double dirY = d > 0.0 ? std::clamp(ray.y / d, -1.0, 1.0) : 0.0;
+  glm::dvec3 c = object * transmittance(fog, eye.y, dirY, d) + scattered(fog, eye.y, dirY, d);
   if (fog.directional && d > 0.0) {
-    const double dirY = std::clamp(ray.y / d, -1.0, 1.0);
     c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color *
          lobe(*fog.directional, glm::dot(ray / d, glm::normalize(fog.directional->direction)));
   }
@@ -238,6 +267,13 @@ double modeDistanceTo(const Fog& fog, double level, double cameraHeight) {
       double l = std::log(fog.peak / level);
       if (l <= 0.0) return 0.0;
       return fog.distanceCoefficient > 0.0 ? std::sqrt(l / fog.distanceCoefficient) : kInf;
+    }
+    case FogType::kAtmospheric: {  // every varying channel done: the smallest positive coefficient
+      double least = kInf;
+      for (int c = 0; c < 3; ++c)
+        for (double k : {fog.extinction[c], fog.inscattering[c]})
+          if (k > 0.0) least = std::min(least, k);
+      return least < kInf ? q / least : kInf;
     }
     case FogType::kHeight: {
       // Horizontal ray: tau = (sum of a e^{-b(y-h)}) t, so t = q / that sum, in log space.

@@ -4,6 +4,8 @@
 
 #include "effects/fog.h"
 
+#include <glm/vec3.hpp>
+
 namespace effects::fog {
 namespace {
 
@@ -45,8 +47,19 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
 void fill(const Fog& fog, double cameraHeight, Table& t) {
   t.factor.resize(t.width * t.height);
   if (fog.directional) t.inscatter.resize(t.width * t.height);
+  const bool rgb = fog.type == FogType::kAtmospheric;
+  if (rgb) t.transmittanceRgb.resize(3 * t.width * t.height), t.scatteredRgb.resize(3 * t.width * t.height);
   for (size_t j = 0; j < t.height; ++j) {
     double dirY = dirYAt(t, double(j));
+    if (rgb)
+      for (size_t i = 0; i < t.width; ++i) {
+        const double d = distAt(t, double(i));
+        const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
+        for (int c = 0; c < 3; ++c) {
+          t.transmittanceRgb[3 * (j * t.width + i) + size_t(c)] = static_cast<float>(tr[c]);
+          t.scatteredRgb[3 * (j * t.width + i) + size_t(c)] = static_cast<float>(sc[c]);
+        }
+      }
     if (fog.directional)
       for (size_t i = 0; i < t.width; ++i)
         t.inscatter[j * t.width + i] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, distAt(t, double(i))));
@@ -85,8 +98,8 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
       double col = double(c) / sub;
       size_t i0 = std::min(size_t(col), t.width - 1), i1 = std::min(i0 + 1, t.width - 1);
       double fx = col - double(i0);
-      auto lerp = [&](const std::vector<float>& v) {
-        auto at = [&](size_t j, size_t i) { return double(v[j * t.width + i]); };
+      auto lerp = [&](const std::vector<float>& v, size_t stride = 1, size_t channel = 0) {
+        auto at = [&](size_t j, size_t i) { return double(v[stride * (j * t.width + i) + channel]); };
         double lerp0 = at(j0, i0) + (at(j0, i1) - at(j0, i0)) * fx;
         double lerp1 = at(j1, i0) + (at(j1, i1) - at(j1, i0)) * fx;
         return lerp0 + (lerp1 - lerp0) * fy;
@@ -94,6 +107,13 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
       double d = distAt(t, col);
       double e = std::fabs(lerp(t.factor) - exact(fog, cameraHeight, d, dirYAt(t, row)));
       if (both) e = std::max(e, std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, dirYAt(t, row), d)));
+      if (!t.transmittanceRgb.empty()) {
+        const glm::dvec3 tr = transmittance(fog, cameraHeight, dirYAt(t, row), d);
+        const glm::dvec3 sc = scattered(fog, cameraHeight, dirYAt(t, row), d);
+        for (size_t c = 0; c < 3; ++c)
+          e = std::max({e, std::fabs(lerp(t.transmittanceRgb, 3, c) - tr[int(c)]),
+                        std::fabs(lerp(t.scatteredRgb, 3, c) - sc[int(c)])});
+      }
       if (e > worst) {
         worst = e;
         worstAt = d;

@@ -20,7 +20,7 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
   const detail::FogVariant variant = detail::fogVariant(f);
-  std::vector<double> types, params, colors, lo, hi, engine, layer2, sun, sunColor;
+  std::vector<double> types, params, colors, lo, hi, engine, layer2, sun, sunColor, inscatter;
   auto add = [&](const fog::Fog& g) {
     types.push_back(int(g.type));
     const double cutoff = std::isfinite(g.cutoffDistance) ? g.cutoffDistance : 0.0;
@@ -45,7 +45,9 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
       case fog::FogType::kHeight:
         q = {g.density > 0 ? std::log(g.density) : 0.0, g.heightFalloff, g.baseHeight, g.density > 0 ? 1.0 : 0.0};
         break;
+      case fog::FogType::kAtmospheric: q = glm::dvec4(g.extinction, 0); break;
     }
+    for (int i = 0; i < 3; ++i) inscatter.push_back(g.type == fog::FogType::kAtmospheric ? g.inscattering[i] : 0.0);
     for (int i = 0; i < 4; ++i) params.push_back(q[i]);
     for (int i = 0; i < 3; ++i) colors.push_back(g.color[i]);
   };
@@ -64,6 +66,8 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
                                          {"uFogColor", "vec3" + slots, colors}};
   if (variant.engine()) out.push_back({"uFogEngine", "vec4" + slots, engine});
   if (variant.secondLayer) out.push_back({"uFogLayer2", "vec4" + slots, layer2});
+  if (std::count(variant.types.begin(), variant.types.end(), fog::FogType::kAtmospheric))
+    out.push_back({"uFogInscatter", "vec3" + slots, inscatter});
   if (variant.directional) {
     out.push_back({"uFogSun", "vec4" + slots, sun});
     out.push_back({"uFogSunColor", "vec4" + slots, sunColor});

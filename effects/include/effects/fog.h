@@ -33,6 +33,8 @@ enum class FogType {
   kDistanceExp2,      // seed 003 eqn 1:    f = 1 / e^(d_c * z^2)  (GL_EXP2 with density sqrt(d_c))
   kDistanceGaussian,  // seed 003 eqn 2:    f = peak * e^(-d_c * z^2)   (see below)
   kHeight,            // exponential height fog: f = exp(-tau), tau the exact optical depth
+  kAtmospheric,       // Bevy FogFalloff::Atmospheric: per channel, C = object * exp(-extinction d)
+                      //   + color * (1 - exp(-inscattering d)); f = the channels' mean transmittance
 };
 
 // Seed 003 eqn 2 prints rho = (1/sqrt(2*pi)) * e^(-0.5 z^2) with no d_c although the text says
@@ -78,6 +80,8 @@ struct Fog {
   double peak = kPaperGaussianPeak;   // kDistanceGaussian only, in (0, 1]
   double heightFalloff = 0.1;         // height fog b >= 0: density a * e^(-b (y - h))
   double baseHeight = 0.0;            // height fog h
+  glm::dvec3 extinction{0.0};         // kAtmospheric: per channel, per unit distance, each >= 0
+  glm::dvec3 inscattering{0.0};       // kAtmospheric: per channel, per unit distance, each >= 0
   // What engines add on top of every mode (Unreal ExponentialHeightFog, Filament FogOptions;
   // docs/effects.md), applied in this order:
   double startDistance = 0.0;  // >= 0: the first part of every ray is clear (Unreal StartDistance,
@@ -117,8 +121,15 @@ double engineLimits(const Fog& fog, double distance, double f);
 double inscatterWeight(const Fog& fog, double originY, double dirY, double distance);
 double lobe(const Directional& d, double cosTheta);
 
+// Per channel: what reaches the eye of the object (transmittance T) and of the fog's own
+// colour (S), so that C = object * T + S (+ the glow). Every mode but kAtmospheric has
+// T = f and S = (1 - f) * color; kAtmospheric has its own per-channel exponentials, under the
+// same start, opacity cap (T >= 1 - maxOpacity, S <= maxOpacity * color) and cutoff (T = 1, S = 0).
+glm::dvec3 transmittance(const Fog& fog, double originY, double dirY, double distance);
+glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distance);
+
 // The colour of an object at `point` seen from `eye` through this fog (one fog, no regions):
-// f * object + (1 - f) * color + inscatterWeight * directional.color * lobe.
+// object * T + S + inscatterWeight * directional.color * lobe.
 glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point);
 
 // Exact optical depth of density a * e^(-b (y - h)) along the ray from height originY with
@@ -170,6 +181,7 @@ struct Table {
   size_t height = 1;  // elevation samples (1 for distance-only fogs)
   double rangeStart = 0.0, rangeEnd = 0.0;
   std::vector<float> inscatter;  // with fog.directional: 1 - f_dir at the same samples (else empty)
+  std::vector<float> transmittanceRgb, scatteredRgb;  // kAtmospheric: T and S, 3 per sample (else empty)
   std::vector<float> factor;  // row-major [elevation][distance]; f at d_i = start + i*(end-start)/(width-1),
                               // dirY_j = -1 + 2j/(height-1)
   double maxError = 0.0;      // max |lerp(table) - exact| by dense sampling, over f and inscatter (if measured)
