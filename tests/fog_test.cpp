@@ -426,6 +426,17 @@ TEST(Fog, DirectionalInscattering) {
       const double dy = -1.0 + 0.5 * double(j), d = t.value().rangeStart + (t.value().rangeEnd - t.value().rangeStart) * double(i) / 32;
       EXPECT_NEAR(t.value().inscatter[j * 33 + i], inscatterWeight(f, 1, dy, d), 1e-7);
     }
+  // Stiff: the sun on the horizon and straight overhead, g at the edges of (-1, 1), rays
+  // grazing the ground, looking at the sun and away, distances from 0 to infinity.
+  for (glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, -1)})
+    for (double g : {-0.9999999, 0.0, 0.9999999})
+      for (glm::dvec3 p : {glm::dvec3(1e6, 1, 0), glm::dvec3(-1e6, 1, 0), glm::dvec3(0, 1, -1e-9), glm::dvec3(0, 1e9, 0)}) {
+        Fog h = f;
+        h.directional->direction = dir;
+        h.directional->g = g;
+        const glm::dvec3 c = shade(h, obj, eye, p);
+        for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isfinite(c[k]) && c[k] >= 0) << g << " " << p.x << " " << p.y;
+      }
   // Validation names the field.
   auto field = [](Fog g) { return validate(g) ? validate(g)->field : std::string("ok"); };
   Fog bad = f;
