@@ -242,27 +242,29 @@ void fog(bool quick, Section& tables, Section& march) {
             1000};
   const std::vector<size_t> sizes =
       quick ? std::vector<size_t>{16, 64, 256} : std::vector<size_t>{16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
-  for (fg::FogType t :
-       {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
-        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight,
-        fg::FogType::kAtmospheric}) {
-    const fg::Fog f = fogOf(t);
+  // One series: tables of every size for `f` (height fog's are 2-D, n x n, up to the
+  // 65 536-entry bound), timed without and measured with the error pass.
+  auto series = [&](const fg::Fog& f, const std::string& name) {
+    const bool twoD = f.type == fg::FogType::kHeight;
     for (size_t n : sizes) {
-      // Height fog tables are 2-D (distance x ray elevation): n x n, up to the 65 536-entry bound.
-      if (t == fg::FogType::kHeight && n > 256) continue;
+      if (twoD && n > 256) continue;
       fg::TableOptions o;
       o.size = n;
-      o.elevations = t == fg::FogType::kHeight ? n : 0;
+      o.elevations = twoD ? n : 0;
       o.cameraHeight = 5;
       o.measureError = false;
       const double ms = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
       o.measureError = true;
       auto table = fg::buildTable(f, o);
-      tables.points.push_back({fg::toString(t),
-                               std::to_string(n) + (t == fg::FogType::kHeight ? " × " + std::to_string(n) : ""), ms,
+      tables.points.push_back({name, std::to_string(n) + (twoD ? " × " + std::to_string(n) : ""), ms,
                                table.ok() ? table.value().maxError : NAN, ""});
     }
-  }
+  };
+  for (fg::FogType t :
+       {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
+        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight,
+        fg::FogType::kAtmospheric})
+    series(fogOf(t), fg::toString(t));
   // The engine terms (fog.h): a start distance, an opacity cap, a cutoff, height fog's second
   // layer and the sun's glow, whose weight 1 - f_dir is a second channel of the same table
   // (the error is the worse of the two channels).
@@ -277,20 +279,7 @@ void fog(bool quick, Section& tables, Section& march) {
     fg::Directional sun;
     sun.startDistance = 12;
     f.directional = sun;
-    const std::string series = std::string(fg::toString(t)) + " + engine terms";
-    for (size_t n : sizes) {
-      if (t == fg::FogType::kHeight && n > 256) continue;
-      fg::TableOptions o;
-      o.size = n;
-      o.elevations = t == fg::FogType::kHeight ? n : 0;
-      o.cameraHeight = 5;
-      o.measureError = false;
-      const double ms = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
-      o.measureError = true;
-      auto table = fg::buildTable(f, o);
-      tables.points.push_back({series, std::to_string(n) + (t == fg::FogType::kHeight ? " × " + std::to_string(n) : ""),
-                               ms, table.ok() ? table.value().maxError : NAN, ""});
-    }
+    series(f, std::string(fg::toString(t)) + " + engine terms");
   }
   march = {"fog-height-march",
            "Height fog: closed-form optical depth against ray marching",
