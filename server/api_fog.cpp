@@ -270,7 +270,13 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
       const fog::Fog& f = r < 0 ? global : regions[size_t(r)].fog;
       glm::dvec3 d = p - camera;
       double w = fog::factor(f, camera, d, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
-      list.push_back({{"region", r}, {"factor", wire(w)}});
+      json sample = {{"region", r}, {"factor", wire(w)}};
+      if (f.type == fog::FogType::kAtmospheric || f.directional) {  // colour = object * T + fogColor
+        const glm::dvec3 s0 = fog::shade(f, glm::dvec3(0), camera, p), s1 = fog::shade(f, glm::dvec3(1), camera, p);
+        sample["transmittance"] = {wire(s1.r - s0.r), wire(s1.g - s0.g), wire(s1.b - s0.b)};
+        sample["fogColor"] = {wire(s0.r), wire(s0.g), wire(s0.b)};
+      }
+      list.push_back(std::move(sample));
     }
     reply.computeMs += watch.ms();
     out["samples"] = std::move(list);

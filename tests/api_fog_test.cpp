@@ -186,6 +186,11 @@ TEST(FogApi, AtmosphericTablesPerChannel) {
   req["table"]["encoding"] = "rgba16f";
   t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
   EXPECT_EQ(base64Decode(t["transmittanceData"].get<std::string>())->size(), 5u * 4 * 2);
+  req["include"] = {"samples"};
+  req["samples"] = {{"camera", {0, 0, 0}}, {"points", {{0, 0, -10}}}};
+  json sample = json::parse(s.postJson("/v1/fog", req)->body)["samples"][0];
+  EXPECT_NEAR(sample["transmittance"][2].get<double>(), tr, 1e-6);
+  EXPECT_NEAR(sample["fogColor"][2].get<double>(), sc, 1e-6);
   auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "ATMOSPHERIC"}, {"extinction", {0, -1, 0}}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/fog/extinction/1")) << p;
 }
