@@ -264,7 +264,7 @@ double modeDistanceTo(const Fog& fog, double level, double cameraHeight) {
     case FogType::kGlExp2: return fog.density > 0.0 ? std::sqrt(q) / fog.density : kInf;
     case FogType::kDistanceExp2: return fog.distanceCoefficient > 0.0 ? std::sqrt(q / fog.distanceCoefficient) : kInf;
     case FogType::kDistanceGaussian: {
-      double l = std::log(fog.peak / level);
+      double l = byte ? std::log(255.0 * fog.peak) : std::log(fog.peak / level);
       if (l <= 0.0) return 0.0;
       return fog.distanceCoefficient > 0.0 ? std::sqrt(l / fog.distanceCoefficient) : kInf;
     }
