@@ -46,7 +46,7 @@ void run(benchmark::State& state, Mode mode, bool measure, bool oneThread = fals
   }
   double tris = double(mesh100k().indices.size() / 3);
   state.counters["triangles"] = tris;
-  state.counters["threads"] = oneThread ? 1.0 : double(pool().threads() + 1);
+  state.counters["poolThreads"] = oneThread ? 1.0 : double(pool().threads() + 1);
   state.counters["tris_per_s"] = benchmark::Counter(tris * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["outVertices"] = last.counters["outputVertices"];
   if (last.error) {

@@ -97,7 +97,7 @@ def main():
     peer = json.loads(subprocess.run(["node", os.path.join(ROOT, "bench", "mikktspace_peer.mjs")], check=True,
                                      capture_output=True, text=True).stdout)
     mikk, mikk1 = tg["BM_MikkTSpace100k"], tg["BM_MikkTSpace100kOneThread"]
-    threads = int(mikk["threads"])
+    threads = int(mikk["poolThreads"])
     rows.append((f"MikkTSpace, 99 500-triangle sphere, {threads} threads", fmt_ms(ms(mikk)),
                  f"{peer['peer']}: {fmt_ms(peer['ms'])}", f"{peer['ms'] / ms(mikk):.0f}× faster", goal(ms(mikk), 15)))
     rows.append(("MikkTSpace, same mesh, 1 thread", fmt_ms(ms(mikk1)), f"same peer: {fmt_ms(peer['ms'])}",

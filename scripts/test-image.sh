@@ -43,7 +43,8 @@ if ! podman image exists docker.io/library/debian:bookworm; then
   tar -C "$root" -c . | podman import -q - docker.io/library/debian:bookworm >/dev/null
   rm -rf "$root"
 fi
-podman tag docker.io/library/debian:bookworm docker.io/library/debian:bookworm-slim
+podman image exists docker.io/library/debian:bookworm-slim ||  # a real one, if pulled, is kept
+  podman tag docker.io/library/debian:bookworm docker.io/library/debian:bookworm-slim
 
 # 2. The image: the runtime stage (what ships) and the full stage (for the size comparison).
 args=(--isolation=chroot --format docker -q)
@@ -89,9 +90,9 @@ mount -t tmpfs -o size=256m,mode=1777 tmpfs "$mnt/tmp"
 mount -t proc proc "$mnt/proc"
 mount --rbind /sys "$mnt/sys"
 mount --rbind /dev "$mnt/dev"
-as_user() { env -i "${env[@]}" chroot --userspec="$user:$user" "$mnt" "$@"; }
+as_user() { env -i "${env[@]}" /usr/sbin/chroot --userspec="$user:$user" "$mnt" "$@"; }
 log=$(mktemp)
-env -i "${env[@]}" chroot --userspec="$user:$user" "$mnt" "${entry[@]}" >"$log" 2>&1 &  # env, chroot exec: $! is effectd
+env -i "${env[@]}" /usr/sbin/chroot --userspec="$user:$user" "$mnt" "${entry[@]}" >"$log" 2>&1 &  # env, chroot exec: $! is effectd
 pid=$!
 cleanup() { kill "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; }
 trap cleanup EXIT

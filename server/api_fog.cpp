@@ -1,5 +1,8 @@
 // POST /v1/fog — fog definitions -> weight tables (with their error), region lookups.
+#include <algorithm>
 #include <cmath>
+
+#include <glm/geometric.hpp>
 
 #include <effects/fog.h>
 #include <render/render.h>
@@ -149,7 +152,7 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
       out["finalColors"] = std::move(finals);
     }
   } else {
-    out["texelLayout"] = "RGBA = ((1-f)*fogColor, f), row-major, " +
+    out["texelLayout"] = "RGBA = (S, f), S the fog's colour reaching the eye ((1-f)*fogColor; ATMOSPHERIC: per channel), row-major, " +
                          std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
     out["data"] = encodeTexels(t, f, encoding);
     if (!t.inscatter.empty()) out["inscatterData"] = encodeChannel(t.inscatter, encoding);
@@ -272,8 +275,10 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
       double w = fog::factor(f, camera, d, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
       json sample = {{"region", r}, {"factor", wire(w)}};
       if (f.type == fog::FogType::kAtmospheric || f.directional) {  // colour = object * T + fogColor
-        const glm::dvec3 s0 = fog::shade(f, glm::dvec3(0), camera, p), s1 = fog::shade(f, glm::dvec3(1), camera, p);
-        sample["transmittance"] = {wire(s1.r - s0.r), wire(s1.g - s0.g), wire(s1.b - s0.b)};
+        const double len = glm::length(d);
+        const glm::dvec3 t = fog::transmittance(f, camera.y, len > 0 ? std::clamp(d.y / len, -1.0, 1.0) : 0.0, len);
+        const glm::dvec3 s0 = fog::shade(f, glm::dvec3(0), camera, p);
+        sample["transmittance"] = {wire(t.r), wire(t.g), wire(t.b)};
         sample["fogColor"] = {wire(s0.r), wire(s0.g), wire(s0.b)};
       }
       list.push_back(std::move(sample));

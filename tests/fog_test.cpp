@@ -340,6 +340,27 @@ TEST(Fog, EngineTermsInTables) {
       const double d = 8.0 * double(i) / double(t.value().width - 1);
       EXPECT_NEAR(t.value().factor[j * t.value().width + i], factorAtElevation(f, 1, dy, d), 1e-7) << i << " " << j;
     }
+  // The last column sits exactly on a cutoff that ends the range: fogged, not rounded past it.
+  for (FogType type : {FogType::kGlExp, FogType::kHeight})
+    for (size_t width : {12, 23, 40, 101}) {
+      Fog c = make(type);
+      c.density = 0.01;
+      c.heightFalloff = 0.1;
+      c.cutoffDistance = type == FogType::kGlExp ? 100.0 : 123.456;
+      TableOptions w;
+      w.size = width;
+      w.elevations = type == FogType::kHeight ? 3 : 0;
+      auto ct = buildTable(c, w);
+      ASSERT_TRUE(ct.ok());
+      ASSERT_EQ(ct.value().rangeEnd, c.cutoffDistance);
+      EXPECT_LT(ct.value().factor[width - 1], 0.99) << toString(type) << " " << width;
+    }
+  // A glow that starts late extends the default range until it is done too.
+  Fog late = make(FogType::kGlExp);
+  late.density = 0.1;
+  late.directional = Directional{};
+  late.directional->startDistance = 100;
+  EXPECT_NEAR(completeDistance(late), 100 + std::log(255.0) / 0.1, 1e-9);
   Fog g = make(FogType::kGlExp);
   g.maxOpacity = 0.5;
   o = TableOptions{};

@@ -92,13 +92,13 @@ std::optional<Error> validate(const Fog& fog) {
   if (!(fog.cutoffDistance > 0.0)) return invalid("/cutoffDistance", "must be > 0 (absent: no cutoff)");
   if (const auto& d = fog.directional) {
     for (int i = 0; i < 3; ++i)
-      if (!(d->color[i] >= 0.0) || !finite(d->color[i]))
-        return invalid("/directional/color/" + std::to_string(i), "must be a finite number >= 0");
+      if (!(d->color[i] >= 0.0 && d->color[i] <= 1e6))
+        return invalid("/directional/color/" + std::to_string(i), "must be in [0, 1e6]");
     const double len = glm::length(d->direction);
     if (!(len > 0.0) || !finite(len)) return invalid("/directional/direction", "must be a finite non-zero vector");
     if (!(d->g > -1.0 && d->g < 1.0)) return invalid("/directional/g", "must be in (-1, 1)");
-    if (d->exponent && !(*d->exponent > 0.0 && finite(*d->exponent)))
-      return invalid("/directional/exponent", "must be a finite number > 0");
+    if (d->exponent && !(*d->exponent > 0.0 && *d->exponent <= 1e6))
+      return invalid("/directional/exponent", "must be in (0, 1e6]");
     if (auto e = nonNegative(d->startDistance, "/directional/startDistance")) return e;
   }
   if (fog.secondLayer) {
@@ -159,7 +159,11 @@ double modeFactor(const Fog& fog, double d) {
     case FogType::kDistanceGaussian:  // seed 003 eqn 2, parameterised (see header)
       return fog.peak * std::exp(-mulZero(fog.distanceCoefficient, d * d));
     case FogType::kHeight: break;  // along a ray: factorAtElevation
-    case FogType::kAtmospheric: break;  // per channel: transmittance
+    case FogType::kAtmospheric: {  // the channels' mean (per channel: transmittance)
+      double sum = 0.0;
+      for (int c = 0; c < 3; ++c) sum += std::exp(-mulZero(fog.extinction[c], d));
+      return sum / 3.0;
+    }
   }
   return 1.0;
 }
@@ -182,10 +186,6 @@ double engineLimits(const Fog& fog, double distance, double f) {
 }
 
 double factorAtElevation(const Fog& fog, double originY, double dirY, double distance) {
-  if (fog.type == FogType::kAtmospheric) {
-    const glm::dvec3 t = transmittance(fog, originY, dirY, distance);
-    return (t.r + t.g + t.b) / 3.0;
-  }
   if (fog.type != FogType::kHeight)
     return engineLimits(fog, distance, modeFactor(fog, std::max(0.0, distance - fog.startDistance)));
   return engineLimits(fog, distance, std::exp(-heightDepth(fog, originY, dirY, distance)));
@@ -297,7 +297,10 @@ double modeDistanceTo(const Fog& fog, double level, double cameraHeight) {
 
 double completeDistance(const Fog& fog, double cameraHeight) {
   const double level = std::max(1.0 / 255.0, 1.0 - fog.maxOpacity);
-  const double d = level >= 1.0 ? 0.0 : fog.startDistance + modeDistanceTo(fog, level, cameraHeight);
+  const double mode = level >= 1.0 ? 0.0 : modeDistanceTo(fog, level, cameraHeight);
+  double d = fog.startDistance + mode;
+  if (fog.directional)  // the glow starts later, and is done as much later
+    d = std::max(d, std::max(fog.startDistance, fog.directional->startDistance) + mode);
   return std::min(d, fog.cutoffDistance);
 }
 

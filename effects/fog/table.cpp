@@ -11,6 +11,7 @@ namespace {
 
 double dirYAt(const Table& t, double row) { return t.height == 1 ? 0.0 : -1.0 + 2.0 * row / double(t.height - 1); }
 double distAt(const Table& t, double col) {
+  if (col >= double(t.width - 1)) return t.rangeEnd;  // exactly: a cutoff at the end must not round past it
   return t.rangeStart + (t.rangeEnd - t.rangeStart) * col / double(t.width - 1);
 }
 
@@ -31,12 +32,13 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
   const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
   if (a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * t.rangeEnd > 700.0) return false;
   if (fog.startDistance > 0.0 || fog.secondLayer) return false;
+  if (k != 0.0 && std::fabs(k) < 1e-290) return false;  // -m/k would lose its precision in subnormals
   const double c = std::exp(logC);
   const double dt = (t.rangeEnd - t.rangeStart) / double(t.width - 1);
   const double rho = std::expm1(-k * dt);
   double m = std::expm1(-k * t.rangeStart);  // e^{-k t} - 1 at the first distance
   for (size_t i = 0; i < t.width; ++i) {
-    const double d = t.rangeStart + dt * double(i);
+    const double d = i + 1 == t.width ? t.rangeEnd : t.rangeStart + dt * double(i);
     const double tau = k == 0.0 ? c * d : c * (-m / k);
     row[i] = static_cast<float>(engineLimits(fog, d, std::exp(-tau)));
     m += rho * (m + 1.0);

@@ -31,7 +31,10 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
     const fog::Directional dir = g.directional.value_or(fog::Directional{});
     const glm::dvec3 toSun = glm::normalize(dir.direction);
     const glm::dvec3 glow = g.directional ? dir.color : glm::dvec3(0);
-    for (double x : {toSun.x, toSun.y, toSun.z, dir.exponent ? 2.0 + *dir.exponent : dir.g}) sun.push_back(x);
+    // In float, g within 6e-8 of +-1 would round to +-1 (a lobe of 0/0): the shader's lobe
+    // stops at |g| = 0.999999 (peak 2e12), where the double reference goes on.
+    const double g32 = std::clamp(dir.g, -0.999999, 0.999999);
+    for (double x : {toSun.x, toSun.y, toSun.z, dir.exponent ? 2.0 + *dir.exponent : g32}) sun.push_back(x);
     for (double x : {glow.r, glow.g, glow.b, dir.startDistance}) sunColor.push_back(x);
     glm::dvec4 q(0);
     switch (g.type) {

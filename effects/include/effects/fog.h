@@ -35,6 +35,7 @@ enum class FogType {
   kHeight,            // exponential height fog: f = exp(-tau), tau the exact optical depth
   kAtmospheric,       // Bevy FogFalloff::Atmospheric: per channel, C = object * exp(-extinction d)
                       //   + color * (1 - exp(-inscattering d)); f = the channels' mean transmittance
+                      //   (under the engine terms as a whole: max(mean, 1 - maxOpacity))
 };
 
 // Seed 003 eqn 2 prints rho = (1/sqrt(2*pi)) * e^(-0.5 z^2) with no d_c although the text says
@@ -63,10 +64,10 @@ struct HeightLayer {
 //   or Unreal's max(cos theta, 0)^exponent when `exponent` is given (a lobe of mean cosine
 //   (n+1)/(n+2) on the forward hemisphere: the HG g of the same mean cosine).
 struct Directional {
-  glm::dvec3 color{1.0, 0.8, 0.6};       // linear RGB, each >= 0 (HDR allowed)
+  glm::dvec3 color{1.0, 0.8, 0.6};       // linear RGB, each in [0, 1e6] (HDR allowed)
   glm::dvec3 direction{0.0, 0.0, -1.0};  // towards the light; non-zero, need not be unit
   double g = 0.7;                        // Henyey-Greenstein asymmetry in (-1, 1)
-  std::optional<double> exponent;        // > 0: Unreal's form instead of HG
+  std::optional<double> exponent;        // (0, 1e6]: Unreal's form instead of HG
   double startDistance = 0.0;            // >= 0; the glow starts at max(this, fog startDistance)
 };
 
