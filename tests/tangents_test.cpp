@@ -268,6 +268,21 @@ TEST(Validate, RejectsBadInputNamingTheIndex) {
   EXPECT_EQ(generate(quad(), small).error().kind, ErrorKind::kLimitExceeded);
 }
 
+// Only coincident-corner triangles: nothing takes part in MikkTSpace (no edges at all), every
+// corner gets the fallback (found by fuzz_glb: bucket pointers into an empty edge list).
+TEST(Mikk, EveryTriangleDegenerateFallsBack) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {0, 0, 0}, {1, 0, 0}};
+  m.uvs = {{0, 0}, {0, 0}, {1, 0}};
+  m.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+  m.indices = {0, 1, 2, 2, 2, 0};
+  auto r = generate(m, {});
+  ASSERT_TRUE(r.ok());
+  expectValid(r.value());
+  EXPECT_EQ(r.value().stats.counters.at("degenerateTriangles"), 2.0);
+  EXPECT_EQ(r.value().stats.counters.at("fallbackCorners"), 6.0);
+}
+
 TEST(Mikk, EmptyMeshIsFine) {
   auto r = generate(Mesh{}, {});
   ASSERT_TRUE(r.ok());

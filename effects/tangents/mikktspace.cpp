@@ -120,6 +120,7 @@ class Mikk {
   // only ever pairs inside its min-vertex bucket, so buckets are sorted and paired in parallel.
   void buildNeighbors() {
     const size_t m = good_.size() * 3;
+    if (m == 0) return;  // every triangle degenerate: no edges (and no bucket pointers into nothing)
     const size_t vcount = mesh_.positions.size();
     std::vector<uint32_t> start(vcount + 1, 0);
     for (size_t g = 0; g < good_.size(); ++g)
@@ -133,7 +134,8 @@ class Mikk {
         edges[fill[std::min(a, b)]++] = {std::max(a, b), uint32_t(g), i & 3u};
       }
     forRange(parallel_, vcount, kParallelGrain, [&](size_t begin, size_t end) {
-      for (size_t v = begin; v < end; ++v) pairBucket(edges.data() + start[v], edges.data() + start[v + 1]);
+      for (size_t v = begin; v < end; ++v)
+        if (start[v] != start[v + 1]) pairBucket(edges.data() + start[v], edges.data() + start[v + 1]);
     });
   }
   struct Edge {  // i0 is the bucket's vertex
