@@ -27,6 +27,14 @@ command -v podman >/dev/null || skip "podman is not installed (apt-get install p
 command -v debootstrap >/dev/null || skip "debootstrap is not installed (apt-get install debootstrap)"
 podman info >/dev/null 2>&1 || skip "podman does not work here: $(podman info 2>&1 | tail -1)"
 unshare --mount --net true 2>/dev/null || skip "cannot create mount and network namespaces"
+# Storage: an image can be imported and mounted (what the checks below stand on).
+probe=localhost/effectd-probe:latest
+if ! { tar -C "$(mktemp -d)" -c . | podman import -q - "$probe" >/dev/null && podman image mount "$probe" >/dev/null &&
+       podman image unmount "$probe" >/dev/null; } 2>/dev/null; then
+  podman rmi -f "$probe" >/dev/null 2>&1 || true
+  skip "podman cannot import and mount an image here"
+fi
+podman rmi -f "$probe" >/dev/null 2>&1 || true
 
 image=localhost/effectd:test
 full=localhost/effectd:test-full
@@ -38,7 +46,8 @@ if ! podman image exists docker.io/library/debian:bookworm; then
   mirror=${mirror:-http://deb.debian.org/debian}
   root=$(mktemp -d)
   say "debootstrap bookworm from $mirror"
-  debootstrap --variant=minbase bookworm "$root" "$mirror" >/dev/null
+  debootstrap --variant=minbase bookworm "$root" "$mirror" >"$root.log" 2>&1 ||
+    { rm -rf "$root"; skip "debootstrap from $mirror failed (no Debian archive here?): $(tail -1 "$root.log")"; }
   rm -rf "$root"/var/cache/apt/archives/*.deb "$root"/var/lib/apt/lists/*
   tar -C "$root" -c . | podman import -q - docker.io/library/debian:bookworm >/dev/null
   rm -rf "$root"
