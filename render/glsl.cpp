@@ -111,22 +111,23 @@ std::string fogGlsl(const FogVariant& v) {
     s << "  }\n";
   }
   s << "  return 1.0;\n}\n";
-  if (v.engine()) {  // fog.h's order: start (fogMode), maxOpacity, cutoff
-    const std::string mode = startParam ? "fogMode(slot, ray, d, e.x)" : "fogMode(slot, ray, d)";
-    s << "float fogFactor(int slot, vec3 world) {\n"
-         "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
+  if (v.engine()) {  // fog.h's order: start (fogMode), maxOpacity, cutoff (fog::engineLimits)
+    const std::string start = startParam ? ", float start" : "", startArg = startParam ? ", start" : "";
+    const std::string mode = "fogMode(slot, ray, d" + startArg + ")";
+    s << "float fogLimited(int slot, vec3 ray, float d" << start << ") {\n"
          "  vec4 e = uFogEngine[slot];\n";
     if (v.cutoff) s << "  if (e.y > 0.0 && d > e.y) return 1.0;\n";
-    s << (v.opacity ? "  return max(" + mode + ", e.z);\n" : "  return " + mode + ";\n") << "}\n";
+    s << (v.opacity ? "  return max(" + mode + ", e.z);\n" : "  return " + mode + ";\n") << "}\n"
+      << "float fogFactor(int slot, vec3 world) {\n"
+         "  vec3 ray = world - uFogCamera;\n"
+      << "  return fogLimited(slot, ray, length(ray)" << (startParam ? ", uFogEngine[slot].x" : "") << ");\n}\n";
   }
   if (v.directional)  // fog::inscatterWeight * color * fog::lobe
     s << "vec3 fogSunGlow(int slot, vec3 world) {\n"
          "  vec4 sun = uFogSun[slot], sc = uFogSunColor[slot];\n"
          "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
          "  if (d == 0.0 || dot(sc.rgb, sc.rgb) == 0.0) return vec3(0.0);\n"
-         "  vec4 e = uFogEngine[slot];\n"
-         "  if (e.y > 0.0 && d > e.y) return vec3(0.0);\n"
-         "  float w = 1.0 - max(fogMode(slot, ray, d, max(e.x, sc.w)), e.z);\n"
+         "  float w = 1.0 - fogLimited(slot, ray, d, max(uFogEngine[slot].x, sc.w));\n"
          "  float c = clamp(dot(ray / d, sun.xyz), -1.0, 1.0);\n"
          "  float g = sun.w;\n"
          "  float den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);\n"

@@ -86,7 +86,7 @@ void appendEncoded(std::string& bytes, float c, const std::string& encoding) {
   }
 }
 
-// One channel per entry (the directional glow's weight), in the table's encoding.
+// Values in order in the table's encoding (the glow's weight; ATMOSPHERIC's RGBA transmittance).
 std::string encodeChannel(const std::vector<float>& values, const std::string& encoding) {
   std::string bytes;
   for (float v : values) appendEncoded(bytes, v, encoding);
@@ -272,10 +272,9 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
       int r = fog::regionAt(regions, p);
       const fog::Fog& f = r < 0 ? global : regions[size_t(r)].fog;
       glm::dvec3 d = p - camera;
-      double w = fog::factor(f, camera, d, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
-      json sample = {{"region", r}, {"factor", wire(w)}};
+      const double len = glm::length(d);
+      json sample = {{"region", r}, {"factor", wire(fog::factor(f, camera, d, len))}};
       if (f.type == fog::FogType::kAtmospheric || f.directional) {  // colour = object * T + fogColor
-        const double len = glm::length(d);
         const glm::dvec3 t = fog::transmittance(f, camera.y, len > 0 ? std::clamp(d.y / len, -1.0, 1.0) : 0.0, len);
         const glm::dvec3 s0 = fog::shade(f, glm::dvec3(0), camera, p);
         sample["transmittance"] = {wire(t.r), wire(t.g), wire(t.b)};

@@ -193,21 +193,27 @@ double factorAtElevation(const Fog& fog, double originY, double dirY, double dis
 
 double factor(const Fog& fog, double d) { return factorAtElevation(fog, fog.baseHeight, 0.0, d); }
 
-glm::dvec3 transmittance(const Fog& fog, double originY, double dirY, double distance) {
-  if (fog.type != FogType::kAtmospheric) return glm::dvec3(factorAtElevation(fog, originY, dirY, distance));
+namespace {
+
+// ATMOSPHERIC: e^(-k d) per channel over the ray beyond the start, under the engine limits.
+glm::dvec3 channelsLimited(const Fog& fog, const glm::dvec3& k, double distance) {
   const double d = std::max(0.0, distance - fog.startDistance);
   glm::dvec3 t;
-  for (int c = 0; c < 3; ++c) t[c] = engineLimits(fog, distance, std::exp(-mulZero(fog.extinction[c], d)));
+  for (int c = 0; c < 3; ++c) t[c] = engineLimits(fog, distance, std::exp(-mulZero(k[c], d)));
   return t;
+}
+
+}  // namespace
+
+glm::dvec3 transmittance(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.type != FogType::kAtmospheric) return glm::dvec3(factorAtElevation(fog, originY, dirY, distance));
+  return channelsLimited(fog, fog.extinction, distance);
 }
 
 glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distance) {
   if (fog.type != FogType::kAtmospheric) return (1.0 - factorAtElevation(fog, originY, dirY, distance)) * fog.color;
-  const double d = std::max(0.0, distance - fog.startDistance);
-  glm::dvec3 s;
-  for (int c = 0; c < 3; ++c)  // the in-scattered weight, capped like the opacity: 1 - engineLimits(1 - w)
-    s[c] = (1.0 - engineLimits(fog, distance, std::exp(-mulZero(fog.inscattering[c], d)))) * fog.color[c];
-  return s;
+  // the in-scattered weight, capped like the opacity: 1 - engineLimits(1 - w)
+  return (1.0 - channelsLimited(fog, fog.inscattering, distance)) * fog.color;
 }
 
 double inscatterWeight(const Fog& fog, double originY, double dirY, double distance) {

@@ -47,27 +47,26 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
 }
 
 void fill(const Fog& fog, double cameraHeight, Table& t) {
-  t.factor.resize(t.width * t.height);
-  if (fog.directional) t.inscatter.resize(t.width * t.height);
+  const size_t n = t.width * t.height;
   const bool rgb = fog.type == FogType::kAtmospheric;
-  if (rgb) t.transmittanceRgb.resize(3 * t.width * t.height), t.scatteredRgb.resize(3 * t.width * t.height);
+  t.factor.resize(n);
+  if (fog.directional) t.inscatter.resize(n);
+  if (rgb) t.transmittanceRgb.resize(3 * n), t.scatteredRgb.resize(3 * n);
   for (size_t j = 0; j < t.height; ++j) {
-    double dirY = dirYAt(t, double(j));
-    if (rgb)
-      for (size_t i = 0; i < t.width; ++i) {
-        const double d = distAt(t, double(i));
-        const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
-        for (int c = 0; c < 3; ++c) {
-          t.transmittanceRgb[3 * (j * t.width + i) + size_t(c)] = static_cast<float>(tr[c]);
-          t.scatteredRgb[3 * (j * t.width + i) + size_t(c)] = static_cast<float>(sc[c]);
-        }
+    const double dirY = dirYAt(t, double(j));
+    const bool rowDone = fog.type == FogType::kHeight && fillHeightRow(fog, cameraHeight, dirY, t, &t.factor[j * t.width]);
+    for (size_t i = 0; i < t.width; ++i) {
+      const size_t e = j * t.width + i;
+      const double d = distAt(t, double(i));
+      if (!rowDone) t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
+      if (fog.directional) t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, d));
+      if (!rgb) continue;
+      const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
+      for (int c = 0; c < 3; ++c) {
+        t.transmittanceRgb[3 * e + size_t(c)] = static_cast<float>(tr[c]);
+        t.scatteredRgb[3 * e + size_t(c)] = static_cast<float>(sc[c]);
       }
-    if (fog.directional)
-      for (size_t i = 0; i < t.width; ++i)
-        t.inscatter[j * t.width + i] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, distAt(t, double(i))));
-    float* row = t.factor.data() + j * t.width;
-    if (fog.type == FogType::kHeight && fillHeightRow(fog, cameraHeight, dirY, t, row)) continue;
-    for (size_t i = 0; i < t.width; ++i) row[i] = static_cast<float>(exact(fog, cameraHeight, distAt(t, double(i)), dirY));
+    }
   }
 }
 
@@ -89,7 +88,7 @@ Result<Table> sized(const Fog& fog, const TableOptions& o, size_t width, size_t 
 
 double measureTableError(const Fog& fog, const Table& t, double cameraHeight, int sub, double* where) {
   double worst = 0.0, worstAt = t.rangeStart;
-  const bool both = fog.directional && t.inscatter.size() == t.factor.size();
+
   const size_t rows = t.height == 1 ? 1 : (t.height - 1) * size_t(sub) + 1;
   const size_t cols = (t.width - 1) * size_t(sub) + 1;
   for (size_t r = 0; r < rows; ++r) {
@@ -108,7 +107,8 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
       };
       double d = distAt(t, col);
       double e = std::fabs(lerp(t.factor) - exact(fog, cameraHeight, d, dirYAt(t, row)));
-      if (both) e = std::max(e, std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, dirYAt(t, row), d)));
+      if (!t.inscatter.empty())
+        e = std::max(e, std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, dirYAt(t, row), d)));
       if (!t.transmittanceRgb.empty()) {
         const glm::dvec3 tr = transmittance(fog, cameraHeight, dirYAt(t, row), d);
         const glm::dvec3 sc = scattered(fog, cameraHeight, dirYAt(t, row), d);

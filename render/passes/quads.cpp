@@ -12,6 +12,11 @@ namespace effects::render {
 
 namespace {
 
+// A height layer as fogHeightTau reads it: (log a, b, h, a > 0).
+glm::dvec4 heightLayerUniform(double a, double b, double h) {
+  return {a > 0 ? std::log(a) : 0.0, b, h, a > 0 ? 1.0 : 0.0};
+}
+
 // Slot 0 = global fog; slots 1.. = regions by increasing volume (stable: ties keep their
 // order), so that the shader's first containing region is regionAt()'s choice.
 std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye) {
@@ -26,8 +31,8 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
     const double cutoff = std::isfinite(g.cutoffDistance) ? g.cutoffDistance : 0.0;
     for (double x : {g.startDistance, cutoff, 1.0 - g.maxOpacity, 0.0}) engine.push_back(x);
     const fog::HeightLayer l = g.secondLayer.value_or(fog::HeightLayer{});
-    for (double x : {l.density > 0 ? std::log(l.density) : 0.0, l.heightFalloff, l.baseHeight, l.density > 0 ? 1.0 : 0.0})
-      layer2.push_back(x);
+    const glm::dvec4 l2 = heightLayerUniform(l.density, l.heightFalloff, l.baseHeight);
+    for (int i = 0; i < 4; ++i) layer2.push_back(l2[i]);
     const fog::Directional dir = g.directional.value_or(fog::Directional{});
     const glm::dvec3 toSun = glm::normalize(dir.direction);
     const glm::dvec3 glow = g.directional ? dir.color : glm::dvec3(0);
@@ -45,9 +50,7 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
       case fog::FogType::kGlExp2: q.x = g.density; break;
       case fog::FogType::kDistanceExp2: q.x = g.distanceCoefficient; break;
       case fog::FogType::kDistanceGaussian: q = {g.distanceCoefficient, g.peak, 0, 0}; break;
-      case fog::FogType::kHeight:
-        q = {g.density > 0 ? std::log(g.density) : 0.0, g.heightFalloff, g.baseHeight, g.density > 0 ? 1.0 : 0.0};
-        break;
+      case fog::FogType::kHeight: q = heightLayerUniform(g.density, g.heightFalloff, g.baseHeight); break;
       case fog::FogType::kAtmospheric: q = glm::dvec4(g.extinction, 0); break;
     }
     for (int i = 0; i < 3; ++i) inscatter.push_back(g.type == fog::FogType::kAtmospheric ? g.inscattering[i] : 0.0);
