@@ -142,6 +142,15 @@ const std::vector<Option>& options() {
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
        "none)",
        setCorsOrigins},
+      {"playground", "EFFECTD_PLAYGROUND",
+       "auto|on|off: the browser playground at / (default auto: on when listening on loopback only)",
+       [](const std::string& s, Config& c) {
+         if (s == "1" || s == "true") c.playground = "on";
+         else if (s == "0" || s == "false") c.playground = "off";
+         else if (s == "auto" || s == "on" || s == "off") c.playground = s;
+         else return false;
+         return true;
+       }},
   };
   return opts;
 }
@@ -157,6 +166,12 @@ std::string usage() {
         "Flags (environment variable in brackets; flags win over the environment):\n";
   for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";
   return os.str();
+}
+
+bool playgroundEnabled(const Config& config) {
+  if (config.playground != "auto") return config.playground == "on";
+  const std::string& h = config.host;
+  return h == "localhost" || h == "::1" || h == "[::1]" || h.rfind("127.", 0) == 0;
 }
 
 std::string parseConfig(const std::vector<std::string>& args, Config& config, bool& help) {

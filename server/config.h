@@ -39,6 +39,7 @@ struct Config {
   int admissionTimeoutMs = 10000;        // longest wait for admission before 503
   size_t responseCacheMb = 64;           // encoded answers kept for repeats; 0 = off
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
+  std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
   Limits limits;
 };
 
@@ -48,5 +49,10 @@ struct Config {
 std::string parseConfig(const std::vector<std::string>& args, Config& config, bool& help);
 
 std::string usage();
+
+// Whether / serves the browser playground. "auto" turns it on only when the server listens on
+// loopback: there the only visitor is the developer at that machine. Bound elsewhere, a page
+// that lets anyone who can reach the port start renders is the operator's decision to make.
+bool playgroundEnabled(const Config& config);
 
 }  // namespace effectd

@@ -15,6 +15,7 @@
 
 #include "config.h"
 #include "endpoints.h"
+#include "playground.h"
 #include "scene.h"
 #include "service.h"
 
@@ -163,13 +164,14 @@ int main(int argc, char** argv) {
 
   effectd::Service service(config);
   effectd::addEffectEndpoints(service);
+  if (effectd::playgroundEnabled(config)) effectd::addPlayground(service);
   int port = service.bind();
   if (port < 0) {
     std::fprintf(stderr, "effectd: cannot listen on %s:%d\n", config.host.c_str(), config.port);
     return 1;
   }
-  std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"listening\",\"host\":\"%s\",\"port\":%d,\"threads\":%d}\n",
-               config.host.c_str(), port, config.threads);
+  std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"listening\",\"host\":\"%s\",\"port\":%d,\"threads\":%d,\"playground\":%s}\n",
+               config.host.c_str(), port, config.threads, effectd::playgroundEnabled(config) ? "true" : "false");
 
   std::atomic<bool> signalled{false};
   std::thread waiter([&] {

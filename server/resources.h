@@ -1,4 +1,4 @@
-// Files of proto/ embedded into the binary at build time (cmake/embed.cmake), so the server
+// Files of proto/ (and of the playground) embedded into the binary at build time (cmake/embed.cmake), so the server
 // serves and validates against exactly the contract it was built with, from any directory.
 #pragma once
 
@@ -9,4 +9,8 @@
 namespace effectd {
 // Keys are paths relative to proto/: "openapi.yaml", "schemas/fog.json", ...
 const std::map<std::string, std::string_view>& resources();
+// The browser playground (server/playground/) and the request examples it starts from; keys are
+// paths relative to the repository: "server/playground/index.html", "proto/examples/fog/...json",
+// "examples/01-lightning.json".
+const std::map<std::string, std::string_view>& playgroundResources();
 }  // namespace effectd

@@ -255,6 +255,23 @@ void Service::addBinaryAlternative(const std::string& path, const std::string& c
     if (r->path == path) r->binary[contentType] = {std::move(handler), std::move(cost)};
 }
 
+void Service::addStatic(const std::string& path, const std::string& contentType, std::string body) {
+  auto r = std::make_unique<Route>();
+  r->path = path;
+  r->methods = {"GET", "HEAD"};
+  routes_.push_back(std::move(r));
+  const bool html = contentType.rfind("text/html", 0) == 0;
+  http_->Get(path, [contentType, html, body = std::move(body)](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    if (html)
+      res.set_header("Content-Security-Policy",
+                     "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+                     "connect-src 'self'; frame-ancestors 'none'");
+    res.set_content(body, contentType);
+  });
+}
+
 void Service::addReadinessCheck(const std::string& name, std::function<std::string()> probe) {
   readiness_.emplace_back(name, std::move(probe));
 }

@@ -94,6 +94,9 @@ class Service {
   // Lets `path` also accept a body of `contentType` (its own handler, no JSON Schema).
   void addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler,
                             BinaryEstimator cost);
+  // GET/HEAD `path` answers `body` as `contentType` (static files: the playground). HTML gets a
+  // Content-Security-Policy that allows only this origin's scripts, styles and requests.
+  void addStatic(const std::string& path, const std::string& contentType, std::string body);
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
   // Responses carry a strong ETag: SHA-256 of the version, the route, the canonical request

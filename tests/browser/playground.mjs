@@ -1,0 +1,187 @@
+// The playground at / in a real browser (Debian's chromium, headless, WebGL2 on SwiftShader):
+// the page loads with no console errors; every example of every effect runs (answer 200, a
+// preview image, a live canvas that is not blank); changing eta re-requests and changes the
+// picture; an invalid value shows the server's problem at the field it names; a GLB upload
+// gets tangents; the shareable URL restores the request; "copy as curl" is a command that
+// works; --playground and the bind address turn the page off. A screenshot of each effect is
+// saved (PLAYGROUND_SCREENSHOTS, default $TMPDIR/effectd-playground); docs/playground/ holds
+// the ones the README shows.
+// Usage: node playground.mjs EFFECTD_BINARY [CHROMIUM]
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import puppeteer from 'puppeteer-core';
+import { check, results, startEffectd } from '../node/effectd.mjs';
+
+const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
+const shots = process.env.PLAYGROUND_SCREENSHOTS || path.join(os.tmpdir(), 'effectd-playground');
+fs.mkdirSync(shots, { recursive: true });
+
+// The page is on, and only on, where it should be.
+for (const [args, expect] of [[[], 200], [['--playground', 'off'], 404], [['--host', '0.0.0.0'], 404],
+                              [['--host', '0.0.0.0', '--playground', 'on'], 200]]) {
+  const { url, process: p } = await startEffectd(binary, args);
+  const res = await fetch(`${url.replace('0.0.0.0', '127.0.0.1')}/`);
+  const csp = res.headers.get('content-security-policy') || '';
+  check(res.status === expect, `GET / with [${args.join(' ')}] answers ${expect}`, res.status);
+  if (expect === 200) check(/script-src 'self'/.test(csp), 'the page has a Content-Security-Policy', csp);
+  p.kill();
+}
+
+const { url: api, process: server } = await startEffectd(binary);
+const browser = await puppeteer.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+         '--ignore-gpu-blocklist'],
+});
+const problems = [];
+let renders = 0;
+async function open(url) {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1400, height: 900 });
+  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') problems.push(`${m.type()}: ${m.text()}`); });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  page.on('request', (r) => { if (r.url().endsWith('/v1/render')) renders++; });
+  await page.goto(url);
+  return page;
+}
+// Resolves once the page has finished a run after `since` runs.
+async function settled(page, since) {
+  await page.waitForFunction((n) => Number(document.body.dataset.runs || 0) > n && !document.body.dataset.busy,
+                             { timeout: 60000 }, since);
+  return page.evaluate(() => window.playground.state.last);
+}
+const runs = (page) => page.evaluate(() => Number(document.body.dataset.runs || 0));
+// Pixels of the live canvas that differ from its corner (the clear colour), and a hash of them.
+const canvasStats = (page) => page.evaluate(() => {
+  const c = document.getElementById('live');
+  const g = Object.assign(document.createElement('canvas'), { width: c.width, height: c.height }).getContext('2d');
+  g.drawImage(c, 0, 0);
+  const d = g.getImageData(0, 0, c.width, c.height).data;
+  let lit = 0, hash = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    if (Math.abs(d[i] - d[0]) + Math.abs(d[i + 1] - d[1]) + Math.abs(d[i + 2] - d[2]) > 24) lit++;
+    hash = (hash * 31 + d[i] + d[i + 1] * 7 + d[i + 2] * 13) | 0;
+  }
+  return { lit, fraction: lit / (d.length / 4), hash };
+});
+// The preview image's size and a hash of its pixels.
+const previewBytes = (page) => page.evaluate(() => {
+  const img = document.getElementById('preview');
+  if (img.hidden || !img.src || !img.naturalWidth) return null;
+  const g = Object.assign(document.createElement('canvas'), { width: img.naturalWidth, height: img.naturalHeight }).getContext('2d');
+  g.drawImage(img, 0, 0);
+  const d = g.getImageData(0, 0, img.naturalWidth, img.naturalHeight).data;
+  let h = 0;
+  for (let i = 0; i < d.length; ++i) h = (h * 31 + d[i]) | 0;
+  return { hash: h, width: img.naturalWidth };
+});
+
+try {
+  const page = await open(`${api}/`);
+  await settled(page, 0);
+  const examples = await page.evaluate(() => fetch('/playground/examples.json').then((r) => r.json()));
+  const effects = await page.$$eval('#effects button', (bs) => bs.map((b) => b.dataset.effect));
+  check(effects.join() === 'lightning,fog,bubble,tangents,scene', 'every effect can be chosen', effects);
+  const shown = { lightning: '07-strike-timeline', fog: '06-engine-terms-sunset', bubble: '05-film-thickness-lights-and-gltf',
+                  tangents: '02-mirrored-uvs-split', scene: '04-storm-over-water' };
+  for (const effect of effects) {
+    check((examples[effect] || []).length > 0, `${effect} has examples`);
+    for (const { name } of examples[effect]) {
+      const before = await runs(page);
+      await page.evaluate((e, n) => {
+        document.querySelector(`#effects button[data-effect="${e}"]`).click();
+        const s = document.getElementById('example');
+        s.value = n;
+        s.dispatchEvent(new Event('change'));
+      }, effect, name);
+      const last = await settled(page, before);
+      await new Promise((r) => setTimeout(r, 150));  // the live view draws on the next frame
+      const live = await canvasStats(page);
+      const preview = await previewBytes(page);
+      const wantPreview = effect !== 'tangents';
+      check(last.status === 200 && !last.error && (!wantPreview || (last.preview === 200 && preview && preview.width > 0)) &&
+            live.lit > 20,
+            `${effect} ${name}: answer, preview and live view`, { last, preview, live });
+      if (shown[effect] === name) await page.screenshot({ path: path.join(shots, `${effect}.png`) });
+    }
+  }
+
+  // Knobs: eta re-requests and changes both pictures.
+  const lightning = async (example) => {
+    const before = await runs(page);
+    await page.evaluate((n) => {
+      document.querySelector('#effects button[data-effect="lightning"]').click();
+      const s = document.getElementById('example');
+      s.value = n;
+      s.dispatchEvent(new Event('change'));
+    }, example);
+    await settled(page, before);
+  };
+  await lightning('01-fast-128');
+  const setEta = async (value) => {
+    const before = await runs(page);
+    await page.evaluate((v) => {
+      const input = document.querySelector('input[data-pointer="/eta"]');
+      input.value = v;
+      input.dispatchEvent(new Event('input', { bubbles: true }));
+    }, value);
+    return settled(page, before);
+  };
+  await new Promise((r) => setTimeout(r, 150));
+  const [p0, c0, r0] = [await previewBytes(page), await canvasStats(page), renders];
+  const last = await setEta('0.5');
+  await new Promise((r) => setTimeout(r, 150));
+  const [p1, c1] = [await previewBytes(page), await canvasStats(page)];
+  check(last.status === 200 && renders > r0 && p1.hash !== p0.hash && c1.hash !== c0.hash,
+        'changing eta re-renders the preview and redraws the live view', { renders: renders - r0, p0, p1, c0, c1 });
+  const request = await page.evaluate(() => window.playground.state.request);
+  check(request.eta === 0.5, 'the form edits the request', request.eta);
+
+  // An invalid value: the problem appears at the field it names (the browser logs the 400).
+  const quiet = problems.length;
+  const bad = await setEta('-3');
+  problems.splice(quiet, problems.length - quiet, ...problems.slice(quiet).filter((m) => !/status of 400/.test(m)));
+  const fieldError = await page.$eval('.field[data-pointer="/eta"]', (f) => ({
+    invalid: f.classList.contains('invalid'), text: (f.querySelector('.field-error') || {}).textContent || '' }));
+  check(bad.status === 400 && fieldError.invalid && /\/eta/.test(fieldError.text), 'an invalid eta shows its problem at the eta field',
+        { bad, fieldError });
+  await page.screenshot({ path: path.join(shots, 'field-error.png') });
+  await setEta('2');
+
+  // The shareable URL restores the request; "copy as curl" is a working command.
+  const shared = await page.evaluate(() => location.href);
+  const wanted = await page.evaluate(() => JSON.stringify(window.playground.state.request));
+  const curl = await page.$eval('#curl', (e) => e.textContent);
+  const second = await open(shared);
+  await settled(second, 0);
+  const restored = await second.evaluate(() => JSON.stringify(window.playground.state.request));
+  check(restored === wanted, 'the page URL restores the request', { shared, restored });
+  await second.close();
+  const out = JSON.parse(execFileSync('bash', ['-c', curl], { encoding: 'utf8' }));
+  check(Array.isArray(out.polylines) && out.method === 'fast', '"copy as curl" runs as a command and answers', curl.slice(0, 200));
+
+  // A GLB upload: the bubble's own glTF, sent as model/gltf-binary, answered with tangents.
+  const glb = path.join(os.tmpdir(), `effectd-playground-${process.pid}.glb`);
+  const res = await fetch(`${api}/v1/bubble`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                                body: JSON.stringify({ mesh: { level: 2 }, format: 'glb' }) });
+  fs.writeFileSync(glb, Buffer.from(await res.arrayBuffer()));
+  await page.evaluate(() => document.querySelector('#effects button[data-effect="tangents"]').click());
+  await settled(page, await runs(page));
+  const before = await runs(page);
+  await (await page.$('#glb')).uploadFile(glb);
+  const uploaded = await settled(page, before);
+  await new Promise((r) => setTimeout(r, 150));
+  const glbLive = await canvasStats(page);
+  check(uploaded.status === 200 && glbLive.fraction > 0.01, 'an uploaded GLB gets tangents, drawn live', { uploaded, glbLive });
+  fs.rmSync(glb);
+
+  check(problems.length === 0, 'no console errors or warnings', problems);
+} finally {
+  await browser.close();
+  server.kill();
+}
+console.log(`screenshots in ${shots}`);
+process.exit(results.failures ? 1 : 0);
