@@ -4,6 +4,7 @@
 // (bolt, candidates, their weights, the axis); its pure parts live beside it (grid.h,
 // laplace.h, astar, weight_tree.h).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -59,6 +60,7 @@ struct Candidate {
   // to the grower's weight reference (kept per candidate: only cells that gain a neighbour
   // change, so a step costs one pass of additions, not a logarithm and a power per candidate).
   double logStatic = 0, weight = 0;
+  double logBoundary = 0;  // kFast: log B, which no new axis changes
 };
 
 class Grower {
@@ -87,8 +89,17 @@ class Grower {
   void removeCandidate(size_t slot);
   void expireCandidates();
   void logWeights(std::vector<double>& out);
-  double fastLogStatic(Cell c);
-  static double fastLogPhi(const Candidate& c) { return c.logStatic - std::log(double(c.neighbours)); }
+  double fastLogStatic(const Candidate& c) const;
+  static double fastLogPhi(const Candidate& c) { return c.logStatic - logCount(c.neighbours); }
+  // log n for the bolt-neighbour counts 1..8, looked up: the same values std::log gives.
+  static double logCount(int n) {
+    static const std::array<double, 9> table = [] {
+      std::array<double, 9> t{};
+      for (int i = 1; i < 9; ++i) t[size_t(i)] = std::log(double(i));
+      return t;
+    }();
+    return table[size_t(n)];
+  }
   void refreshFastWeight(Candidate& c);
   void restartFastWeights();
   size_t sampleFast();
@@ -118,6 +129,7 @@ class Grower {
   std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
   std::unique_ptr<detail::Laplace> laplace_, reference_;
   Rng rng_{p_.seed};
+  const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
   int step_ = 0;
   Cell anchor_, attractor_;    // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
   double weightRef_ = 0;       // kFast: weights are exp(eta * log Phi - weightRef_)
@@ -177,7 +189,8 @@ void Grower::addCandidatesAround(int node) {
     if (p_.method == Method::kCharges)
       for (const Node& n : bolt_.nodes) cand.charge += 1.0 / std::hypot(double(x - n.cell.x), double(y - n.cell.y));
     if (p_.method == Method::kFast) {
-      cand.logStatic = fastLogStatic(cand.cell);
+      cand.logBoundary = std::log(boundary(cand.cell));
+      cand.logStatic = fastLogStatic(cand);
       refreshFastWeight(cand);
     }
     candidateOf_[i] = int32_t(cands_.size());
@@ -236,8 +249,8 @@ void Grower::logWeights(std::vector<double>& out) {
 // is the border/obstacle charge potential (large near them: Phi small), P (eqn 5) the
 // distance to the positive charge, G the candidate's step along anchor -> attractor. N (eqn 6,
 // the adjacent bolt cells) changes as the bolt grows and is applied in refreshFastWeight().
-double Grower::fastLogStatic(Cell c) {
-  const double lnGrowth = std::log(p_.axisGrowth);
+double Grower::fastLogStatic(const Candidate& cand) const {
+  const Cell c = cand.cell;
   double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
   const double len = std::hypot(ax, ay);
   if (len > 0) {
@@ -250,7 +263,7 @@ double Grower::fastLogStatic(Cell c) {
   const double along = (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
   const double G = std::floor(along <= len ? along : 2 * len - along);
   const double P = std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
-  return G * lnGrowth - std::log(boundary(c)) - std::log(std::max(P, 0.5));
+  return G * lnGrowth_ - cand.logBoundary - std::log(std::max(P, 0.5));
 }
 
 // Phi^eta of one candidate against the current reference (eta = 0: every weight 1).
@@ -265,7 +278,7 @@ void Grower::refreshFastWeight(Candidate& c) {
 
 // A new axis (segment start, next waypoint): every candidate's G and P change.
 void Grower::restartFastWeights() {
-  for (Candidate& c : cands_) c.logStatic = fastLogStatic(c.cell);
+  for (Candidate& c : cands_) c.logStatic = fastLogStatic(c);
   rescale_ = true;
 }
 
