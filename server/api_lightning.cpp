@@ -13,6 +13,8 @@ using nlohmann::json;
 namespace lt = effects::lightning;
 
 std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::string& at) {
+  for (const char* threeD : {"boxes", "spheres", "mesh", "glb"})
+    if (o.contains(threeD)) throw fieldError(400, at + "/" + threeD, "is for 3-D grids (grid.depth)");
   std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
   bool any = false;
   if (o.contains("rects")) {
@@ -51,21 +53,32 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::stri
   return grid;
 }
 
-lt::Cell cellOf(const json& j) { return {j[0].get<int>(), j[1].get<int>()}; }
+// A cell of the request: [x, y] on a 2-D grid, [x, y, z] on a 3-D one.
+lt::Cell cellOf(const json& j, int depth, const std::string& at) {
+  if (j.size() != (depth ? 3u : 2u))
+    throw fieldError(400, at, depth ? "must be [x, y, z] on a 3-D grid" : "must be [x, y] on a 2-D grid (no grid.depth)");
+  return {j[0].get<int>(), j[1].get<int>(), depth ? j[2].get<int>() : 0};
+}
 
-// "polylines": per line its channel, width, flat [x, y, ...] points, and per point the step and intensity.
-json polylinesJson(const std::vector<lt::Polyline>& polylines) {
+// "polylines": per line its channel, width, flat [x, y, ...] points (3-D: [x, y, z, ...], in
+// world units with "world"), and per point the step and intensity.
+json polylinesJson(const std::vector<lt::Polyline>& polylines, int depth, const World& world) {
   json lines = json::array();
   for (const auto& l : polylines) {
     json xy = json::array(), step = json::array(), intensity = json::array();
     for (const auto& v : l.vertices) {
-      xy.push_back(v.x);
-      xy.push_back(v.y);
+      if (depth) {
+        const auto p = world.toWorld(v.x, v.y, v.z);
+        for (double c : p) xy.push_back(wire(c));
+      } else {
+        xy.push_back(v.x);
+        xy.push_back(v.y);
+      }
       step.push_back(v.step);
       intensity.push_back(v.intensity);
     }
     lines.push_back({{"channel", l.main ? "main" : "branch"},
-                     {"width", l.width},
+                     {"width", world.given ? wire(l.width * world.cellSize) : double(l.width)},
                      {"points", std::move(xy)},
                      {"step", std::move(step)},
                      {"intensity", std::move(intensity)}});
@@ -79,6 +92,7 @@ json cellsJson(const lt::Bolt& bolt) {
   for (const auto& n : bolt.nodes) {
     c.push_back(n.cell.x);
     c.push_back(n.cell.y);
+    if (bolt.depth) c.push_back(n.cell.z);
   }
   return c;
 }
@@ -96,7 +110,7 @@ json treeJson(const lt::Bolt& bolt) {
 // "guide": the A* waypoints, [[x, y], ...].
 json guideJson(const lt::Bolt& bolt) {
   json g = json::array();
-  for (const auto& c : bolt.guide) g.push_back({c.x, c.y});
+  for (const auto& c : bolt.guide) g.push_back(bolt.depth ? json::array({c.x, c.y, c.z}) : json::array({c.x, c.y}));
   return g;
 }
 
@@ -147,25 +161,33 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   lt::Params& p = r.params;
   p.width = body["grid"]["width"];
   p.height = body["grid"]["height"];
-  const size_t cells = size_t(p.width) * size_t(p.height);
+  p.depth = body["grid"].value("depth", 0);
+  const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
   if (cells > config.limits.maxGridCells)
     throw fieldError(413, at + "/grid",
                      "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
                          std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
-  if (body.contains("obstacles")) p.obstacles = parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
-  p.start = cellOf(body["start"]);
+  if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
+  r.world = parseWorld(body, at + "/world");
+  if (body.contains("obstacles"))
+    p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
+                                                 at + "/obstacles")
+                          : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
+  p.start = cellOf(body["start"], p.depth, at + "/start");
   p.targets.clear();
-  for (const auto& t : body["targets"]) p.targets.push_back(cellOf(t));
+  for (size_t i = 0; i < body["targets"].size(); ++i)
+    p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   const std::string method = body.value("method", "fast");
   p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
-  if (p.method != lt::Method::kFast && cells > config.limits.maxSolverGridCells)
+  const size_t solverLimit = p.depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells;
+  if (p.method != lt::Method::kFast && cells > solverLimit)
     throw fieldError(413, at + "/grid",
-                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
-                         std::to_string(config.limits.maxSolverGridCells) + " for method " + method +
-                         " (--max-solver-grid-cells); the fast method takes up to " +
-                         std::to_string(config.limits.maxGridCells));
+                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " + std::to_string(solverLimit) +
+                         " for method " + method +
+                         (p.depth ? " (--max-solver-volume-cells)" : " (--max-solver-grid-cells)") +
+                         "; the fast method takes up to " + std::to_string(config.limits.maxGridCells));
   p.eta = body.value("eta", p.eta);
-  p.neighbourhood = body.value("neighbourhood", p.neighbourhood);
+  p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
   p.axisGrowth = lt::calibratedAxisGrowth(p);
   if (body.value("variant", "calibrated") == "paper") {
     p.lifetime = lt::kPaperLifetime;
@@ -209,7 +231,10 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;
-  json out = {{"method", bolt.stats.method}, {"grid", {p.width, p.height}}};
+  json out = {{"method", bolt.stats.method},
+              {"grid", p.depth ? json::array({p.width, p.height, p.depth}) : json::array({p.width, p.height})}};
+  if (request.world.given)
+    out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};
   if (p.method == lt::Method::kFast) out["variant"] = body.value("variant", "calibrated");
   out["mainChannelLength"] = bolt.mainChannel.size();
   out["cellCount"] = bolt.nodes.size();
@@ -217,7 +242,7 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
 
   if (include.has("polylines") || include.has("timeline")) {
     const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
-    if (include.has("polylines")) out["polylines"] = polylinesJson(lines);
+    if (include.has("polylines")) out["polylines"] = polylinesJson(lines, p.depth, request.world);
     if (include.has("timeline")) out["timeline"] = timelineJson(lt::timeline(bolt, lines, request.timeline));
   }
   if (include.has("cells")) out["cells"] = cellsJson(bolt);
@@ -226,7 +251,8 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   if (include.has("fractalDimension")) {
     std::vector<lt::Cell> cellsOnly;
     for (const auto& n : bolt.nodes) cellsOnly.push_back(n.cell);
-    out["fractalDimension"] = lt::fractalDimension(cellsOnly, p.width, p.height);
+    out["fractalDimension"] = p.depth ? lt::fractalDimension(cellsOnly, p.width, p.height, p.depth)
+                                      : lt::fractalDimension(cellsOnly, p.width, p.height);
   }
   if (include.has("error")) {
     out["error"] = {{"meanTotalVariation", bolt.stats.error.value_or(0.0)},

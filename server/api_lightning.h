@@ -8,6 +8,7 @@
 
 #include <effects/lightning.h>
 
+#include "lightning_volume.h"
 #include "service.h"
 
 namespace effectd {
@@ -18,6 +19,7 @@ struct LightningRequest {
   effects::lightning::Params params;
   effects::lightning::ShapeParams shape;
   effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
+  World world;                                  // 3-D: where the grid lies ("world")
 };
 // The request at JSON pointer `at` ("" for the endpoint's body); problems name fields under it.
 LightningRequest parseLightning(const nlohmann::json& body, const Config& config, const std::string& at);

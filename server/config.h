@@ -13,6 +13,7 @@ struct Limits {
   size_t maxGridCells = 4096u * 4096u;      // lightning grid width*height
   size_t maxGrowthSteps = 2'000'000;        // lightning cells added per request
   size_t maxSolverGridCells = 256u * 256u;  // dbm and charges: every step costs O(cells)
+  size_t maxSolverVolumeCells = 64u * 64u * 64u;  // dbm on 3-D grids
   size_t maxTableSize = 65536;              // fog table entries (all dimensions together)
   size_t maxMeshVertices = 2'000'000;       // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;

@@ -42,11 +42,16 @@ Cost lightningCost(const json& body, const Config& config) {
   // Sizes over a configured limit are refused by the handler naming the field: clamp here.
   const std::string method = body.value("method", "fast");
   const bool solver = method != "fast";
-  const size_t cells = std::min(size_t(body["grid"]["width"].get<int>()) * size_t(body["grid"]["height"].get<int>()),
-                                solver ? config.limits.maxSolverGridCells : config.limits.maxGridCells);
+  const size_t depth = size_t(body["grid"].value("depth", 0));
+  const size_t cells =
+      std::min(size_t(body["grid"]["width"].get<int>()) * size_t(body["grid"]["height"].get<int>()) * std::max<size_t>(depth, 1),
+               solver ? (depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells)
+                      : config.limits.maxGridCells);
   // Working set per cell: fast keeps the obstacle grid, candidate and potential state and
-  // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils).
-  const size_t perCell = solver ? 160 : 24;
+  // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils: 27-point
+  // ones in 3-D). 3-D fast adds the A* guide's cost and parent per voxel and the octree's
+  // charge byte (measured: bench/lightning_bench BM_Volume*).
+  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 40 : 24);
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps =
       std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);

@@ -186,5 +186,108 @@ TEST(LightningApi, WalledTargetIs422NotAHang) {
   }
 }
 
+// 3-D: a bolt from a cloud layer down to a tower, around a building block, in world units.
+json volumeRequest() {
+  return {{"grid", {{"width", 32}, {"height", 32}, {"depth", 32}}},
+          {"start", {16, 0, 16}},
+          {"targets", {{20, 31, 8}}},
+          {"world", {{"origin", {-16.0, 32.0, 16.0}}, {"cellSize", 0.5}}},
+          {"obstacles",
+           {{"boxes", {{6, 14, 6, 14, 6, 14}}},
+            {"spheres", {{{"center", {-8.0, 20.0, 4.0}}, {"radius", 2.0}}}},
+            {"mesh", {{"positions", {-14.0, 28.0, 14.0, 2.0, 28.0, 14.0, -14.0, 28.0, -2.0}}, {"indices", {0, 1, 2}}}}}},
+          {"seed", 3},
+          {"include", {"polylines", "cells", "guide", "fractalDimension", "timeline"}}};
+}
+
+TEST(LightningApi, VolumeBoltInWorldUnits) {
+  TestServer s;
+  auto r = s.postJson("/v1/lightning", volumeRequest());
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  EXPECT_EQ(j["grid"], json::array({32, 32, 32}));
+  EXPECT_EQ(j["world"]["cellSize"], 0.5);
+  const json& cells = j["cells"];
+  ASSERT_EQ(cells.size() % 3, 0u);
+  for (size_t i = 0; i < cells.size(); i += 3) {
+    const int x = cells[i], y = cells[i + 1], z = cells[i + 2];
+    EXPECT_FALSE(x >= 6 && x < 20 && y >= 14 && y < 20 && z >= 6 && z < 20) << "inside the box";
+  }
+  // Points: three per vertex, in world units inside the grid's box.
+  for (const auto& line : j["polylines"]) {
+    ASSERT_EQ(line["points"].size(), 3 * line["step"].size());
+    for (size_t i = 0; i < line["points"].size(); i += 3) {
+      const double x = line["points"][i], y = line["points"][i + 1], z = line["points"][i + 2];
+      EXPECT_TRUE(x >= -16 && x <= 0 && y >= 16 && y <= 32 && z >= 0 && z <= 16) << x << " " << y << " " << z;
+    }
+  }
+  EXPECT_EQ(j["polylines"][0]["width"], 2 * 0.5);
+  EXPECT_EQ(j["timeline"]["polylines"].size(), j["polylines"].size());
+  for (const auto& g : j["guide"]) EXPECT_EQ(g.size(), 3u);
+  // Same request, same bytes.
+  EXPECT_EQ(s.postJson("/v1/lightning", volumeRequest())->body, r->body);
+}
+
+TEST(LightningApi, VolumeObstaclesFromAGlb) {
+  // The bubble's own glTF (a unit sphere) scaled into the grid blocks the voxels of its surface.
+  TestServer s;
+  auto glb = s.postJson("/v1/bubble", json{{"mesh", {{"level", 2}, {"radius", 6}}}, {"format", "glb"}});
+  ASSERT_EQ(glb->status, 200);
+  json req = volumeRequest();
+  req["obstacles"] = {{"glb", base64Encode(glb->body)}};
+  req["world"] = {{"origin", {-16.0, 16.0, 16.0}}, {"cellSize", 1.0}};  // the sphere's centre is voxel (16, 16, 16)
+  req["start"] = {16, 0, 16};
+  req["targets"] = {{16, 16, 16}};  // inside the hollow sphere: unreachable through its surface
+  auto r = s.postJson("/v1/lightning", req);
+  EXPECT_EQ(r->status, 422) << r->body;
+  req["targets"] = {{16, 31, 16}};
+  r = s.postJson("/v1/lightning", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  for (size_t i = 0; i < j["cells"].size(); i += 3) {
+    const double dx = j["cells"][i].get<int>() + 0.5 - 16, dy = j["cells"][i + 1].get<int>() + 0.5 - 16,
+                 dz = j["cells"][i + 2].get<int>() + 0.5 - 16;
+    EXPECT_GT(std::sqrt(dx * dx + dy * dy + dz * dz), 5.0) << "inside the sphere's shell";
+  }
+}
+
+TEST(LightningApi, VolumeProblemsNameTheField) {
+  TestServer s;
+  auto problem = [&](json req, int status, const std::string& pointer) {
+    auto r = s.postJson("/v1/lightning", req);
+    ASSERT_EQ(r->status, status) << r->body;
+    EXPECT_EQ(json::parse(r->body)["errors"][0]["pointer"], pointer) << r->body;
+  };
+  json req = volumeRequest();
+  req["start"] = {16, 0};
+  problem(req, 400, "/start");
+  req = volumeRequest();
+  req["obstacles"] = {{"rects", {{0, 0, 4, 4}}}};
+  problem(req, 400, "/obstacles/rects");
+  req = request(32);
+  req["world"] = {{"cellSize", 1}};
+  problem(req, 400, "/world");
+  req = request(32);
+  req["obstacles"] = {{"boxes", {{0, 0, 0, 4, 4, 4}}}};
+  problem(req, 400, "/obstacles/boxes");
+  req = volumeRequest();
+  req["obstacles"] = {{"mesh", {{"positions", {0, 0, 0, 1, 1, 1, 2, 2}}, {"indices", {0, 1, 2}}}}};
+  problem(req, 400, "/obstacles/mesh/positions");
+  req = volumeRequest();
+  req["obstacles"] = {{"mesh", {{"positions", {0, 0, 0, 1, 1, 1, 2, 2, 2}}, {"indices", {0, 1, 3}}}}};
+  problem(req, 400, "/obstacles/mesh/indices/2");
+  req = volumeRequest();
+  req["grid"] = {{"width", 80}, {"height", 80}, {"depth", 80}};
+  req["method"] = "dbm";
+  problem(req, 413, "/grid");
+  req = volumeRequest();
+  req["obstacles"] = {{"glb", base64Encode("not a glb")}};
+  auto r = s.postJson("/v1/lightning", req);
+  EXPECT_EQ(r->status, 400) << r->body;
+  req = volumeRequest();
+  req["method"] = "charges";
+  problem(req, 400, "/method");
+}
+
 }  // namespace
 }  // namespace effectd::testing

@@ -546,7 +546,7 @@ TEST(Render, ConcurrentRendersAreCorrectAndThePoolStaysWithinItsSize) {
   effects::lightning::Polyline line;
   line.main = true;
   line.width = 2;
-  line.vertices = {{0.5f, 0.5f, 0, 1.0f, 0}, {7.5f, 7.5f, 1, 1.0f, 1}};
+  line.vertices = {{0.5f, 0.5f, 0.0f, 0, 1.0f, 0}, {7.5f, 7.5f, 0.0f, 1, 1.0f, 1}};
   scene.lightning->polylines = {line};
   std::vector<std::future<effects::Result<rd::Frame>>> jobs;
   std::vector<std::thread> clients;

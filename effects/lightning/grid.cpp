@@ -161,6 +161,27 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
 }
 
 bool lineOfSight(const Grid& g, Cell a, Cell b) {
+  if (g.depth > 1) {
+    // 3-D: the voxels the segment between the centres passes through (Amanatides & Woo);
+    // every one must be free.
+    int x = a.x, y = a.y, z = a.z;
+    const int d[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
+    int step[3];
+    double tMax[3], tDelta[3];
+    for (int k = 0; k < 3; ++k) {
+      step[k] = d[k] > 0 ? 1 : -1;
+      tDelta[k] = d[k] ? 1.0 / std::abs(d[k]) : INFINITY;
+      tMax[k] = d[k] ? 0.5 * tDelta[k] : INFINITY;
+    }
+    while (true) {
+      if (g.blocked(x, y, z)) return false;
+      if (x == b.x && y == b.y && z == b.z) return true;
+      const int k = tMax[0] <= tMax[1] && tMax[0] <= tMax[2] ? 0 : tMax[1] <= tMax[2] ? 1 : 2;
+      if (tMax[k] > 1.0) return true;  // rounding: the end voxel is reached
+      (k == 0 ? x : k == 1 ? y : z) += step[k];
+      tMax[k] += tDelta[k];
+    }
+  }
   // Bresenham; every cell on the line must be free.
   int dx = std::abs(b.x - a.x), dy = -std::abs(b.y - a.y);
   int sx = a.x < b.x ? 1 : -1, sy = a.y < b.y ? 1 : -1, err = dx + dy;
@@ -183,9 +204,9 @@ bool lineOfSight(const Grid& g, Cell a, Cell b) {
 std::vector<Cell> turningPoints(const std::vector<Cell>& path) {
   std::vector<Cell> out;
   for (size_t i = 1; i + 1 < path.size(); ++i) {
-    int dx0 = path[i].x - path[i - 1].x, dy0 = path[i].y - path[i - 1].y;
-    int dx1 = path[i + 1].x - path[i].x, dy1 = path[i + 1].y - path[i].y;
-    if (dx0 != dx1 || dy0 != dy1) out.push_back(path[i]);
+    int dx0 = path[i].x - path[i - 1].x, dy0 = path[i].y - path[i - 1].y, dz0 = path[i].z - path[i - 1].z;
+    int dx1 = path[i + 1].x - path[i].x, dy1 = path[i + 1].y - path[i].y, dz1 = path[i + 1].z - path[i].z;
+    if (dx0 != dx1 || dy0 != dy1 || dz0 != dz1) out.push_back(path[i]);
   }
   if (!path.empty()) out.push_back(path.back());
   return out;
@@ -194,43 +215,55 @@ std::vector<Cell> turningPoints(const std::vector<Cell>& path) {
 }  // namespace detail
 
 std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
-                        int neighbourhood) {
-  detail::Grid g{width, height, &obstacles};
+                        int neighbourhood, int depth) {
+  detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
   const detail::Stencil st = detail::stencil(neighbourhood);
-  const size_t n = size_t(width) * size_t(height);
-  std::vector<float> cost(n, INFINITY);
-  std::vector<int32_t> parent(n, -1);
-  auto h = [&](int x, int y) {
-    double dx = std::abs(x - to.x), dy = std::abs(y - to.y);
-    if (st.size == 4) return dx + dy;                                        // Manhattan
-    return std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy);  // octile
+  const size_t n = g.cells();
+  // Zeroed: a 3-D search touches the pages around its path only. cost[j] holds only once seen[j].
+  detail::Zeroed<float> cost(n);
+  detail::Zeroed<uint8_t> seen(n);
+  detail::CellIndex parent(n);
+  const bool manhattan = st.size == 4 || st.size == 6;
+  auto h = [&](Cell c) {
+    double dx = std::abs(c.x - to.x), dy = std::abs(c.y - to.y), dz = std::abs(c.z - to.z);
+    if (manhattan) return dx + dy + dz;
+    if (depth == 0) return std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy);  // octile
+    // 3-D octile: the largest difference straight, the middle one diagonally, the smallest
+    // along space diagonals.
+    double v[3] = {dx, dy, dz};
+    std::sort(v, v + 3);
+    return v[2] + (std::sqrt(2.0) - 1.0) * v[1] + (std::sqrt(3.0) - std::sqrt(2.0)) * v[0];
   };
+  const float kStep[4] = {0.0f, 1.0f, float(std::sqrt(2.0)), float(std::sqrt(3.0))};
   using Item = std::pair<double, int32_t>;  // f, index (ties: smaller index first: deterministic)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
   size_t s = g.index(from), t = g.index(to);
   cost[s] = 0;
-  open.push({h(from.x, from.y), int32_t(s)});
+  seen[s] = 1;
+  open.push({h(from), int32_t(s)});
   while (!open.empty()) {
     auto [f, i] = open.top();
     open.pop();
-    int x = i % width, y = i / width;
-    if (f > cost[size_t(i)] + h(x, y) + 1e-6) continue;  // stale entry
+    const Cell c = g.cellAt(size_t(i));
+    if (f > cost[size_t(i)] + h(c) + 1e-6) continue;  // stale entry
     if (size_t(i) == t) break;
     for (int k = 0; k < st.size; ++k) {
-      int nx = x + st.dx[k], ny = y + st.dy[k];
-      if (!g.inside(nx, ny) || g.blocked(nx, ny)) continue;
-      size_t j = size_t(ny) * width + nx;
-      float c = cost[size_t(i)] + ((st.dx[k] && st.dy[k]) ? float(std::sqrt(2.0)) : 1.0f);
-      if (c < cost[j]) {
-        cost[j] = c;
-        parent[j] = i;
-        open.push({c + h(nx, ny), int32_t(j)});
+      const Cell m{c.x + st.dx[k], c.y + st.dy[k], c.z + st.dz[k]};
+      if (!g.inside(m.x, m.y, m.z) || g.blocked(m.x, m.y, m.z)) continue;
+      size_t j = g.index(m);
+      float step = kStep[(st.dx[k] != 0) + (st.dy[k] != 0) + (st.dz[k] != 0)];
+      float cj = cost[size_t(i)] + step;
+      if (!seen[j] || cj < cost[j]) {
+        seen[j] = 1;
+        cost[j] = cj;
+        parent.set(j, i);
+        open.push({cj + h(m), int32_t(j)});
       }
     }
   }
-  if (parent[t] < 0 && s != t) return {};
+  if (parent.get(t) < 0 && s != t) return {};
   std::vector<Cell> path;
-  for (int32_t i = int32_t(t); i >= 0; i = parent[size_t(i)]) path.push_back({i % width, i / width});
+  for (int32_t i = int32_t(t); i >= 0; i = parent.get(size_t(i))) path.push_back(g.cellAt(size_t(i)));
   std::reverse(path.begin(), path.end());
   return path;
 }

@@ -1,43 +1,102 @@
-// Private to effects/lightning: the obstacle grid, its boundary map, A* and line of sight.
+// Private to effects/lightning: the obstacle grid (2-D or 3-D), its boundary maps, A* and line
+// of sight.
 #pragma once
 
 #include <atomic>
 #include <cstdlib>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "effects/lightning.h"
 
 namespace effects::lightning::detail {
 
+// A per-cell array of zeros in calloc'd memory: large blocks come from fresh pages, which
+// the kernel supplies zeroed, so the pages a request never touches are never faulted in (a
+// 3-D grid's bolt touches a sliver of its voxels; filling 128^3 entries cost more than growing
+// the bolt).
+template <class T>
+class Zeroed {
+ public:
+  explicit Zeroed(size_t n = 0) { reset(n); }
+  void reset(size_t n) {
+    p_.reset(static_cast<T*>(std::calloc(n ? n : 1, sizeof(T))));
+    if (!p_) throw std::bad_alloc();
+  }
+  T& operator[](size_t i) { return p_[i]; }
+  const T& operator[](size_t i) const { return p_[i]; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T[], Free> p_;
+};
+
+// A per-cell index, -1 where unset, over Zeroed memory (stored + 1).
+class CellIndex {
+ public:
+  explicit CellIndex(size_t n = 0) : v_(n) {}
+  int32_t get(size_t i) const { return v_[i] - 1; }
+  void set(size_t i, int32_t value) { v_[i] = value + 1; }
+
+ private:
+  Zeroed<int32_t> v_;
+};
+
 struct Grid {
   int width, height;
   const std::vector<uint8_t>* obstacles;  // may be empty
-  bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
-  bool blocked(int x, int y) const {
-    return !obstacles->empty() && (*obstacles)[size_t(y) * size_t(width) + size_t(x)] != 0;
+  int depth = 1;                          // 1 for a 2-D grid
+  bool inside(int x, int y, int z = 0) const {
+    return x >= 0 && y >= 0 && z >= 0 && x < width && y < height && z < depth;
   }
-  size_t index(Cell c) const { return size_t(c.y) * size_t(width) + size_t(c.x); }
+  size_t index(int x, int y, int z = 0) const {
+    return (size_t(z) * size_t(height) + size_t(y)) * size_t(width) + size_t(x);
+  }
+  size_t index(Cell c) const { return index(c.x, c.y, c.z); }
+  bool blocked(int x, int y, int z = 0) const { return !obstacles->empty() && (*obstacles)[index(x, y, z)] != 0; }
+  size_t cells() const { return size_t(width) * size_t(height) * size_t(depth); }
+  Cell cellAt(size_t i) const {
+    const size_t w = size_t(width), h = size_t(height);
+    return {int(i % w), int(i / w % h), int(i / (w * h))};
+  }
 };
 
 constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 constexpr int kDx4[4] = {0, -1, 1, 0};
 constexpr int kDy4[4] = {-1, 0, 0, 1};
+constexpr int kDz0[26] = {};
+// 3-D: the 26 offsets in z, y, x order, and the 6 faces.
+constexpr int kDx26[26] = {-1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1, -1, 0, 1};
+constexpr int kDy26[26] = {-1, -1, -1, 0, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 1, 1, 1, -1, -1, -1, 0, 0, 0, 1, 1, 1};
+constexpr int kDz26[26] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+constexpr int kDx6[6] = {0, 0, -1, 1, 0, 0};
+constexpr int kDy6[6] = {0, -1, 0, 0, 1, 0};
+constexpr int kDz6[6] = {-1, 0, 0, 0, 0, 1};
 
-// The neighbour offsets of a 4- or 8-neighbourhood (Params::neighbourhood).
+// The neighbour offsets of a 4- or 8-neighbourhood, or in 3-D a 6- or 26-neighbourhood
+// (Params::neighbourhood; dz is all 0 in 2-D).
 struct Stencil {
   const int* dx;
   const int* dy;
   int size;
+  const int* dz = kDz0;
 };
 inline Stencil stencil(int neighbourhood) {
-  return neighbourhood == 4 ? Stencil{kDx4, kDy4, 4} : Stencil{kDx, kDy, 8};
+  switch (neighbourhood) {
+    case 4: return {kDx4, kDy4, 4};
+    case 6: return {kDx6, kDy6, 6, kDz6};
+    case 26: return {kDx26, kDy26, 26, kDz26};
+    default: return {kDx, kDy, 8};
+  }
 }
 // a and b are the same cell or neighbours in the neighbourhood.
 inline bool touching(Cell a, Cell b, int neighbourhood) {
-  const int dx = std::abs(a.x - b.x), dy = std::abs(a.y - b.y);
-  return neighbourhood == 4 ? dx + dy <= 1 : dx <= 1 && dy <= 1;
+  const int dx = std::abs(a.x - b.x), dy = std::abs(a.y - b.y), dz = std::abs(a.z - b.z);
+  return neighbourhood == 4 || neighbourhood == 6 ? dx + dy + dz <= 1 : dx <= 1 && dy <= 1 && dz <= 1;
 }
 
 // Seed 002 eqn 4: potential of the negative charges on the grid border (a ring of cells just
@@ -77,6 +136,28 @@ class BoundaryMap {
 
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
                                                      bool* hit);
+
+// Seed 002 eqn 4 in 3-D: sum of 1/r over the shell of voxels around the grid and the obstacle
+// voxels. An octree of charge counts and centroids (blocks of 4^3 voxels and up) answers a
+// query in O(log n) blocks with the opening angle of the 2-D map; blocks nearer than two of
+// their sides are summed voxel by voxel. Memory: one byte per voxel of the padded grid and
+// 16 bytes per 4^3 block (about 1.3 bytes per voxel).
+class VolumeBoundary {
+ public:
+  VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles);
+  double potential(int x, int y, int z) const;
+  size_t bytes() const;
+
+ private:
+  struct Level {
+    int w, h, d;              // blocks per side
+    std::vector<float> count, cx, cy, cz;
+  };
+  double visit(int level, int bx, int by, int bz, double px, double py, double pz) const;
+  int dw_, dh_, dd_;             // domain (grid + shell) size
+  Zeroed<uint8_t> charge_;       // per domain voxel
+  std::vector<Level> levels_;    // levels_[k]: blocks of 4 * 2^k voxels a side
+};
 
 bool lineOfSight(const Grid& g, Cell a, Cell b);
 // Turning points of a path (direction changes), ending with its last cell.

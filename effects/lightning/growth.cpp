@@ -10,6 +10,7 @@
 
 #include "grid.h"
 #include "laplace.h"
+#include "laplace3.h"
 #include "weight_tree.h"
 
 namespace effects::lightning {
@@ -27,14 +28,22 @@ const char* toString(Solver s) { return s == Solver::kCg ? "cg" : "mgpcg"; }
 std::optional<Error> validate(const Params& p) {
   if (p.width < 3 || p.height < 3) return invalid("/grid", "width and height must be >= 3");
   if (p.width > 65536 || p.height > 65536) return overLimit("/grid", "width and height must be <= 65536");
-  if (!p.obstacles.empty() && p.obstacles.size() != size_t(p.width) * size_t(p.height))
-    return invalid("/obstacles", "must have width*height cells");
+  if (p.depth != 0 && (p.depth < 3 || p.depth > 4096)) return invalid("/grid/depth", "must be 0 (2-D) or in [3, 4096]");
+  if (p.depth && (p.width > 4096 || p.height > 4096))
+    return overLimit("/grid", "a 3-D grid's width and height must be <= 4096");
+  const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
+  if (!p.obstacles.empty() && p.obstacles.size() != cells)
+    return invalid("/obstacles", p.depth ? "must have width*height*depth cells" : "must have width*height cells");
   if (!(p.eta >= 0.0 && p.eta <= 50.0)) return invalid("/eta", "must be in [0, 50]");
   if (!(p.axisGrowth >= 1.0 && p.axisGrowth <= 64.0)) return invalid("/axisGrowth", "must be in [1, 64]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
-  if (p.neighbourhood != 4 && p.neighbourhood != 8) return invalid("/neighbourhood", "must be 4 or 8");
+  if (p.depth == 0 && p.neighbourhood != 4 && p.neighbourhood != 8)
+    return invalid("/neighbourhood", "must be 4 or 8 on a 2-D grid");
+  if (p.depth && p.neighbourhood != 6 && p.neighbourhood != 26)
+    return invalid("/neighbourhood", "must be 6 or 26 on a 3-D grid");
+  if (p.depth && p.method == Method::kCharges) return invalid("/method", "charges is 2-D only; use fast or dbm");
   return std::nullopt;
 }
 
@@ -66,12 +75,16 @@ struct Candidate {
 class Grower {
  public:
   Grower(const Params& p, Bolt& bolt)
-      : p_(p), g_{p.width, p.height, &p.obstacles}, stencil_(detail::stencil(p.neighbourhood)), bolt_(bolt) {
-    nodeOf_.assign(size_t(p.width) * size_t(p.height), -1);
-    candidateOf_.assign(nodeOf_.size(), -1);
-    reserved_.assign(nodeOf_.size(), 0);
+      : p_(p),
+        g_{p.width, p.height, &p.obstacles, std::max(p.depth, 1)},
+        stencil_(detail::stencil(p.neighbourhood)),
+        bolt_(bolt) {
+    const size_t cells = g_.cells();
+    nodeOf_ = detail::CellIndex(cells);
+    candidateOf_ = detail::CellIndex(cells);
+    reserved_.reset(cells);
     for (const Cell& t : p.targets)
-      if (g_.inside(t.x, t.y)) reserved_[g_.index(t)] = 1;
+      if (g_.inside(t.x, t.y, t.z)) reserved_[g_.index(t)] = 1;
   }
 
   std::optional<Error> run();
@@ -79,10 +92,10 @@ class Grower {
  private:
   // Free for growth: inside, no obstacle, not bolt, not a target still to be reached (those
   // join the bolt only when it touches them).
-  bool free(int x, int y) const {
-    if (!g_.inside(x, y) || g_.blocked(x, y)) return false;
-    size_t i = g_.index({x, y});
-    return nodeOf_[i] < 0 && !reserved_[i];
+  bool free(int x, int y, int z) const {
+    if (!g_.inside(x, y, z) || g_.blocked(x, y, z)) return false;
+    size_t i = g_.index(x, y, z);
+    return nodeOf_.get(i) < 0 && !reserved_[i];
   }
   int addNode(Cell c, int parent);
   void addCandidatesAround(int node);
@@ -110,7 +123,7 @@ class Grower {
   double boundary(Cell c);
   std::optional<Error> growSegment(size_t k);
   std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
-  std::unique_ptr<detail::Laplace> dbmProblem(Cell target) const;
+  std::unique_ptr<detail::Potential> dbmProblem(Cell target) const;
   void reviveFrontier(int from, size_t segmentFirstNode);
   void weighCandidates(std::vector<double>& logPhi);
   void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
@@ -122,12 +135,13 @@ class Grower {
   Grid g_;
   detail::Stencil stencil_;
   Bolt& bolt_;
-  std::vector<int32_t> nodeOf_, candidateOf_;
-  std::vector<uint8_t> reserved_;
+  detail::CellIndex nodeOf_, candidateOf_;
+  detail::Zeroed<uint8_t> reserved_;
   std::vector<Candidate> cands_;
   std::vector<float> boundaryMemo_;
   std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
-  std::unique_ptr<detail::Laplace> laplace_, reference_;
+  std::unique_ptr<const detail::VolumeBoundary> volumeMap_;  // 3-D
+  std::unique_ptr<detail::Potential> laplace_, reference_;
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
   int step_ = 0;
@@ -145,10 +159,10 @@ class Grower {
 int Grower::addNode(Cell c, int parent) {
   int id = int(bolt_.nodes.size());
   bolt_.nodes.push_back({c, parent, step_});
-  nodeOf_[g_.index(c)] = id;
-  if (int slot = candidateOf_[g_.index(c)]; slot >= 0) removeCandidate(size_t(slot));
-  if (laplace_) laplace_->fix(c.x, c.y, 0.0);
-  if (reference_) reference_->fix(c.x, c.y, 0.0);
+  nodeOf_.set(g_.index(c), id);
+  if (int slot = candidateOf_.get(g_.index(c)); slot >= 0) removeCandidate(size_t(slot));
+  if (laplace_) laplace_->fix(c, 0.0);
+  if (reference_) reference_->fix(c, 0.0);
   if (p_.method == Method::kCharges) {  // Kim et al. 2007: one new term per candidate
     for (auto& cand : cands_) cand.charge += 1.0 / std::hypot(double(cand.cell.x - c.x), double(cand.cell.y - c.y));
   }
@@ -156,10 +170,10 @@ int Grower::addNode(Cell c, int parent) {
 }
 
 void Grower::removeCandidate(size_t slot) {
-  candidateOf_[g_.index(cands_[slot].cell)] = -1;
+  candidateOf_.set(g_.index(cands_[slot].cell), -1);
   if (slot + 1 != cands_.size()) {
     cands_[slot] = cands_.back();
-    candidateOf_[g_.index(cands_[slot].cell)] = int32_t(slot);
+    candidateOf_.set(g_.index(cands_[slot].cell), int32_t(slot));
   }
   markWeight(slot);
   markWeight(cands_.size() - 1);
@@ -169,22 +183,22 @@ void Grower::removeCandidate(size_t slot) {
 void Grower::addCandidatesAround(int node) {
   Cell c = bolt_.nodes[size_t(node)].cell;
   for (int k = 0; k < stencil_.size; ++k) {
-    int x = c.x + stencil_.dx[k], y = c.y + stencil_.dy[k];
-    if (!free(x, y)) continue;
-    size_t i = g_.index({x, y});
-    if (candidateOf_[i] >= 0) {
-      Candidate& cand = cands_[size_t(candidateOf_[i])];
+    int x = c.x + stencil_.dx[k], y = c.y + stencil_.dy[k], z = c.z + stencil_.dz[k];
+    if (!free(x, y, z)) continue;
+    size_t i = g_.index(x, y, z);
+    if (const int32_t slot = candidateOf_.get(i); slot >= 0) {
+      Candidate& cand = cands_[size_t(slot)];
       cand.neighbours = std::min(cand.neighbours + 1, stencil_.size);
       cand.born = step_;
       cand.parent = node;
       if (p_.method == Method::kFast) refreshFastWeight(cand);
-      markWeight(size_t(candidateOf_[i]));
+      markWeight(size_t(slot));
       continue;
     }
-    Candidate cand{{x, y}, step_, 0, node, 0.0};
+    Candidate cand{{x, y, z}, step_, 0, node, 0.0};
     for (int j = 0; j < stencil_.size; ++j) {
-      int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j];
-      if (g_.inside(nx, ny) && nodeOf_[g_.index({nx, ny})] >= 0) ++cand.neighbours;
+      int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j], nz = z + stencil_.dz[j];
+      if (g_.inside(nx, ny, nz) && nodeOf_.get(g_.index(nx, ny, nz)) >= 0) ++cand.neighbours;
     }
     if (p_.method == Method::kCharges)
       for (const Node& n : bolt_.nodes) cand.charge += 1.0 / std::hypot(double(x - n.cell.x), double(y - n.cell.y));
@@ -193,7 +207,7 @@ void Grower::addCandidatesAround(int node) {
       cand.logStatic = fastLogStatic(cand);
       refreshFastWeight(cand);
     }
-    candidateOf_[i] = int32_t(cands_.size());
+    candidateOf_.set(i, int32_t(cands_.size()));
     cands_.push_back(cand);
     markWeight(cands_.size() - 1);
   }
@@ -208,6 +222,7 @@ void Grower::expireCandidates() {
 }
 
 double Grower::boundary(Cell c) {
+  if (volumeMap_) return volumeMap_->potential(c.x, c.y, c.z);  // once per candidate: no memo
   float& memo = boundaryMemo_[g_.index(c)];
   if (memo == 0.0f) memo = float(boundaryMap_->potential(c.x, c.y));
   return memo;
@@ -222,7 +237,7 @@ void Grower::logWeights(std::vector<double>& out) {
       break;
     case Method::kDbm:
       for (size_t i = 0; i < cands_.size(); ++i) {
-        double phi = laplace_->phi(cands_[i].cell.x, cands_[i].cell.y);
+        double phi = laplace_->phi(cands_[i].cell);
         out[i] = phi > 0 ? std::log(phi) : kNegInf;
       }
       break;
@@ -251,18 +266,21 @@ void Grower::logWeights(std::vector<double>& out) {
 // the adjacent bolt cells) changes as the bolt grows and is applied in refreshFastWeight().
 double Grower::fastLogStatic(const Candidate& cand) const {
   const Cell c = cand.cell;
-  double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y;
-  const double len = std::hypot(ax, ay);
+  double ax = attractor_.x - anchor_.x, ay = attractor_.y - anchor_.y, az = attractor_.z - anchor_.z;
+  const double len = p_.depth ? std::hypot(ax, ay, az) : std::hypot(ax, ay);
   if (len > 0) {
     ax /= len;
     ay /= len;
+    az /= len;
   }
   // G counts steps towards the attractor and, past it, back: folded at the attractor's
   // distance. Unfolded, 2^G kept rewarding cells beyond the target, and a bolt that
   // overshot in a tall grid ran on to the far wall (128 x 32767: 2 M steps, minutes).
-  const double along = (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
+  const double along = p_.depth ? (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay + (c.z - anchor_.z) * az
+                               : (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
   const double G = std::floor(along <= len ? along : 2 * len - along);
-  const double P = std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
+  const double P = p_.depth ? std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y), double(c.z - attractor_.z))
+                            : std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
   return G * lnGrowth_ - cand.logBoundary - std::log(std::max(P, 0.5));
 }
 
@@ -366,15 +384,15 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   std::vector<size_t> cells;
   for (const Node& n : bolt_.nodes)
     for (int k = 0; k < stencil_.size; ++k) {
-      int x = n.cell.x + stencil_.dx[k], y = n.cell.y + stencil_.dy[k];
-      if (free(x, y)) cells.push_back(g_.index({x, y}));
+      int x = n.cell.x + stencil_.dx[k], y = n.cell.y + stencil_.dy[k], z = n.cell.z + stencil_.dz[k];
+      if (free(x, y, z)) cells.push_back(g_.index(x, y, z));
     }
   std::sort(cells.begin(), cells.end());
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
   std::vector<double> refPhi(cells.size());
   double top = 0;
   for (size_t k = 0; k < cells.size(); ++k) {
-    refPhi[k] = std::max(0.0, reference_->phi(int(cells[k] % size_t(g_.width)), int(cells[k] / size_t(g_.width))));
+    refPhi[k] = std::max(0.0, reference_->phi(g_.cellAt(cells[k])));
     top = std::max(top, refPhi[k]);
   }
   double refSum = 0;
@@ -401,24 +419,27 @@ double Grower::stepError(const std::vector<double>& logPhi) {
 std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
   std::vector<uint8_t> blocked = p_.obstacles;
   if (k > 0) {
-    if (blocked.empty()) blocked.assign(nodeOf_.size(), 0);
+    if (blocked.empty()) blocked.assign(g_.cells(), 0);
     for (const Node& n : bolt_.nodes) blocked[g_.index(n.cell)] = 1;
     blocked[g_.index(fromCell)] = 0;
   }
   Stopwatch guideWatch;
-  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood);
+  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
   return path;
 }
 
 // The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1.
-std::unique_ptr<detail::Laplace> Grower::dbmProblem(Cell target) const {
-  auto lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
-  for (int y = 0; y < p_.height; ++y)
-    for (int x = 0; x < p_.width; ++x)
-      if (g_.blocked(x, y)) lap->fix(x, y, 0.0);
-  for (const Node& n : bolt_.nodes) lap->fix(n.cell.x, n.cell.y, 0.0);
-  lap->fix(target.x, target.y, 1.0);
+std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target) const {
+  std::unique_ptr<detail::Potential> lap;
+  if (p_.depth)
+    lap = std::make_unique<detail::Laplace3>(p_.width, p_.height, p_.depth);
+  else
+    lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
+  for (size_t i = 0; i < g_.cells(); ++i)
+    if (!p_.obstacles.empty() && p_.obstacles[i]) lap->fix(g_.cellAt(i), 0.0);
+  for (const Node& n : bolt_.nodes) lap->fix(n.cell, 0.0);
+  lap->fix(target, 1.0);
   return lap;
 }
 
@@ -522,8 +543,8 @@ std::optional<Error> Grower::growSegment(size_t k) {
 
 std::optional<Error> Grower::run() {
   auto checkCell = [&](Cell c, const std::string& field) -> std::optional<Error> {
-    if (!g_.inside(c.x, c.y)) return invalid(field, "is outside the grid");
-    if (g_.blocked(c.x, c.y)) return unsatisfiable(field, "is inside an obstacle");
+    if (!g_.inside(c.x, c.y, c.z)) return invalid(field, "is outside the grid");
+    if (g_.blocked(c.x, c.y, c.z)) return unsatisfiable(field, "is inside an obstacle");
     return std::nullopt;
   };
   if (auto e = checkCell(p_.start, "/start")) return e;
@@ -536,13 +557,17 @@ std::optional<Error> Grower::run() {
       if (p_.targets[j] == p_.targets[k]) return unsatisfiable(f, "repeats an earlier target");
     if (p_.targets[k] == p_.start) return unsatisfiable(f, "equals start");
   }
-  if (p_.method == Method::kFast) {
+  if (p_.method == Method::kFast && p_.depth) {
+    Stopwatch w;
+    volumeMap_ = std::make_unique<detail::VolumeBoundary>(p_.width, p_.height, p_.depth, p_.obstacles);
+    bolt_.stats.counters["boundaryMapMs"] = w.ms();
+  } else if (p_.method == Method::kFast) {
     Stopwatch w;
     bool hit = false;
     boundaryMap_ = detail::cachedBoundaryMap(p_.width, p_.height, p_.obstacles, &hit);
     bolt_.stats.counters["boundaryMapMs"] = w.ms();
     bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
-    boundaryMemo_.assign(nodeOf_.size(), 0.0f);
+    boundaryMemo_.assign(g_.cells(), 0.0f);
   }
   addNode(p_.start, -1);
   for (size_t k = 0; k < p_.targets.size(); ++k) {
@@ -572,9 +597,11 @@ std::optional<Error> Grower::run() {
 
 Result<Bolt> grow(const Params& params) {
   if (auto e = validate(params)) return *e;
-  if (size_t(params.width) * size_t(params.height) > (size_t(1) << 30)) return overLimit("/grid", "grid too large");
+  if (size_t(params.width) * size_t(params.height) * size_t(std::max(params.depth, 1)) > (size_t(1) << 30))
+    return overLimit("/grid", "grid too large");
   Stopwatch watch;
   Bolt bolt;
+  bolt.depth = params.depth;
   Grower grower(params, bolt);
   if (auto e = grower.run()) return *e;
   bolt.stats.method =

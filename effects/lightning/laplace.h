@@ -17,14 +17,25 @@
 
 namespace effects::lightning::detail {
 
-class Laplace {
+// The DBM potential of a 2-D grid (Laplace) or a 3-D one (Laplace3, laplace3.h).
+class Potential {
+ public:
+  virtual ~Potential() = default;
+  // Fix a cell at a value (it stops being an unknown).
+  virtual void fix(Cell c, double value) = 0;
+  // Solves to ||r|| <= tolerance * ||b|| from the current potential; returns iterations.
+  virtual int solve(Solver solver, double tolerance, double* relResidual) = 0;
+  virtual double phi(Cell c) const = 0;
+};
+
+class Laplace final : public Potential {
  public:
   Laplace(int width, int height);
-  // Fix a cell at a value (it stops being an unknown).
   void fix(int x, int y, double value);
-  // Solves to ||r|| <= tolerance * ||b|| from the current potential; returns iterations.
-  int solve(Solver solver, double tolerance, double* relResidual);
+  void fix(Cell c, double value) override { fix(c.x, c.y, value); }
+  int solve(Solver solver, double tolerance, double* relResidual) override;
   double phi(int x, int y) const { return phi_[at(x, y)]; }
+  double phi(Cell c) const override { return phi(c.x, c.y); }
 
  private:
   size_t at(int x, int y) const { return size_t(y + 1) * stride_ + size_t(x + 1); }

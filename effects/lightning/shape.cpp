@@ -8,10 +8,11 @@ namespace effects::lightning {
 namespace {
 
 // A hash of (seed, node) -> two uniforms: jitter independent of growth order and RNG state.
-void jitterOf(uint64_t seed, int node, double& u, double& v) {
+void jitterOf(uint64_t seed, int node, double& u, double& v, double* w) {
   Rng r(seed ^ (0x9E3779B97F4A7C15ULL * uint64_t(node + 1)), 0xB5297A4D3F84D5B5ULL);
   u = r.uniform();
   v = r.uniform();
+  if (w) *w = r.uniform();  // 3-D bolts only: 2-D draws stay as they were
 }
 
 // The bolt as a tree: each node's children, the height of its subtree, and its tree distance
@@ -52,11 +53,12 @@ int deepestChild(const Tree& t, size_t node) {
 // A node's polyline vertex: its cell's centre, jittered, and the intensity of its branch.
 Vertex vertexOf(const Bolt& bolt, const ShapeParams& s, const Tree& t, int node) {
   const Node& nd = bolt.nodes[size_t(node)];
-  double u = 0.5, v = 0.5;
-  if (s.jitter > 0) jitterOf(s.jitterSeed, node, u, v);
+  double u = 0.5, v = 0.5, w = 0.5;
+  if (s.jitter > 0) jitterOf(s.jitterSeed, node, u, v, bolt.depth ? &w : nullptr);
   Vertex out;
   out.x = float(nd.cell.x + 0.5 + s.jitter * (u - 0.5));
   out.y = float(nd.cell.y + 0.5 + s.jitter * (v - 0.5));
+  if (bolt.depth) out.z = float(nd.cell.z + 0.5 + s.jitter * (w - 0.5));
   out.step = nd.step;
   out.node = node;
   out.intensity = t.fromMain[size_t(node)] == 0
@@ -98,24 +100,11 @@ std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& s) {
   return out;
 }
 
-double fractalDimension(const std::vector<Cell>& cells, int width, int height) {
-  if (cells.size() < 2) return 0.0;
-  int maxBox = std::max(1, std::min(width, height) / 4);
-  std::vector<double> logInvS, logN;
-  std::vector<uint64_t> keys;
-  for (int s = 1; s <= maxBox; s *= 2) {
-    size_t best = SIZE_MAX;
-    for (int off = 0; off < 4; ++off) {
-      int ox = (off & 1) ? s / 2 : 0, oy = (off & 2) ? s / 2 : 0;
-      if (s == 1 && off) break;
-      keys.clear();
-      for (const Cell& c : cells) keys.push_back(uint64_t(uint32_t((c.x + ox) / s)) << 32 | uint32_t((c.y + oy) / s));
-      std::sort(keys.begin(), keys.end());
-      best = std::min(best, size_t(std::unique(keys.begin(), keys.end()) - keys.begin()));
-    }
-    logInvS.push_back(-std::log(double(s)));
-    logN.push_back(std::log(double(best)));
-  }
+namespace {
+
+// D from box counts: the slope of log N against log(1/s) over the straightest run of >= 4
+// scales (the whole range when there are fewer).
+double slopeOfCounts(const std::vector<double>& logInvS, const std::vector<double>& logN) {
   auto fit = [&](size_t a, size_t b, double& slope) {  // least squares over [a, b)
     double n = double(b - a), sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
     for (size_t i = a; i < b; ++i) {
@@ -147,6 +136,46 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height) {
       }
     }
   return bestSlope;
+}
+
+// Box counts for sides 1, 2, 4, ... up to maxBox: per side the fewest boxes over the offsets
+// 0 and s/2 on each axis; key(c, s, ox, oy, oz) names the box of cell c.
+template <class Key>
+double boxCountingDimension(const std::vector<Cell>& cells, int maxBox, int offsets, Key key) {
+  std::vector<double> logInvS, logN;
+  std::vector<uint64_t> keys;
+  for (int s = 1; s <= maxBox; s *= 2) {
+    size_t best = SIZE_MAX;
+    for (int off = 0; off < offsets; ++off) {
+      int ox = (off & 1) ? s / 2 : 0, oy = (off & 2) ? s / 2 : 0, oz = (off & 4) ? s / 2 : 0;
+      if (s == 1 && off) break;
+      keys.clear();
+      for (const Cell& c : cells) keys.push_back(key(c, s, ox, oy, oz));
+      std::sort(keys.begin(), keys.end());
+      best = std::min(best, size_t(std::unique(keys.begin(), keys.end()) - keys.begin()));
+    }
+    logInvS.push_back(-std::log(double(s)));
+    logN.push_back(std::log(double(best)));
+  }
+  return slopeOfCounts(logInvS, logN);
+}
+
+}  // namespace
+
+double fractalDimension(const std::vector<Cell>& cells, int width, int height) {
+  if (cells.size() < 2) return 0.0;
+  return boxCountingDimension(cells, std::max(1, std::min(width, height) / 4), 4, [](Cell c, int s, int ox, int oy, int) {
+    return uint64_t(uint32_t((c.x + ox) / s)) << 32 | uint32_t((c.y + oy) / s);
+  });
+}
+
+double fractalDimension(const std::vector<Cell>& cells, int width, int height, int depth) {
+  if (cells.size() < 2) return 0.0;
+  return boxCountingDimension(cells, std::max(1, std::min({width, height, depth}) / 4), 8,
+                              [](Cell c, int s, int ox, int oy, int oz) {
+                                return uint64_t(uint32_t((c.x + ox) / s)) << 42 |
+                                       uint64_t(uint32_t((c.y + oy) / s)) << 21 | uint32_t((c.z + oz) / s);
+                              });
 }
 
 }  // namespace effects::lightning

@@ -59,7 +59,8 @@ void nodeTimes(const Bolt& bolt, const TimelineParams& p, std::vector<double>& l
     const Node& nd = bolt.nodes[i];
     const size_t parent = size_t(nd.parent);
     const Cell a = bolt.nodes[parent].cell;
-    length[i] = length[parent] + p.cellSize * std::hypot(double(nd.cell.x - a.x), double(nd.cell.y - a.y));
+    const double dx = nd.cell.x - a.x, dy = nd.cell.y - a.y, dz = nd.cell.z - a.z;
+    length[i] = length[parent] + p.cellSize * (dz != 0 ? std::hypot(dx, dy, dz) : std::hypot(dx, dy));
     // The leader jumps a whole step at a time: a vertex lights with the step that covers it.
     const auto from = uint64_t(length[parent] / p.leaderStep), to = uint64_t(length[i] / p.leaderStep);
     leader[i] = leader[parent];

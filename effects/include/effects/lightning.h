@@ -1,4 +1,4 @@
-// effects/lightning.h — lightning paths by Laplacian growth on a 2-D grid.
+// effects/lightning.h — lightning paths by Laplacian growth on a 2-D grid or a 3-D voxel grid.
 //
 // Source: seed 002 (Yun & Yoon, "Physically Inspired Fast Lightning Rendering", KAIST 2016),
 // Niemeyer et al. 1984 (DBM), Kim & Lin 2004 (DBM with CG), Kim, Sewall, Sud & Lin 2007
@@ -23,6 +23,11 @@
 // the fast and charges methods follow the turning points of an 8-connected A* path (seed
 // 002 section 3.2); DBM needs no guide (Laplace solutions have no local minima).
 //
+// 3-D (Params::depth > 0): voxels (x, y, z), x right, y down, z away; 26 neighbours by default
+// (6 on request); kFast's B sums 1/r over the voxels of the shell around the grid and the
+// obstacle voxels (a Barnes-Hut octree); kDbm solves the 7-point Laplacian; A* moves over the
+// same neighbourhood. kCharges is 2-D only. docs/effects.md section 1.7.
+//
 // Errors: start/target outside the grid or inside an obstacle, start == target, an
 // unreachable target -> kUnsatisfiable naming the field; exhausting the step budget ->
 // kLimitExceeded. Deterministic: same Params -> same Bolt, bit for bit.
@@ -39,8 +44,8 @@
 namespace effects::lightning {
 
 struct Cell {
-  int x = 0, y = 0;
-  bool operator==(const Cell& o) const { return x == o.x && y == o.y; }
+  int x = 0, y = 0, z = 0;  // z: 3-D grids only (0 in 2-D)
+  bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
 };
 
 enum class Method { kFast, kDbm, kCharges };
@@ -64,7 +69,9 @@ const char* toString(Solver s);
 
 struct Params {
   int width = 128, height = 128;
-  std::vector<uint8_t> obstacles;  // empty, or width*height flags (row-major, nonzero = blocked)
+  int depth = 0;                   // 0: a 2-D grid; >= 3: a 3-D grid of width*height*depth voxels
+  std::vector<uint8_t> obstacles;  // empty, or width*height(*depth) flags (x fastest, then y,
+                                   // then z; nonzero = blocked)
   Cell start{64, 0};
   std::vector<Cell> targets{{64, 127}};
   Method method = Method::kFast;
@@ -74,7 +81,8 @@ struct Params {
                                                // (calibratedAxisGrowth() with lifetime 0 meets
                                                // DBM's D, cells and tips)
   int neighbourhood = 8;    // 8 (diagonals too) or 4: which cells are candidates, which
-                            // touch a target, how the A* guide moves, N's range (eqn 6)
+                            // touch a target, how the A* guide moves, N's range (eqn 6);
+                            // in 3-D 26 (faces, edges and corners) or 6 (faces)
   Guide guide = Guide::kAuto;
   Solver solver = Solver::kMgpcg;  // kDbm
   double tolerance = 1e-6;         // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
@@ -92,6 +100,7 @@ struct Node {
 };
 
 struct Bolt {
+  int depth = 0;                 // the grid's (0: 2-D)
   std::vector<Node> nodes;       // in growth order
   std::vector<int> mainChannel;  // node indices, start -> last target
   std::vector<Cell> guide;       // waypoints used (empty without a guide)
@@ -105,6 +114,9 @@ Result<Bolt> grow(const Params& params);
 // 1, 2, 4, ... up to a quarter of the grid, the minimum box count over four grid offsets;
 // D is the slope of log N against log(1/s) fitted over the straightest run of >= 4 scales.
 double fractalDimension(const std::vector<Cell>& cells, int width, int height);
+// The same in 3-D: cubes of side 1, 2, 4, ... up to a quarter of the smallest side, the
+// minimum over eight offsets.
+double fractalDimension(const std::vector<Cell>& cells, int width, int height, int depth);
 
 // ---- for tests and the error report --------------------------------------------------
 // Converged potential of the DBM problem for a given bolt (Phi = 0 on bolt, obstacles and
@@ -117,11 +129,24 @@ std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_
 // obstacle cells of 1/r (Barnes-Hut, opening angle 0.5; exact for r < 2 block sizes).
 // Normalisation (division by a constant) cancels in p_i and is not applied.
 double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c);
+// In 3-D: the shell of voxels around the grid and the obstacle voxels (an octree, same angle).
+double boundaryPotential(int width, int height, int depth, const std::vector<uint8_t>& obstacles, Cell c);
+
+// Conservative voxelisation (3-D obstacles from meshes): sets obstacles[(z*height + y)*width
+// + x] for every voxel [x, x+1] x [y, y+1] x [z, z+1] that a triangle touches (separating-axis
+// test). positions: x, y, z per vertex in voxel units; indices: three per triangle, each
+// < positions.size() / 3; coordinates must be finite. Returns the voxels tested.
+size_t voxelizeTriangles(int width, int height, int depth, const std::vector<double>& positions,
+                         const std::vector<uint32_t>& indices, std::vector<uint8_t>& obstacles);
+// The voxels voxelizeTriangles would test (the triangles' clipped bounding boxes), to refuse
+// a mesh before the work.
+size_t voxelizationWork(int width, int height, int depth, const std::vector<double>& positions,
+                        const std::vector<uint32_t>& indices);
 
 // A* over the 8-neighbourhood (octile heuristic) or the 4-neighbourhood (Manhattan); empty if
-// unreachable.
+// unreachable. With depth > 0, over the 26-neighbourhood (3-D octile) or the 6 (Manhattan).
 std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
-                        int neighbourhood = 8);
+                        int neighbourhood = 8, int depth = 0);
 
 }  // namespace effects::lightning
 
@@ -137,7 +162,7 @@ struct ShapeParams {
 };
 
 struct Vertex {
-  float x = 0, y = 0;      // grid units, jittered inside the cell
+  float x = 0, y = 0, z = 0;  // grid units, jittered inside the cell (z: 3-D bolts)
   int step = 0;            // growth step of the cell (animate the leader by step, the return
                            // stroke along the main channel from the last step back)
   float intensity = 1.0f;  // 1 on the main channel, fading along branches
