@@ -4,11 +4,17 @@
 //   64^2, >= 2000x at 128^2); dbm with MGPCG at 128^2 (target <= 100 ms); fast at 1024^2 with
 //   ~20 % obstacles (target <= 50 ms, less with the boundary map cached); fast at 4096^2, the
 //   default grid limit, with the process's peak RSS.
-// Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds.
+// 3-D (issue 20): fast at 64^3 .. 256^3 (targets 128^3 <= 20 ms, 256^3 <= 200 ms) with peak
+// RSS per voxel; dbm with MGPCG at 32^3 and 64^3 (target 64^3 <= 1 s) beside plain CG at 32^3.
+// Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds;
+// `lightning_bench --fractal3d [seeds]` fast against dbm at 64^3 (default 10 seeds).
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -82,6 +88,53 @@ BENCHMARK(BM_DbmMgpcg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmCg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Fast1024Obstacles)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+// 3-D: start at the top face's centre, target at the bottom face's centre, 26 neighbours.
+Params volumeLayout(int n, Method m, uint64_t seed = 1) {
+  Params p;
+  p.width = p.height = p.depth = n;
+  p.neighbourhood = 26;
+  p.method = m;
+  p.seed = seed;
+  p.start = {n / 2, 0, n / 2};
+  p.targets = {{n / 2, n - 1, n / 2}};
+  return p;
+}
+void BM_VolumeFast(benchmark::State& s) {
+  const int n = int(s.range(0));
+  run(s, volumeLayout(n, Method::kFast));
+  s.counters["peakRssBytesPerVoxel"] = s.counters["peakRssMB"] * 1048576.0 / (double(n) * n * n);
+}
+void BM_VolumeDbm(benchmark::State& s) { run(s, volumeLayout(int(s.range(0)), Method::kDbm)); }
+void BM_VolumeDbmCg(benchmark::State& s) {
+  Params p = volumeLayout(int(s.range(0)), Method::kDbm);
+  p.solver = Solver::kCg;
+  run(s, p);
+}
+BENCHMARK(BM_VolumeFast)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VolumeFast)->Arg(256)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VolumeDbm)->Arg(32)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VolumeDbm)->Arg(64)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VolumeDbmCg)->Arg(32)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+void fractal3d(int seeds) {
+  std::printf("fractal dimension, 64^3, 26 neighbours, eta 2, %d seeds (mean +- sd; cells median)\n", seeds);
+  for (Method m : {Method::kFast, Method::kDbm}) {
+    std::vector<double> d, cells;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      auto b = grow(volumeLayout(64, m, uint64_t(seed)));
+      std::vector<Cell> cs;
+      for (const auto& n : b.value().nodes) cs.push_back(n.cell);
+      d.push_back(fractalDimension(cs, 64, 64, 64));
+      cells.push_back(double(cs.size()));
+    }
+    double mean = 0, sd = 0;
+    for (double v : d) mean += v / double(d.size());
+    for (double v : d) sd += (v - mean) * (v - mean) / double(d.size());
+    std::sort(cells.begin(), cells.end());
+    std::printf("  %-5s D = %.3f +- %.3f, cells %.0f\n", toString(m), mean, std::sqrt(sd), cells[cells.size() / 2]);
+  }
+}
+
 void fractal() {
   std::printf("fractal dimension, 128x128, 20 seeds (mean +- sd)\n");
   struct Row {
@@ -118,9 +171,15 @@ void fractal() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // As effectd runs (server/main.cpp): blocks over 256 KB from mmap, so the calloc'd per-voxel
+  // state of a 3-D grid comes as fresh zero pages instead of being cleared.
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
   for (int i = 1; i < argc; ++i)
     if (std::strcmp(argv[i], "--fractal") == 0) {
       fractal();
+      return 0;
+    } else if (std::strcmp(argv[i], "--fractal3d") == 0) {
+      fractal3d(i + 1 < argc ? std::atoi(argv[i + 1]) : 10);
       return 0;
     }
   benchmark::Initialize(&argc, argv);

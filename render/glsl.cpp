@@ -267,13 +267,16 @@ std::string quadFragment(const FogVariant* fog) {
   return s + "  fragColor = vec4(c, 1.0);\n}\n";
 }
 
-std::string boltVertex() {
+std::string boltVertex(bool world) {
+  // A 3-D bolt's vertices carry their depth (NDC z), tested against the scene's depth buffer.
   return std::string(kVertexHeader) +
          "layout(location = 0) in vec2 aPixel;\n"
-         "layout(location = 1) in vec3 aLine;  // x: intensity, y: signed distance across (px), z: half width\n"
+         "layout(location = 1) in vec3 aLine;  // x: intensity, y: signed distance across (px), z: half width\n" +
+         (world ? "layout(location = 2) in float aDepth;\n" : "") +
          "uniform vec2 uSize;\nout vec3 vLine;\n"
          "void main() {\n  vLine = aLine;\n"
-         "  gl_Position = vec4(2.0 * aPixel.x / uSize.x - 1.0, 1.0 - 2.0 * aPixel.y / uSize.y, 0.0, 1.0);\n}\n";
+         "  gl_Position = vec4(2.0 * aPixel.x / uSize.x - 1.0, 1.0 - 2.0 * aPixel.y / uSize.y, " +
+         (world ? "aDepth" : "0.0") + ", 1.0);\n}\n";
 }
 
 std::string boltFragment() {

@@ -45,7 +45,7 @@ std::string waveVertex();
 std::string waveFragment();
 std::string quadVertex();
 std::string quadFragment(const FogVariant* fog);
-std::string boltVertex();
+std::string boltVertex(bool world);
 std::string boltFragment();
 std::string blurFragment();
 std::string compositeFragment(bool glow);

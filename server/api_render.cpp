@@ -132,6 +132,16 @@ rd::Lightning sceneLightning(const json& body, const Config& config, Animation* 
   const effects::lightning::Bolt bolt = growBolt(r.params, "/lightning");
   rd::Lightning l;
   l.polylines = effects::lightning::polylines(bolt, r.shape);
+  if (r.params.depth) {  // a 3-D bolt lies in the scene: its vertices in world units
+    World world = r.world;
+    world.given = true;  // without "world": origin 0, one unit per voxel
+    for (auto& line : l.polylines)
+      for (auto& v : line.vertices) {
+        const auto p = world.toWorld(v.x, v.y, v.z);
+        v.x = float(p[0]), v.y = float(p[1]), v.z = float(p[2]);
+      }
+    l.world = true;
+  }
   if (animation && animation->frames.count > 0) {
     animation->bolt = l.polylines;
     animation->strike = effects::lightning::timeline(bolt, l.polylines, r.timeline);

@@ -1,6 +1,7 @@
 // Seed 002's bolt on screen: each polyline segment drawn as an anti-aliased quad into a
 // core buffer (MAX blending), an optional separable Gaussian glow at half resolution, and a
-// composite that adds both over the frame.
+// composite that adds both over the frame. A 3-D bolt's segments are projected through the
+// camera as camera-facing ribbons and depth-tested against the scene's geometry.
 #include <algorithm>
 #include <cmath>
 
@@ -37,6 +38,47 @@ std::vector<float> boltGeometry(const Lightning& l, int width, int height) {
       put(a, ia, -1), put(b, ib, 1), put(a, ia, 1);
     }
   }
+  return v;
+}
+
+// A 3-D bolt: each segment projected to pixels (with its NDC depth), as a screen-facing ribbon
+// whose width is coreWidth pixels at the bolt's middle, scaled by perspective. Segments with an
+// end behind the near plane are left out.
+std::vector<float> boltGeometry3d(const Lightning& l, const View& view, int width, int height) {
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const auto& line : l.polylines)
+    for (const auto& v : line.vertices) lo = glm::min(lo, glm::dvec3(v.x, v.y, v.z)), hi = glm::max(hi, glm::dvec3(v.x, v.y, v.z));
+  const glm::dmat4 vp(view.viewProjection);
+  const double middle = std::max(1e-6, (vp * glm::dvec4(0.5 * (lo + hi), 1.0)).w);
+  std::vector<float> v;
+  struct Projected {
+    glm::dvec2 pixel;
+    double depth, w;
+  };
+  auto project = [&](const lightning::Vertex& p) {
+    const glm::dvec4 c = vp * glm::dvec4(p.x, p.y, p.z, 1.0);
+    return Projected{{(c.x / c.w * 0.5 + 0.5) * width, (0.5 - c.y / c.w * 0.5) * height}, c.z / c.w, c.w};
+  };
+  const double nearW = 1e-4 * middle;
+  for (const auto& line : l.polylines)
+    for (size_t i = 1; i < line.vertices.size(); ++i) {
+      Projected a = project(line.vertices[i - 1]), b = project(line.vertices[i]);
+      if (a.w < nearW || b.w < nearW) continue;
+      glm::dvec2 d = b.pixel - a.pixel;
+      const double len = glm::length(d);
+      d = len > 1e-9 ? d / len : glm::dvec2(1, 0);
+      const glm::dvec2 n(-d.y, d.x);
+      const double ha = 0.5 * line.width * l.coreWidth * middle / a.w, hb = 0.5 * line.width * l.coreWidth * middle / b.w;
+      a.pixel -= d * ha, b.pixel += d * hb;
+      const float ia = line.vertices[i - 1].intensity, ib = line.vertices[i].intensity;
+      auto put = [&](const Projected& p, double half, float intensity, double side) {
+        const double margin = half + 1.0;
+        const glm::dvec2 q = p.pixel + n * (side * margin);
+        v.insert(v.end(), {float(q.x), float(q.y), intensity, float(side * margin), float(half), float(p.depth)});
+      };
+      put(a, ha, ia, -1), put(b, hb, ib, -1), put(b, hb, ib, 1);
+      put(a, ha, ia, -1), put(b, hb, ib, 1), put(a, ha, ia, 1);
+    }
   return v;
 }
 
@@ -82,19 +124,28 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   Target core;
   if (!core.create(scene.width, scene.height, GL_RGBA16F, false))
     return unsatisfiable("/renderer", "the lightning buffer cannot be created");
+  if (l.world) {  // the scene's depth, to be tested against (not written)
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f.main.depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      return unsatisfiable("/renderer", "the lightning buffer cannot share the scene's depth");
+  }
   core.use();
   glClear(GL_COLOR_BUFFER_BIT);
   {
-    auto program = gpu.program("bolt", boltVertex(), boltFragment());
+    auto program = gpu.program(l.world ? "bolt:world" : "bolt", boltVertex(l.world), boltFragment());
     if (!program.ok()) return program.error();
     Program& p = *program.value();
     glUseProgram(p.id);
     p.set("uSize", glm::vec2(scene.width, scene.height));
-    std::vector<float> data = boltGeometry(l, scene.width, scene.height);
-    Vertices mesh(data, {2, 3});
+    const std::vector<float> data =
+        l.world ? boltGeometry3d(l, f.view, scene.width, scene.height) : boltGeometry(l, scene.width, scene.height);
+    const int stride = l.world ? 6 : 5;
+    Vertices mesh(data, l.world ? std::vector<int>{2, 3, 1} : std::vector<int>{2, 3});
     glEnable(GL_BLEND);
     glBlendEquation(GL_MAX);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(data.size() / 5));
+    if (l.world) glEnable(GL_DEPTH_TEST), glDepthFunc(GL_LEQUAL), glDepthMask(GL_FALSE);
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(data.size() / size_t(stride)));
+    if (l.world) glDisable(GL_DEPTH_TEST), glDepthMask(GL_TRUE), glDepthFunc(GL_LESS);
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
     glBindVertexArray(gpu.emptyVao);

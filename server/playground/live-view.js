@@ -211,6 +211,7 @@ export class LiveView {
       else if (r instanceof WebGLVertexArrayObject) gl.deleteVertexArray(r);
     }
     this.resources = [];
+    this.boltBuffers = [];
     this.draw = null;
     this.duration = 0;
     this.player.box.hidden = true;
@@ -265,47 +266,72 @@ export class LiveView {
     return { eye, viewProjection: multiply(perspective(fovY, distance * 0.01, distance * 100), lookAt(eye, center)) };
   }
 
-  // answer: /v1/lightning with polylines (and a timeline when it has one).
+  // answer: /v1/lightning with polylines (and a timeline when it has one). A 2-D bolt is drawn
+  // in its grid; a 3-D one (grid [w, h, d], points x, y, z) through the orbit camera, its
+  // ribbons rebuilt from the projected points whenever the view changes.
   showLightning(answer) {
     this.reset();
     const gl = this.gl, prog = this.program(BOLT_VS, BOLT_FS);
-    const [w, h] = answer.grid;
+    const volume = answer.grid.length === 3;
+    const dims = volume ? 3 : 2;
     const lines = answer.polylines || [];
     const timeline = answer.timeline;
-    const pos = [], across = [], side = [], width = [], vertexOf = [];
-    let vertices = 0;
     const first = [];  // each polyline's first vertex in the flat vertex list
+    let vertices = 0;
+    for (const line of lines) first.push(vertices), vertices += line.points.length / dims;
+    let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity], widest = 0;
     for (const line of lines) {
-      first.push(vertices);
-      const p = line.points, n = p.length / 2;
-      for (let i = 0; i + 1 < n; ++i) {
-        const ax = p[2 * i], ay = p[2 * i + 1], bx = p[2 * i + 2], by = p[2 * i + 3];
-        const len = Math.hypot(bx - ax, by - ay) || 1, nx = -(by - ay) / len, ny = (bx - ax) / len;
-        // Extend each segment by half a width so joints close.
-        const ex = ((bx - ax) / len) * line.width * 0.5, ey = ((by - ay) / len) * line.width * 0.5;
-        const A = [ax - ex, ay - ey], B = [bx + ex, by + ey];
-        for (const [q, s, v] of [[A, -1, i], [B, -1, i + 1], [B, 1, i + 1], [A, -1, i], [B, 1, i + 1], [A, 1, i]]) {
-          pos.push(q[0] - w / 2, q[1] - h / 2);  // cells from the grid's centre
-          across.push(nx, ny);
-          side.push(s);
-          width.push(line.width);
-          vertexOf.push(vertices + v);
-        }
-      }
-      vertices += n;
+      widest = Math.max(widest, line.width);
+      for (let i = 0; i < line.points.length; i += dims)
+        for (let k = 0; k < dims; ++k) lo[k] = Math.min(lo[k], line.points[i + k]), hi[k] = Math.max(hi[k], line.points[i + k]);
     }
-    const brightness = new Float32Array(vertices);
-    const perQuad = new Float32Array(vertexOf.length);
-    const vao = gl.createVertexArray();
-    this.resources.push(vao);
-    gl.bindVertexArray(vao);
-    this.attribute(prog, 'aPosition', new Float32Array(pos), 2);
-    this.attribute(prog, 'aAcross', new Float32Array(across), 2);
-    this.attribute(prog, 'aSide', new Float32Array(side), 1);
-    this.attribute(prog, 'aWidth', new Float32Array(width), 1);
-    const bright = this.attribute(prog, 'aBrightness', perQuad, 1);
-    gl.bindVertexArray(null);
+    const [w, h] = answer.grid;
+    const center = lo.map((x, k) => (x + hi[k]) / 2), size = Math.hypot(...sub(hi.slice(0, dims), lo.slice(0, dims))) || 1;
+    // Points to the plane the ribbons are built in: grid cells from the centre (y down) in 2-D,
+    // normalised device coordinates in 3-D.
+    const flat2d = (p, i) => [p[i] - w / 2, p[i + 1] - h / 2];
+    const vertexOf = [];
+    let vao = null, bright = null, count = 0, perQuad = new Float32Array(0);
+    const build = (project, widthOf) => {
+      const pos = [], across = [], side = [], width = [];
+      vertexOf.length = 0;
+      lines.forEach((line, li) => {
+        const p = line.points, n = p.length / dims;
+        const wl = widthOf(line.width);
+        for (let i = 0; i + 1 < n; ++i) {
+          const a = project(p, i * dims), b = project(p, (i + 1) * dims);
+          if (!a || !b) continue;
+          const len = Math.hypot(b[0] - a[0], b[1] - a[1]) || 1, nx = -(b[1] - a[1]) / len, ny = (b[0] - a[0]) / len;
+          // Extend each segment by half a width so joints close.
+          const ex = ((b[0] - a[0]) / len) * wl * 0.5, ey = ((b[1] - a[1]) / len) * wl * 0.5;
+          const A = [a[0] - ex, a[1] - ey], B = [b[0] + ex, b[1] + ey];
+          for (const [q, sd, v] of [[A, -1, i], [B, -1, i + 1], [B, 1, i + 1], [A, -1, i], [B, 1, i + 1], [A, 1, i]]) {
+            pos.push(q[0], q[1]);
+            across.push(nx, ny);
+            side.push(sd);
+            width.push(wl);
+            vertexOf.push(first[li] + v);
+          }
+        }
+      });
+      // The previous projection's buffers go (a 3-D view rebuilds on every draw).
+      const old = new Set([vao, ...(this.boltBuffers || [])]);
+      for (const r of old) if (r) r instanceof WebGLVertexArrayObject ? gl.deleteVertexArray(r) : gl.deleteBuffer(r);
+      this.resources = this.resources.filter((r) => !old.has(r));
+      vao = gl.createVertexArray();
+      gl.bindVertexArray(vao);
+      perQuad = new Float32Array(vertexOf.length);
+      this.boltBuffers = [this.attribute(prog, 'aPosition', new Float32Array(pos), 2), this.attribute(prog, 'aAcross', new Float32Array(across), 2),
+                          this.attribute(prog, 'aSide', new Float32Array(side), 1), this.attribute(prog, 'aWidth', new Float32Array(width), 1)];
+      bright = this.attribute(prog, 'aBrightness', perQuad, 1);
+      this.boltBuffers.push(bright);
+      this.resources.push(vao);
+      gl.bindVertexArray(null);
+      count = vertexOf.length;
+    };
+    if (!volume) build(flat2d, (x) => x);
 
+    const brightness = new Float32Array(vertices);
     const k = timeline && timeline.keyframes;
     const light = (t) => {
       lines.forEach((line, li) => {
@@ -334,6 +360,16 @@ export class LiveView {
     }
     const scale = 1.9 / Math.max(w, h);
     this.draw = () => {
+      if (volume) {  // project through the orbit camera; the widest line is 3 px at the middle
+        const { viewProjection: m } = this.orbit(center, size * 1.3);
+        const px = 2 / this.canvas.width;
+        build((p, i) => {
+          const x = p[i], y = p[i + 1], z = p[i + 2];
+          const cw = m[3] * x + m[7] * y + m[11] * z + m[15];
+          if (cw < 1e-3 * size) return null;
+          return [(m[0] * x + m[4] * y + m[8] * z + m[12]) / cw, (m[1] * x + m[5] * y + m[9] * z + m[13]) / cw];
+        }, (lw) => (lw / (widest || 1)) * 3 * px / 0.45);
+      }
       light(timeline ? this.t : 0);
       if (timeline) this.player.clock.textContent = `${(this.t * 1000).toFixed(1)} ms of ${(this.duration * 1000).toFixed(0)} ms`;
       gl.viewport(0, 0, this.canvas.width, this.canvas.height);
@@ -341,7 +377,7 @@ export class LiveView {
       gl.clear(gl.COLOR_BUFFER_BIT);
       gl.useProgram(prog);
       gl.bindVertexArray(vao);
-      gl.uniform2f(gl.getUniformLocation(prog, 'uScale'), scale, -scale);
+      gl.uniform2f(gl.getUniformLocation(prog, 'uScale'), volume ? 1 : scale, volume ? 1 : -scale);
       gl.uniform3f(gl.getUniformLocation(prog, 'uColor'), 0.55, 0.65, 1.0);
       gl.enable(gl.BLEND);
       gl.blendFunc(gl.ONE, gl.ONE);
@@ -349,7 +385,7 @@ export class LiveView {
         gl.uniform1f(gl.getUniformLocation(prog, 'uWidthScale'), widthScale);
         gl.uniform1f(gl.getUniformLocation(prog, 'uFalloff'), falloff);
         gl.uniform1f(gl.getUniformLocation(prog, 'uGain'), gain);
-        gl.drawArrays(gl.TRIANGLES, 0, vertexOf.length);
+        gl.drawArrays(gl.TRIANGLES, 0, count);
       }
       gl.bindVertexArray(null);
     };

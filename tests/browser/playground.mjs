@@ -86,7 +86,7 @@ try {
   const effects = await page.$$eval('#effects button', (bs) => bs.map((b) => b.dataset.effect));
   check(effects.join() === 'lightning,fog,bubble,tangents,scene', 'every effect can be chosen', effects);
   const shown = { lightning: '07-strike-timeline', fog: '06-engine-terms-sunset', bubble: '05-film-thickness-lights-and-gltf',
-                  tangents: '02-mirrored-uvs-split', scene: '04-storm-over-water' };
+                  tangents: '02-mirrored-uvs-split', scene: '09-bolt-3d' };
   for (const effect of effects) {
     check((examples[effect] || []).length > 0, `${effect} has examples`);
     for (const { name } of examples[effect]) {

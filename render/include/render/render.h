@@ -103,6 +103,11 @@ struct Lightning {
   std::vector<lightning::Polyline> polylines;
   int gridWidth = 0, gridHeight = 0;
   glm::dvec4 rect{0, 0, 1, 1};
+  // A 3-D bolt: vertices are world positions (x, y, z), drawn through the scene's camera as
+  // camera-facing ribbons, depth-tested against the scene; coreWidth is then the width in
+  // pixels where the bolt's middle lies, wider nearer the camera and narrower farther. rect
+  // and the grid size do not apply.
+  bool world = false;
   glm::dvec3 color{0.75, 0.85, 1.0};
   double coreWidth = 1.5;  // pixels per unit of polyline width (main 2, branch 1)
   double glowSigma = 6;    // Gaussian sigma in pixels; 0 = no glow (no blur pass)
