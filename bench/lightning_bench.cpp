@@ -7,7 +7,8 @@
 // 3-D (issue 20): fast at 64^3 .. 256^3 (targets 128^3 <= 20 ms, 256^3 <= 200 ms) with peak
 // RSS per voxel; dbm with MGPCG at 32^3 and 64^3 (target 64^3 <= 1 s) beside plain CG at 32^3.
 // Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds;
-// `lightning_bench --fractal3d [seeds]` fast against dbm at 64^3 (default 10 seeds).
+// `lightning_bench --fractal3d [seeds [n]]` fast against dbm on n^3 at eta 1-3 (default 10
+// seeds, 64^3).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 #include <sys/resource.h>
@@ -116,23 +117,34 @@ BENCHMARK(BM_VolumeDbm)->Arg(32)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeDbm)->Arg(64)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeDbmCg)->Arg(32)->Iterations(1)->Unit(benchmark::kMillisecond);
 
-void fractal3d(int seeds) {
-  std::printf("fractal dimension, 64^3, 26 neighbours, eta 2, %d seeds (mean +- sd; cells median)\n", seeds);
-  for (Method m : {Method::kFast, Method::kDbm}) {
-    std::vector<double> d, cells;
-    for (int seed = 1; seed <= seeds; ++seed) {
-      auto b = grow(volumeLayout(64, m, uint64_t(seed)));
-      std::vector<Cell> cs;
-      for (const auto& n : b.value().nodes) cs.push_back(n.cell);
-      d.push_back(fractalDimension(cs, 64, 64, 64));
-      cells.push_back(double(cs.size()));
+void fractal3d(int seeds, int n) {
+  std::printf("fractal dimension, %d^3, 26 neighbours, %d seeds (mean +- sd; cells and tips median)\n", n, seeds);
+  for (double eta : {1.0, 2.0, 3.0})
+    for (Method m : {Method::kFast, Method::kDbm}) {
+      std::vector<double> d, cells, tips;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        Params p = volumeLayout(n, m, uint64_t(seed));
+        p.eta = eta;
+        auto b = grow(p);
+        std::vector<Cell> cs;
+        std::vector<char> hasChild(b.value().nodes.size(), 0);
+        for (const auto& node : b.value().nodes) {
+          cs.push_back(node.cell);
+          if (node.parent >= 0) hasChild[size_t(node.parent)] = 1;
+        }
+        d.push_back(fractalDimension(cs, n, n, n));
+        cells.push_back(double(cs.size()));
+        tips.push_back(double(std::count(hasChild.begin(), hasChild.end(), 0)));
+      }
+      double mean = 0, sd = 0;
+      for (double v : d) mean += v / double(d.size());
+      for (double v : d) sd += (v - mean) * (v - mean) / double(d.size());
+      std::sort(cells.begin(), cells.end());
+      std::sort(tips.begin(), tips.end());
+      std::printf("  eta %.0f %-5s D = %.3f +- %.3f, cells %.0f, tips %.0f\n", eta, toString(m), mean, std::sqrt(sd),
+                  cells[cells.size() / 2], tips[tips.size() / 2]);
+      std::fflush(stdout);
     }
-    double mean = 0, sd = 0;
-    for (double v : d) mean += v / double(d.size());
-    for (double v : d) sd += (v - mean) * (v - mean) / double(d.size());
-    std::sort(cells.begin(), cells.end());
-    std::printf("  %-5s D = %.3f +- %.3f, cells %.0f\n", toString(m), mean, std::sqrt(sd), cells[cells.size() / 2]);
-  }
 }
 
 void fractal() {
@@ -179,7 +191,7 @@ int main(int argc, char** argv) {
       fractal();
       return 0;
     } else if (std::strcmp(argv[i], "--fractal3d") == 0) {
-      fractal3d(i + 1 < argc ? std::atoi(argv[i + 1]) : 10);
+      fractal3d(i + 1 < argc ? std::atoi(argv[i + 1]) : 10, i + 2 < argc ? std::atoi(argv[i + 2]) : 64);
       return 0;
     }
   benchmark::Initialize(&argc, argv);

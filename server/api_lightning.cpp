@@ -30,6 +30,7 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::stri
     for (size_t i = 0; i < rows.size(); ++i) {
       int y = rows[i]["y"];
       if (y >= h) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/y", "is outside the grid");
+      if (rows[i].contains("z")) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/z", "is for 3-D grids (grid.depth)");
       for (const auto& run : rows[i]["runs"]) {
         int x0 = run[0], len = run[1];
         for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;

@@ -147,9 +147,8 @@ World parseWorld(const json& body, const std::string& at) {
 
 std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, const World& world, const Config& config,
                                           const std::string& at) {
-  for (const char* twoD : {"rects", "rows"})
-    if (o.contains(twoD))
-      throw fieldError(400, at + "/" + twoD, "is for 2-D grids; a 3-D grid takes boxes, spheres, bitmap, mesh or glb");
+  if (o.contains("rects"))
+    throw fieldError(400, at + "/rects", "is for 2-D grids; a 3-D grid takes boxes, spheres, rows, bitmap, mesh or glb");
   std::vector<uint8_t> grid(size_t(w) * size_t(h) * size_t(d), 0);
   auto index = [&](int x, int y, int z) { return (size_t(z) * size_t(h) + size_t(y)) * size_t(w) + size_t(x); };
   bool any = false;
@@ -178,6 +177,21 @@ std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, co
             const double dx = x + 0.5 - c[0], dy = y + 0.5 - c[1], dz = z + 0.5 - c[2];
             if (dx * dx + dy * dy + dz * dz <= r * r) grid[index(x, y, z)] = 1;
           }
+    }
+    any = true;
+  }
+  if (o.contains("rows")) {
+    const json& rows = o["rows"];
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const std::string row = at + "/rows/" + std::to_string(i);
+      if (!rows[i].contains("z")) throw fieldError(400, row + "/z", "is required on a 3-D grid");
+      const int y = rows[i]["y"], z = rows[i]["z"];
+      if (y >= h) throw fieldError(400, row + "/y", "is outside the grid");
+      if (z >= d) throw fieldError(400, row + "/z", "is outside the grid");
+      for (const auto& run : rows[i]["runs"]) {
+        const int x0 = run[0], len = run[1];
+        for (int x = x0; x < std::min(w, x0 + len); ++x) grid[index(x, y, z)] = 1;
+      }
     }
     any = true;
   }

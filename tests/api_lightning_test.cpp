@@ -194,6 +194,7 @@ json volumeRequest() {
           {"world", {{"origin", {-16.0, 32.0, 16.0}}, {"cellSize", 0.5}}},
           {"obstacles",
            {{"boxes", {{6, 14, 6, 14, 6, 14}}},
+            {"rows", {{{"y", 25}, {"z", 3}, {"runs", {{0, 10}, {20, 5}}}}}},
             {"spheres", {{{"center", {-8.0, 20.0, 4.0}}, {"radius", 2.0}}}},
             {"mesh", {{"positions", {-14.0, 28.0, 14.0, 2.0, 28.0, 14.0, -14.0, 28.0, -2.0}}, {"indices", {0, 1, 2}}}}}},
           {"seed", 3},
@@ -287,6 +288,12 @@ TEST(LightningApi, VolumeProblemsNameTheField) {
   req = volumeRequest();
   req["method"] = "charges";
   problem(req, 400, "/method");
+  req = volumeRequest();
+  req["obstacles"] = {{"rows", {{{"y", 3}, {"runs", {{0, 4}}}}}}};
+  problem(req, 400, "/obstacles/rows/0/z");
+  req = request(32);
+  req["obstacles"] = {{"rows", {{{"y", 3}, {"z", 1}, {"runs", {{0, 4}}}}}}};
+  problem(req, 400, "/obstacles/rows/0/z");
 }
 
 }  // namespace
