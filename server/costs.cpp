@@ -49,9 +49,11 @@ Cost lightningCost(const json& body, const Config& config) {
                       : config.limits.maxGridCells);
   // Working set per cell: fast keeps the obstacle grid, candidate and potential state and
   // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils: 27-point
-  // ones in 3-D). 3-D fast adds the A* guide's cost and parent per voxel and the octree's
-  // charge byte (measured: bench/lightning_bench BM_Volume*).
-  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 40 : 24);
+  // ones in 3-D). 3-D fast keeps its per-voxel state in calloc'd pages that only the bolt and
+  // the A* search touch: at worst (a search that floods the volume) A*'s cost, seen flag and
+  // parent (9 bytes), the obstacle and octree charge bytes; a typical bolt touches ~2 bytes
+  // per voxel (bench/lightning_bench BM_VolumeFast).
+  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 12 : 24);
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps =
       std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);

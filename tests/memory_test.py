@@ -94,6 +94,31 @@ try:
 finally:
     s.stop()
 
+# 1b. Eight concurrent 3-D requests (fast 256^3 and dbm 64^3) under a 512 MB budget: the
+#     process stays under base + 1.25 x budget and every answer is 200 or 503.
+budget = 512
+s = Server("--memory-budget-mb", str(budget), "--heavy-threads", "8", "--threads", "16", "--response-cache-mb", "0")
+try:
+    s.post("/v1/fog", {"fog": {"fogType": "GL_EXP"}})
+    base = s.kb("VmRSS")
+    s.reset_peak()
+
+    def volume(i):
+        n, method = (256, "fast") if i % 4 else (48, "dbm")
+        return s.post("/v1/lightning", {"grid": {"width": n, "height": n, "depth": n}, "start": [n // 2, 0, n // 2],
+                                        "targets": [[n // 2, n - 1, n // 2]], "method": method, "seed": i + 1})
+    answers = concurrently(8, volume)
+    peak = s.kb("VmHWM")
+    statuses = [a[0] for a in answers]
+    print(f"     8 x 3-D bolts (256^3 fast, 48^3 dbm), budget {budget} MB: base {base // 1024} MB, "
+          f"peak {peak // 1024} MB, statuses {statuses}")
+    check(peak <= base + 1.25 * budget * 1024, f"peak RSS {peak // 1024} MB <= base {base // 1024} + 1.25 x {budget} MB")
+    check(all(st == 200 or (st == 503 and h.get("Retry-After")) for st, h, _ in answers),
+          "every 3-D answer is 200 or 503 with Retry-After")
+    check(statuses.count(200) >= 1, "some 3-D bolts were served")
+finally:
+    s.stop()
+
 # 2. A queue that cannot wait: 503 with Retry-After. A request larger than the whole budget:
 #    413 naming the flag.
 s = Server("--memory-budget-mb", "450", "--heavy-threads", "16", "--threads", "16", "--response-cache-mb", "0",
