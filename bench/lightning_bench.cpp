@@ -29,6 +29,7 @@ namespace {
 using namespace effects::lightning;
 
 using fixtures::lightningLayout;
+using fixtures::volumeLayout;
 
 void run(benchmark::State& state, Params p) {
   uint64_t seed = 1;
@@ -89,17 +90,6 @@ BENCHMARK(BM_DbmMgpcg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmCg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Fast1024Obstacles)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-// 3-D: start at the top face's centre, target at the bottom face's centre, 26 neighbours.
-Params volumeLayout(int n, Method m, uint64_t seed = 1) {
-  Params p;
-  p.width = p.height = p.depth = n;
-  p.neighbourhood = 26;
-  p.method = m;
-  p.seed = seed;
-  p.start = {n / 2, 0, n / 2};
-  p.targets = {{n / 2, n - 1, n / 2}};
-  return p;
-}
 void BM_VolumeFast(benchmark::State& s) {
   const int n = int(s.range(0));
   run(s, volumeLayout(n, Method::kFast));

@@ -8,19 +8,12 @@
 
 #include <effects/lightning.h>
 
+#include "fixtures.h"
+
 namespace effects::lightning {
 namespace {
 
-Params volume(int n, Method m = Method::kFast, uint64_t seed = 1) {
-  Params p;
-  p.width = p.height = p.depth = n;
-  p.neighbourhood = 26;
-  p.method = m;
-  p.seed = seed;
-  p.start = {n / 2, 0, n / 2};
-  p.targets = {{n / 2, n - 1, n / 2}};
-  return p;
-}
+Params volume(int n, Method m = Method::kFast, uint64_t seed = 1) { return fixtures::volumeLayout(n, m, seed); }
 
 size_t at(const Params& p, int x, int y, int z) { return (size_t(z) * size_t(p.height) + size_t(y)) * size_t(p.width) + size_t(x); }
 

@@ -10,24 +10,6 @@ namespace {
 constexpr int kPreSmooth = 1;  // red-black / lexicographic Gauss-Seidel sweeps per level side
 constexpr int kCoarsestSweeps = 12;
 
-int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-
-// Bilinear weight of the coarse cell sitting on fine cell c for fine cell f, per axis.
-double axisWeight(int d) { return d == 0 ? 1.0 : 0.5; }
-
-// Coarse parents (index, weight) of fine cell g along one axis of n coarse cells: an odd g
-// sits on one (weight 1), an even g lies between two (1/2 each). Returns how many.
-int coarseParents(int g, int n, int* p, double* w) {
-  int np = 0;
-  if (g & 1) {
-    if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, w[np++] = 1.0;
-  } else {
-    if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, w[np++] = 0.5;
-    if (g / 2 < n) p[np] = g / 2, w[np++] = 0.5;
-  }
-  return np;
-}
-
 }  // namespace
 
 Laplace::Laplace(int width, int height) : w_(width), h_(height), stride_(width + 2) {
@@ -263,45 +245,23 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
   const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
   const bool mg = solver == Solver::kMgpcg;
-  int it = 0;
   const int maxIt = 20 * (w_ + h_) + 1000;  // CG converges in O(sqrt(cond)) ~ O(n) iterations
-  if (std::sqrt(rr) > goal) {
-    if (mg)
-      precondition();
-    else
-      z_ = r_;
-    p_ = z_;
-    double rz = 0;
-    for (size_t i = 0; i < n; ++i) rz += r_[i] * z_[i];
-    for (; it < maxIt; ++it) {
-      double pap = 0;
-      for (size_t i = s; i + s < n; ++i) {
-        ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
-        pap += p_[i] * ap_[i];
-      }
-      if (!(pap > 0)) break;
-      const double alpha = rz / pap;
-      rr = 0;
-      for (size_t i = 0; i < n; ++i) {
-        phi_[i] += alpha * p_[i];
-        r_[i] -= alpha * ap_[i];
-        rr += r_[i] * r_[i];
-      }
-      if (std::sqrt(rr) <= goal) {
-        ++it;
-        break;
-      }
-      if (mg)
-        precondition();
-      else
-        z_ = r_;
-      double rzNew = 0;
-      for (size_t i = 0; i < n; ++i) rzNew += r_[i] * z_[i];
-      const double beta = rzNew / rz;
-      rz = rzNew;
-      for (size_t i = 0; i < n; ++i) p_[i] = z_[i] + beta * p_[i];  // z is 0 on fixed cells
-    }
-  }
+  const int it = conjugateGradients(
+      phi_, r_, z_, p_, ap_, goal, maxIt, rr,
+      [&] {
+        if (mg)
+          precondition();
+        else
+          z_ = r_;
+      },
+      [&] {
+        double pap = 0;
+        for (size_t i = s; i + s < n; ++i) {
+          ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
+          pap += p_[i] * ap_[i];
+        }
+        return pap;
+      });
   if (relResidual) *relResidual = std::sqrt(rr) / bnorm;
   return it;
 }

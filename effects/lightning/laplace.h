@@ -11,11 +11,65 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "effects/lightning.h"
 
 namespace effects::lightning::detail {
+
+// Vertex-centred coarsening, per axis (2-D and 3-D alike): coarse cell J sits on fine cell 2J+1.
+inline int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+// Bilinear weight of the coarse cell sitting on fine cell c for fine cell f, per axis (d = f - c).
+inline double axisWeight(int d) { return d == 0 ? 1.0 : 0.5; }
+// Coarse parents (index, weight) of fine cell g along one axis of n coarse cells: an odd g
+// sits on one (weight 1), an even g lies between two (1/2 each). Returns how many.
+inline int coarseParents(int g, int n, int* p, double* w) {
+  int np = 0;
+  if (g & 1) {
+    if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, w[np++] = 1.0;
+  } else {
+    if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, w[np++] = 0.5;
+    if (g / 2 < n) p[np] = g / 2, w[np++] = 0.5;
+  }
+  return np;
+}
+
+// Conjugate gradients from phi with residual r (r = b - A phi, rr = its squared norm) until
+// ||r|| <= goal or maxIt iterations; precondition() sets z from r, applyAndDot() sets
+// ap = A p and returns p . ap. The vectors share one padded layout (pads stay 0). Returns the
+// iterations; rr ends as the final residual's squared norm.
+template <class Precondition, class ApplyAndDot>
+int conjugateGradients(std::vector<double>& phi, std::vector<double>& r, std::vector<double>& z,
+                       std::vector<double>& p, const std::vector<double>& ap, double goal, int maxIt, double& rr,
+                       Precondition precondition, ApplyAndDot applyAndDot) {
+  const size_t n = phi.size();
+  int it = 0;
+  if (!(std::sqrt(rr) > goal)) return 0;
+  precondition();
+  p = z;
+  double rz = 0;
+  for (size_t i = 0; i < n; ++i) rz += r[i] * z[i];
+  for (; it < maxIt; ++it) {
+    const double pap = applyAndDot();
+    if (!(pap > 0)) break;
+    const double alpha = rz / pap;
+    rr = 0;
+    for (size_t i = 0; i < n; ++i) {
+      phi[i] += alpha * p[i];
+      r[i] -= alpha * ap[i];
+      rr += r[i] * r[i];
+    }
+    if (std::sqrt(rr) <= goal) return it + 1;
+    precondition();
+    double rzNew = 0;
+    for (size_t i = 0; i < n; ++i) rzNew += r[i] * z[i];
+    const double beta = rzNew / rz;
+    rz = rzNew;
+    for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];  // z is 0 on fixed cells
+  }
+  return it;
+}
 
 // The DBM potential of a 2-D grid (Laplace) or a 3-D one (Laplace3, laplace3.h).
 class Potential {

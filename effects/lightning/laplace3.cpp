@@ -9,22 +9,6 @@ namespace {
 
 constexpr int kCoarsestSweeps = 12;
 
-int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-double axisWeight(int d) { return d == 0 ? 1.0 : 0.5; }
-
-// Coarse parents (index, weight) of fine voxel g along one axis of n coarse voxels: an odd g
-// sits on one (weight 1), an even g lies between two (1/2 each). Returns how many.
-int coarseParents(int g, int n, int* p, double* w) {
-  int np = 0;
-  if (g & 1) {
-    if ((g - 1) / 2 < n) p[np] = (g - 1) / 2, w[np++] = 1.0;
-  } else {
-    if (g / 2 - 1 >= 0 && g / 2 - 1 < n) p[np] = g / 2 - 1, w[np++] = 0.5;
-    if (g / 2 < n) p[np] = g / 2, w[np++] = 0.5;
-  }
-  return np;
-}
-
 // Offsets of the 27-point stencil in a padded level with rows of sx and slabs of sx * sy.
 std::array<ptrdiff_t, 27> offsets(size_t sx, size_t sy) {
   std::array<ptrdiff_t, 27> o{};
@@ -305,7 +289,6 @@ int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
   const double goal = tolerance * bnorm;
   const bool mg = solver == Solver::kMgpcg && levels_.size() > 1;
   const int maxIt = 20 * (w_ + h_ + d_) + 1000;
-  int it = 0;
   auto precondition = [&] {
     if (mg) {
       if (!dirty_.empty()) updateCoarse();
@@ -314,35 +297,12 @@ int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
       z_ = r_;
     }
   };
-  if (std::sqrt(rr) > goal) {
-    precondition();
-    p_ = z_;
-    double rz = 0;
-    for (size_t i = 0; i < n; ++i) rz += r_[i] * z_[i];
-    for (; it < maxIt; ++it) {
-      apply(p_, ap_);
-      double pap = 0;
-      for (size_t i = 0; i < n; ++i) pap += p_[i] * ap_[i];
-      if (!(pap > 0)) break;
-      const double alpha = rz / pap;
-      rr = 0;
-      for (size_t i = 0; i < n; ++i) {
-        phi_[i] += alpha * p_[i];
-        r_[i] -= alpha * ap_[i];
-        rr += r_[i] * r_[i];
-      }
-      if (std::sqrt(rr) <= goal) {
-        ++it;
-        break;
-      }
-      precondition();
-      double rzNew = 0;
-      for (size_t i = 0; i < n; ++i) rzNew += r_[i] * z_[i];
-      const double beta = rzNew / rz;
-      rz = rzNew;
-      for (size_t i = 0; i < n; ++i) p_[i] = z_[i] + beta * p_[i];
-    }
-  }
+  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, precondition, [&] {
+    apply(p_, ap_);
+    double pap = 0;
+    for (size_t i = 0; i < n; ++i) pap += p_[i] * ap_[i];
+    return pap;
+  });
   if (relResidual) *relResidual = std::sqrt(rr) / bnorm;
   return it;
 }
