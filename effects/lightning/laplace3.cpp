@@ -37,7 +37,7 @@ Laplace3::Laplace3(int width, int height, int depth)
     l.sx = size_t(w) + 2, l.sy = size_t(h) + 2;
     const size_t m = l.sx * l.sy * (size_t(d) + 2);
     l.a.assign(m, {});
-    for (auto* v : {&l.invDiag, &l.e, &l.r}) v->assign(m, 0.0);
+    for (auto* v : {&l.invDiag, &l.e, &l.r, &l.res}) v->assign(m, 0.0);
     levels_.push_back(std::move(l));
   }
   dirty_ = {0, 0, 0, w_ - 1, h_ - 1, d_ - 1};
@@ -128,8 +128,10 @@ void Laplace3::updateCoarse() {
   dirty_ = {0, 0, 0, -1, -1, -1};
 }
 
-void Laplace3::smoothFine(bool forward) {
+void Laplace3::smoothFine(bool forward, bool fromZero) {
   // Red-black Gauss-Seidel on 6e - sum e_n = r over the unknowns (e is 0 on fixed voxels).
+  // From zero, the first colour's neighbours are all 0; writing every voxel of both colours
+  // (the pad is never written) then replaces clearing the vector.
   const size_t slab = sx_ * sy_;
   double* e = z_.data();
   for (int pass = 0; pass < 2; ++pass) {
@@ -137,6 +139,11 @@ void Laplace3::smoothFine(bool forward) {
     for (int z = 0; z < d_; ++z)
       for (int y = 0; y < h_; ++y) {
         const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
+        if (fromZero && pass == 0) {
+          for (int x = (y + z + colour) & 1; x < w_; x += 2)
+            e[row + size_t(x)] = mask_[row + size_t(x)] * (1.0 / 6.0) * r_[row + size_t(x)];
+          continue;
+        }
         for (int x = (y + z + colour) & 1; x < w_; x += 2) {
           const size_t i = row + size_t(x);
           e[i] = mask_[i] * (1.0 / 6.0) * (r_[i] + e[i - 1] + e[i + 1] + e[i - sx_] + e[i + sx_] + e[i - slab] + e[i + slab]);
@@ -169,14 +176,18 @@ void Laplace3::smoothCoarse(Level& l, bool forward) {
   }
 }
 
-void Laplace3::apply(const std::vector<double>& v, std::vector<double>& out) const {
+double Laplace3::apply(const std::vector<double>& v, std::vector<double>& out) const {
   const size_t slab = sx_ * sy_;
+  double dot = 0;
   for (int z = 0; z < d_; ++z)
     for (int y = 0; y < h_; ++y) {
       const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-      for (size_t i = row; i < row + size_t(w_); ++i)
+      for (size_t i = row; i < row + size_t(w_); ++i) {
         out[i] = mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] - v[i - slab] - v[i + slab]);
+        dot += v[i] * out[i];
+      }
     }
+  return dot;
 }
 
 // e_k approximately solves A_k e_k = r_k; k = 0 is the fine level (r_ -> z_).
@@ -185,9 +196,7 @@ void Laplace3::apply(const std::vector<double>& v, std::vector<double>& out) con
 void Laplace3::vcycle(size_t k) {
   const bool fine = k == 0;
   const bool coarsest = k + 1 == levels_.size();
-  if (fine) {
-    std::fill(z_.begin(), z_.end(), 0.0);
-  } else {
+  if (!fine) {
     Level& l = levels_[k];
     std::fill(l.e.begin(), l.e.end(), 0.0);
     if (coarsest) {
@@ -195,18 +204,21 @@ void Laplace3::vcycle(size_t k) {
       return;
     }
   }
-  fine ? smoothFine(true) : smoothCoarse(levels_[k], true);
+  fine ? smoothFine(true, true) : smoothCoarse(levels_[k], true);
   if (!coarsest) {
     const int fw = fine ? w_ : levels_[k].w, fh = fine ? h_ : levels_[k].h, fd = fine ? d_ : levels_[k].d;
     const size_t fsx = fine ? sx_ : levels_[k].sx, fsy = fine ? sy_ : levels_[k].sy;
-    // This level's residual into res_ (the level's padding 0: restriction reads it).
-    std::fill(res_.begin(), res_.begin() + ptrdiff_t(fsx * fsy * (size_t(fd) + 2)), 0.0);
+    // This level's residual into its own buffer, whose padding stays 0 (restriction reads it).
+    std::vector<double>& res = fine ? res_ : levels_[k].res;
     if (fine) {
-      apply(z_, ap_);
+      const size_t slab = sx_ * sy_;
+      const double* v = z_.data();
       for (int z = 0; z < d_; ++z)
         for (int y = 0; y < h_; ++y) {
           const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-          for (size_t i = row; i < row + size_t(w_); ++i) res_[i] = mask_[i] * (r_[i] - ap_[i]);
+          for (size_t i = row; i < row + size_t(w_); ++i)
+            res[i] = mask_[i] * (r_[i] - mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] -
+                                                     v[i - slab] - v[i + slab]));
         }
     } else {
       const Level& l = levels_[k];
@@ -217,7 +229,7 @@ void Laplace3::vcycle(size_t k) {
             const size_t i = (size_t(z + 1) * l.sy + size_t(y + 1)) * l.sx + size_t(x + 1);
             double s = l.r[i];
             for (size_t o = 0; o < 27; ++o) s -= l.a[i][o] * l.e[size_t(ptrdiff_t(i) + off[o])];
-            res_[i] = s;
+            res[i] = s;
           }
     }
     // Restriction P^T: full weighting over the 3x3x3 fine voxels around 2J+1, separably
@@ -228,7 +240,7 @@ void Laplace3::vcycle(size_t k) {
       for (int cy = 0; cy < c.h; ++cy)
         for (int cx = 0; cx < c.w; ++cx) {
           const size_t i = (size_t(2 * cz + 2) * fsy + size_t(2 * cy + 2)) * fsx + size_t(2 * cx + 2);
-          auto row = [&](size_t j) { return 0.5 * res_[j - 1] + res_[j] + 0.5 * res_[j + 1]; };
+          auto row = [&](size_t j) { return 0.5 * res[j - 1] + res[j] + 0.5 * res[j + 1]; };
           auto plane = [&](size_t j) { return 0.5 * row(j - fsx) + row(j) + 0.5 * row(j + fsx); };
           c.r[(size_t(cz + 1) * c.sy + size_t(cy + 1)) * c.sx + size_t(cx + 1)] =
               0.5 * plane(i - fslab) + plane(i) + 0.5 * plane(i + fslab);
@@ -265,7 +277,7 @@ void Laplace3::vcycle(size_t k) {
       }
     }
   }
-  fine ? smoothFine(false) : smoothCoarse(levels_[k], false);
+  fine ? smoothFine(false, false) : smoothCoarse(levels_[k], false);
 }
 
 void Laplace3::residualFine(std::vector<double>& out) const {
@@ -297,12 +309,7 @@ int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
       z_ = r_;
     }
   };
-  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, precondition, [&] {
-    apply(p_, ap_);
-    double pap = 0;
-    for (size_t i = 0; i < n; ++i) pap += p_[i] * ap_[i];
-    return pap;
-  });
+  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, precondition, [&] { return apply(p_, ap_); });
   if (relResidual) *relResidual = std::sqrt(rr) / bnorm;
   return it;
 }

@@ -28,7 +28,7 @@ class Laplace3 final : public Potential {
     int w = 0, h = 0, d = 0;
     size_t sx = 0, sy = 0;                // padded row length and rows per slab
     std::vector<std::array<double, 27>> a;  // a[i][(dx+1) + 3 (dy+1) + 9 (dz+1)]; all 0 when inactive
-    std::vector<double> invDiag, e, r;
+    std::vector<double> invDiag, e, r, res;  // res: this level's residual (pads stay 0)
   };
   struct Box {
     int x0, y0, z0, x1, y1, z1;  // inclusive; empty when x0 > x1
@@ -37,10 +37,11 @@ class Laplace3 final : public Potential {
   void galerkinRow(size_t k, int cx, int cy, int cz);
   void updateCoarse();
   void vcycle(size_t k);
-  void smoothFine(bool forward);
+  void smoothFine(bool forward, bool fromZero);
   void smoothCoarse(Level& l, bool forward);
   void residualFine(std::vector<double>& out) const;
-  void apply(const std::vector<double>& v, std::vector<double>& out) const;  // the fine operator
+  // The fine operator: out = A v over the unknowns; returns v . out.
+  double apply(const std::vector<double>& v, std::vector<double>& out) const;
 
   int w_, h_, d_;
   size_t sx_, sy_;
