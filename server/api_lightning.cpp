@@ -168,16 +168,6 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
     throw fieldError(413, at + "/grid",
                      "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
                          std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
-  if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
-  r.world = parseWorld(body, at + "/world");
-  if (body.contains("obstacles"))
-    p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
-                                                 at + "/obstacles")
-                          : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
-  p.start = cellOf(body["start"], p.depth, at + "/start");
-  p.targets.clear();
-  for (size_t i = 0; i < body["targets"].size(); ++i)
-    p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   const std::string method = body.value("method", "fast");
   p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
   const size_t solverLimit = p.depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells;
@@ -187,6 +177,17 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
                          " for method " + method +
                          (p.depth ? " (--max-solver-volume-cells)" : " (--max-solver-grid-cells)") +
                          "; the fast method takes up to " + std::to_string(config.limits.maxGridCells));
+  // The limits first, then the obstacles (a mesh is voxelised here).
+  if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
+  r.world = parseWorld(body);
+  if (body.contains("obstacles"))
+    p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
+                                                 at + "/obstacles")
+                          : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
+  p.start = cellOf(body["start"], p.depth, at + "/start");
+  p.targets.clear();
+  for (size_t i = 0; i < body["targets"].size(); ++i)
+    p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   p.eta = body.value("eta", p.eta);
   p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
   p.axisGrowth = lt::calibratedAxisGrowth(p);

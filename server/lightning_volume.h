@@ -28,7 +28,8 @@ struct World {
   }
 };
 
-World parseWorld(const nlohmann::json& body, const std::string& at);
+// The request's "world" (schema-valid); absent: not given.
+World parseWorld(const nlohmann::json& body);
 
 // The obstacle voxels of a w x h x d grid (empty when none are given); problems name the field
 // under `at` ("/obstacles").

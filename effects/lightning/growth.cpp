@@ -62,7 +62,7 @@ constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 struct Candidate {
   Cell cell;
   int born;        // step at which it last gained a bolt neighbour
-  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8 (1..4 in a 4-neighbourhood)
+  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8 (1..4 in a 4-neighbourhood, 1..26 in 3-D)
   int parent;      // node it attaches to if chosen: its newest bolt neighbour
   double charge;   // kCharges: sum over bolt cells of 1/r
   // kFast: log(2^G / (B * P)), fixed while the segment's axis stands, and Phi^eta relative
@@ -104,11 +104,12 @@ class Grower {
   void logWeights(std::vector<double>& out);
   double fastLogStatic(const Candidate& c) const;
   static double fastLogPhi(const Candidate& c) { return c.logStatic - logCount(c.neighbours); }
-  // log n for the bolt-neighbour counts 1..8, looked up: the same values std::log gives.
+  // log n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's 26-neighbourhood), looked
+  // up: the same values std::log gives.
   static double logCount(int n) {
-    static const std::array<double, 9> table = [] {
-      std::array<double, 9> t{};
-      for (int i = 1; i < 9; ++i) t[size_t(i)] = std::log(double(i));
+    static const std::array<double, 27> table = [] {
+      std::array<double, 27> t{};
+      for (int i = 1; i < 27; ++i) t[size_t(i)] = std::log(double(i));
       return t;
     }();
     return table[size_t(n)];
