@@ -7,8 +7,8 @@
 // 3-D (issue 20): fast at 64^3 .. 256^3 (targets 128^3 <= 20 ms, 256^3 <= 200 ms) with peak
 // RSS per voxel; dbm with MGPCG at 32^3 and 64^3 (target 64^3 <= 1 s) beside plain CG at 32^3.
 // Fractal dimensions: `lightning_bench --fractal` prints mean +- sd over 20 seeds;
-// `lightning_bench --fractal3d [seeds [n]]` fast against dbm on n^3 at eta 1-3 (default 10
-// seeds, 64^3).
+// `lightning_bench --fractal3d [seeds [n [eta]]]` fast against dbm on n^3 at eta 1-3, or the
+// one eta given (default 10 seeds, 64^3).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 #include <sys/resource.h>
@@ -107,10 +107,11 @@ BENCHMARK(BM_VolumeDbm)->Arg(32)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeDbm)->Arg(64)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VolumeDbmCg)->Arg(32)->Iterations(1)->Unit(benchmark::kMillisecond);
 
-void fractal3d(int seeds, int n) {
+void fractal3d(int seeds, int n, double onlyEta) {
   std::printf("fractal dimension, %d^3, 26 neighbours, %d seeds (mean +- sd; cells and tips median)\n", n, seeds);
   for (double eta : {1.0, 2.0, 3.0})
     for (Method m : {Method::kFast, Method::kDbm}) {
+      if (onlyEta > 0 && eta != onlyEta) continue;
       std::vector<double> d, cells, tips;
       for (int seed = 1; seed <= seeds; ++seed) {
         Params p = volumeLayout(n, m, uint64_t(seed));
@@ -181,7 +182,8 @@ int main(int argc, char** argv) {
       fractal();
       return 0;
     } else if (std::strcmp(argv[i], "--fractal3d") == 0) {
-      fractal3d(i + 1 < argc ? std::atoi(argv[i + 1]) : 10, i + 2 < argc ? std::atoi(argv[i + 2]) : 64);
+      fractal3d(i + 1 < argc ? std::atoi(argv[i + 1]) : 10, i + 2 < argc ? std::atoi(argv[i + 2]) : 64,
+                i + 3 < argc ? std::atof(argv[i + 3]) : 0);
       return 0;
     }
   benchmark::Initialize(&argc, argv);
