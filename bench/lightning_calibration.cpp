@@ -6,7 +6,8 @@
 //
 //   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
 //                         [--seeds S] [--dbm-seeds S] [--neighbourhood 4|8] [--fit]
-//                         [--charges-eta E]...
+//                         [--charges-eta E]... [--screening S]...
+// --screening: the exponent of eqn 6's N (1 in the paper), one row (or fit) per value.
 // --charges-eta: rows for the charges method (Kim et al. 2007) at these eta, beside DBM's
 // row at each --eta: which charges eta gives DBM's statistics.
 // --fit: instead of the --axis rows, the base per cell at which the fast method's median
@@ -100,11 +101,19 @@ double fitAxis(const lt::Params& base, double dbmCells, int seeds) {
   return std::exp(0.5 * (lo + hi));
 }
 
+// ", screening s" where it is not eqn 6's 1.
+std::string screeningNote(double s) {
+  if (s == 1.0) return "";
+  char note[32];
+  std::snprintf(note, sizeof note, ", screening %g", s);
+  return note;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<int> grids;
-  std::vector<double> etas, axes, chargesEtas;
+  std::vector<double> etas, axes, chargesEtas, screenings;
   std::vector<int> lifetimes;
   int seeds = 20, dbmSeeds = 10, neighbourhood = 8;
   bool fit = false;
@@ -123,6 +132,8 @@ int main(int argc, char** argv) {
       etas.push_back(std::atof(v));
     else if (flag == "--axis")
       axes.push_back(std::atof(v));
+    else if (flag == "--screening")
+      screenings.push_back(std::atof(v));
     else if (flag == "--lifetime")
       lifetimes.push_back(std::atoi(v));
     else if (flag == "--seeds")
@@ -142,6 +153,7 @@ int main(int argc, char** argv) {
   if (etas.empty()) etas = {1, 2, 3};
   const bool calibrated = axes.empty();  // each row at calibratedAxisGrowth() of its grid and eta
   if (lifetimes.empty()) lifetimes = {lt::Params{}.lifetime};
+  if (screenings.empty()) screenings = {lt::Params{}.screening};
   std::printf("| grid | eta | method | setting | D | cells (median) | tips (median) | ms/bolt |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int n : grids)
@@ -157,14 +169,17 @@ int main(int argc, char** argv) {
         p.method = lt::Method::kDbm;
         const double dbmCells = row(n, eta, "dbm", "mgpcg", p, dbmSeeds);
         if (fit) {
-          lt::Params f = base;
-          f.lifetime = lifetimes.front();
-          const double axis = fitAxis(f, dbmCells, seeds);
-          f.axisGrowth = axis;
-          char setting[96];
-          std::snprintf(setting, sizeof setting, "fitted axis %.4f (ln %.4f), lifetime %d", axis, std::log(axis),
-                        f.lifetime);
-          row(n, eta, "fast", setting, f, seeds);
+          for (double sc : screenings) {
+            lt::Params f = base;
+            f.lifetime = lifetimes.front();
+            f.screening = sc;
+            const double axis = fitAxis(f, dbmCells, seeds);
+            f.axisGrowth = axis;
+            char setting[128];
+            std::snprintf(setting, sizeof setting, "fitted axis %.4f (ln %.4f), lifetime %d%s", axis, std::log(axis),
+                          f.lifetime, screeningNote(sc).c_str());
+            row(n, eta, "fast", setting, f, seeds);
+          }
           continue;
         }
       }
@@ -179,13 +194,15 @@ int main(int argc, char** argv) {
       if (!chargesEtas.empty()) continue;
       if (calibrated) axes = {lt::calibratedAxisGrowth(base)};
       for (double a : axes)
-        for (int l : lifetimes) {
-          lt::Params p = base;
-          p.axisGrowth = a;
-          p.lifetime = l;
-          char setting[64];
-          std::snprintf(setting, sizeof setting, "axis %g, lifetime %d", a, l);
-          row(n, eta, "fast", setting, p, seeds);
-        }
+        for (int l : lifetimes)
+          for (double sc : screenings) {
+            lt::Params p = base;
+            p.axisGrowth = a;
+            p.lifetime = l;
+            p.screening = sc;
+            char setting[96];
+            std::snprintf(setting, sizeof setting, "axis %g, lifetime %d%s", a, l, screeningNote(sc).c_str());
+            row(n, eta, "fast", setting, p, seeds);
+          }
     }
 }

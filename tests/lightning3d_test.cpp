@@ -114,6 +114,36 @@ TEST(Lightning3d, SameRequestSameBolt) {
   }
 }
 
+// The boundary octree and its memo are cached per (size, obstacle set): a bolt grown on a warm
+// map (its memo partly filled by another seed's bolt) is the bolt grown on a fresh one.
+TEST(Lightning3d, CachedBoundaryOctreeGivesTheSameBolt) {
+  Params p = volume(16);
+  p.width = 37, p.height = 29, p.depth = 23;  // a size no other test uses: the first call builds
+  p.start = {18, 0, 11};
+  p.targets = {{18, 28, 11}};
+  p.obstacles.assign(size_t(37) * 29 * 23, 0);
+  p.obstacles[at(p, 5, 14, 5)] = 1;
+  p.seed = 5;
+  auto cold = grow(p);
+  ASSERT_TRUE(cold.ok());
+  EXPECT_EQ(cold.value().stats.counters.at("boundaryMapCached"), 0);
+  Params other = p;
+  other.seed = 6;
+  ASSERT_TRUE(grow(other).ok());
+  auto warm = grow(p);
+  ASSERT_TRUE(warm.ok());
+  EXPECT_EQ(warm.value().stats.counters.at("boundaryMapCached"), 1);
+  ASSERT_EQ(cold.value().nodes.size(), warm.value().nodes.size());
+  for (size_t i = 0; i < cold.value().nodes.size(); ++i) {
+    EXPECT_EQ(cold.value().nodes[i].cell, warm.value().nodes[i].cell);
+    EXPECT_EQ(cold.value().nodes[i].parent, warm.value().nodes[i].parent);
+  }
+  p.obstacles[at(p, 6, 14, 5)] = 1;  // another scene
+  auto moved = grow(p);
+  ASSERT_TRUE(moved.ok());
+  EXPECT_EQ(moved.value().stats.counters.at("boundaryMapCached"), 0);
+}
+
 TEST(Lightning3d, DbmSolveConvergesToTheLaplaceSolution) {
   // The 7-point problem of a bolt: MGPCG's relative residual meets the tolerance, and its
   // potential equals plain CG's to the tolerance's scale.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <queue>
@@ -121,14 +122,17 @@ double BoundaryMap::potential(int x, int y) const {
   return v;
 }
 
-std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
-                                                     bool* hit) {
-  // Least recently used first out, bounded in bytes (maps and their keys).
+std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
+                                      bool* hit, const std::function<std::shared_ptr<const void>()>& build,
+                                      size_t (*mapBytes)(const void*)) {
+  // Least recently used first out, bounded in bytes (maps and their keys); 2-D and 3-D maps
+  // share the budget.
   struct Entry {
-    int w, h;
+    int w, h, d;
     std::vector<uint8_t> obstacles;  // compared with memcmp: a millisecond at 4096^2
-    std::shared_ptr<const BoundaryMap> map;
-    size_t bytes() const { return obstacles.size() + map->bytes(); }
+    std::shared_ptr<const void> map;
+    size_t mapBytes;
+    size_t bytes() const { return obstacles.size() + mapBytes; }
   };
   static std::mutex mu;
   static std::list<Entry> lru;  // most recent first
@@ -136,7 +140,7 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
   {
     std::lock_guard<std::mutex> lock(mu);
     for (auto it = lru.begin(); it != lru.end(); ++it) {
-      if (it->w == width && it->h == height && it->obstacles == obstacles) {
+      if (it->w == width && it->h == height && it->d == depth && it->obstacles == obstacles) {
         lru.splice(lru.begin(), lru, it);
         if (hit) *hit = true;
         return lru.front().map;
@@ -144,8 +148,8 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
     }
   }
   if (hit) *hit = false;
-  auto map = std::make_shared<const BoundaryMap>(width, height, obstacles);  // built outside the lock
-  Entry entry{width, height, obstacles, map};
+  std::shared_ptr<const void> map = build();  // built outside the lock
+  Entry entry{width, height, depth, obstacles, map, mapBytes(map.get())};
   if (entry.bytes() > kBudgetBytes) return map;  // used by this request only
   std::lock_guard<std::mutex> lock(mu);
   lru.push_front(std::move(entry));
@@ -158,6 +162,14 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
       ++it;
   }
   return map;
+}
+
+std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
+                                                     bool* hit) {
+  return std::static_pointer_cast<const BoundaryMap>(cachedMap(
+      width, height, 0, obstacles, hit,
+      [&] { return std::make_shared<const BoundaryMap>(width, height, obstacles); },
+      [](const void* m) { return static_cast<const BoundaryMap*>(m)->bytes(); }));
 }
 
 bool lineOfSight(const Grid& g, Cell a, Cell b) {

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <new>
 #include <vector>
@@ -134,6 +135,12 @@ class BoundaryMap {
   std::unique_ptr<std::atomic<float>[]> memo_;  // 0 = not computed yet (a potential is > 0)
 };
 
+// The boundary maps of recent (size, obstacle set) pairs, 2-D (depth 0) and 3-D, kept within
+// 64 MB in all, least recently used first out: build() makes a missing one; *hit says whether
+// it was there.
+std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
+                                      bool* hit, const std::function<std::shared_ptr<const void>()>& build,
+                                      size_t (*mapBytes)(const void*));
 std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
                                                      bool* hit);
 
@@ -141,11 +148,15 @@ std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, cons
 // voxels. An octree of charge counts and centroids (blocks of 4^3 voxels and up) answers a
 // query in O(log n) blocks with the opening angle of the 2-D map; blocks nearer than two of
 // their sides are summed voxel by voxel. Memory: one byte per voxel of the padded grid and
-// 16 bytes per 4^3 block (about 1.3 bytes per voxel).
+// 16 bytes per 4^3 block (about 1.3 bytes per voxel), and on grids up to kMemoVoxels the
+// memo of 4 bytes per voxel (as BoundaryMap's: each voxel's value kept once computed, shared
+// by every request on a cached map; the value is then a float's whether it came from the memo
+// or not).
 class VolumeBoundary {
  public:
   VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles);
-  double potential(int x, int y, int z) const;
+  double potential(int x, int y, int z) const;  // thread-safe
+  static constexpr size_t kMemoVoxels = size_t(1) << 21;  // 128^3
   size_t bytes() const;
 
  private:
@@ -153,11 +164,17 @@ class VolumeBoundary {
     int w, h, d;              // blocks per side
     std::vector<float> count, cx, cy, cz;
   };
-  double visit(int level, int bx, int by, int bz, double px, double py, double pz) const;
+  double leaf(int bx, int by, int bz, double px, double py, double pz) const;
+  double open(int level, int bx, int by, int bz, double px, double py, double pz) const;
   int dw_, dh_, dd_;             // domain (grid + shell) size
   Zeroed<uint8_t> charge_;       // per domain voxel
   std::vector<Level> levels_;    // levels_[k]: blocks of 4 * 2^k voxels a side
+  int w_, h_;                    // grid width and height (the memo's rows)
+  size_t memoVoxels_ = 0;
+  std::unique_ptr<std::atomic<float>[]> memo_;  // 0 = not computed yet (a potential is > 0)
 };
+std::shared_ptr<const VolumeBoundary> cachedVolumeBoundary(int width, int height, int depth,
+                                                           const std::vector<uint8_t>& obstacles, bool* hit);
 
 bool lineOfSight(const Grid& g, Cell a, Cell b);
 // Turning points of a path (direction changes), ending with its last cell.

@@ -36,6 +36,7 @@ std::optional<Error> validate(const Params& p) {
     return invalid("/obstacles", p.depth ? "must have width*height*depth cells" : "must have width*height cells");
   if (!(p.eta >= 0.0 && p.eta <= 50.0)) return invalid("/eta", "must be in [0, 50]");
   if (!(p.axisGrowth >= 1.0 && p.axisGrowth <= 64.0)) return invalid("/axisGrowth", "must be in [1, 64]");
+  if (!(p.screening >= 0.0 && p.screening <= 8.0)) return invalid("/screening", "must be in [0, 8]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
@@ -103,17 +104,7 @@ class Grower {
   void expireCandidates();
   void logWeights(std::vector<double>& out);
   double fastLogStatic(const Candidate& c) const;
-  static double fastLogPhi(const Candidate& c) { return c.logStatic - logCount(c.neighbours); }
-  // log n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's 26-neighbourhood), looked
-  // up: the same values std::log gives.
-  static double logCount(int n) {
-    static const std::array<double, 27> table = [] {
-      std::array<double, 27> t{};
-      for (int i = 1; i < 27; ++i) t[size_t(i)] = std::log(double(i));
-      return t;
-    }();
-    return table[size_t(n)];
-  }
+  double fastLogPhi(const Candidate& c) const { return c.logStatic - logN_[size_t(c.neighbours)]; }
   void refreshFastWeight(Candidate& c);
   void restartFastWeights();
   size_t sampleFast();
@@ -141,10 +132,17 @@ class Grower {
   std::vector<Candidate> cands_;
   std::vector<float> boundaryMemo_;
   std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
-  std::unique_ptr<const detail::VolumeBoundary> volumeMap_;  // 3-D
+  std::shared_ptr<const detail::VolumeBoundary> volumeMap_;  // 3-D
   std::unique_ptr<detail::Potential> laplace_, reference_;
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
+  // kFast: screening * ln n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's
+  // 26-neighbourhood), looked up (screening 1: the values std::log gives).
+  const std::array<double, 27> logN_ = [s = p_.screening] {
+    std::array<double, 27> t{};
+    for (int i = 1; i < 27; ++i) t[size_t(i)] = s * std::log(double(i));
+    return t;
+  }();
   int step_ = 0;
   Cell anchor_, attractor_;    // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
   double weightRef_ = 0;       // kFast: weights are exp(eta * log Phi - weightRef_)
@@ -223,7 +221,7 @@ void Grower::expireCandidates() {
 }
 
 double Grower::boundary(Cell c) {
-  if (volumeMap_) return volumeMap_->potential(c.x, c.y, c.z);  // once per candidate: no memo
+  if (volumeMap_) return volumeMap_->potential(c.x, c.y, c.z);  // memoised in the map (up to 128^3)
   float& memo = boundaryMemo_[g_.index(c)];
   if (memo == 0.0f) memo = float(boundaryMap_->potential(c.x, c.y));
   return memo;
@@ -560,8 +558,10 @@ std::optional<Error> Grower::run() {
   }
   if (p_.method == Method::kFast && p_.depth) {
     Stopwatch w;
-    volumeMap_ = std::make_unique<detail::VolumeBoundary>(p_.width, p_.height, p_.depth, p_.obstacles);
+    bool hit = false;
+    volumeMap_ = detail::cachedVolumeBoundary(p_.width, p_.height, p_.depth, p_.obstacles, &hit);
     bolt_.stats.counters["boundaryMapMs"] = w.ms();
+    bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
   } else if (p_.method == Method::kFast) {
     Stopwatch w;
     bool hit = false;

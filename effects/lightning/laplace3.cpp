@@ -17,6 +17,15 @@ std::array<ptrdiff_t, 27> offsets(size_t sx, size_t sy) {
   return o;
 }
 
+// sum_k a[k] * centre[off[k]] over the 27-point stencil, in nine row sums added pairwise: a
+// 27-long chain of dependent additions made the coarse sweeps wait on the adder, not memory.
+inline double stencilDot(const std::array<double, 27>& a, const double* centre, const std::array<ptrdiff_t, 27>& off) {
+  double row[9];
+  for (size_t j = 0; j < 9; ++j)
+    row[j] = a[3 * j] * centre[off[3 * j]] + a[3 * j + 1] * centre[off[3 * j + 1]] + a[3 * j + 2] * centre[off[3 * j + 2]];
+  return (((row[0] + row[1]) + (row[2] + row[3])) + ((row[4] + row[5]) + (row[6] + row[7]))) + row[8];
+}
+
 }  // namespace
 
 Laplace3::Laplace3(int width, int height, int depth)
@@ -37,15 +46,31 @@ Laplace3::Laplace3(int width, int height, int depth)
     l.sx = size_t(w) + 2, l.sy = size_t(h) + 2;
     const size_t m = l.sx * l.sy * (size_t(d) + 2);
     l.a.assign(m, {});
+    l.row.assign(m, nullptr);
     for (auto* v : {&l.invDiag, &l.e, &l.r, &l.res}) v->assign(m, 0.0);
     levels_.push_back(std::move(l));
+  }
+  for (Level& l : levels_)
+    for (size_t i = 0; i < l.a.size(); ++i) l.row[i] = &l.a[i];
+  dirty_ = {0, 0, 0, w_ - 1, h_ - 1, d_ - 1};
+  findInteriorRows();
+}
+
+// Each coarse level's interior row: the row of its centre voxel while nothing is fixed. Rows
+// are computed the same way everywhere, so a row far from fixed voxels and borders equals it
+// bit for bit, and galerkinRow() points such rows at it.
+void Laplace3::findInteriorRows() {
+  updateCoarse();
+  for (size_t k = 1; k < levels_.size(); ++k) {
+    Level& l = levels_[k];
+    l.interior = l.a[(size_t(l.d / 2 + 1) * l.sy + size_t(l.h / 2 + 1)) * l.sx + size_t(l.w / 2 + 1)];
   }
   dirty_ = {0, 0, 0, w_ - 1, h_ - 1, d_ - 1};
 }
 
 size_t Laplace3::bytes() const {
   size_t b = phi_.size() * (8 * sizeof(double) + 1);
-  for (const Level& l : levels_) b += l.a.size() * (sizeof(l.a[0]) + 3 * sizeof(double));
+  for (const Level& l : levels_) b += l.a.size() * (sizeof(l.a[0]) + sizeof(l.row[0]) + 4 * sizeof(double));
   return b;
 }
 
@@ -87,7 +112,7 @@ void Laplace3::galerkinRow(size_t k, int cx, int cy, int cz) {
           const int ox = o % 3 - 1, oy = o / 3 % 3 - 1, oz = o / 9 - 1;
           double a;
           if (f) {
-            a = f->a[fi][size_t(o)];
+            a = (*f->row[fi])[size_t(o)];
           } else {  // the fine 7-point operator on unknowns
             if (!unknown_[fi] || std::abs(ox) + std::abs(oy) + std::abs(oz) > 1) continue;
             const ptrdiff_t off = ptrdiff_t(ox) + ptrdiff_t(oy) * ptrdiff_t(fsx) + ptrdiff_t(oz) * ptrdiff_t(fsx * fsy);
@@ -109,6 +134,7 @@ void Laplace3::galerkinRow(size_t k, int cx, int cy, int cz) {
       }
   const size_t ci = (size_t(cz + 1) * c.sy + size_t(cy + 1)) * c.sx + size_t(cx + 1);
   c.a[ci] = row;
+  c.row[ci] = row == c.interior ? &c.interior : &c.a[ci];
   c.invDiag[ci] = row[13] > 0 ? 1.0 / row[13] : 0.0;
 }
 
@@ -146,7 +172,9 @@ void Laplace3::smoothFine(bool forward, bool fromZero) {
         }
         for (int x = (y + z + colour) & 1; x < w_; x += 2) {
           const size_t i = row + size_t(x);
-          e[i] = mask_[i] * (1.0 / 6.0) * (r_[i] + e[i - 1] + e[i + 1] + e[i - sx_] + e[i + sx_] + e[i - slab] + e[i + slab]);
+          // Added pairwise, not as one chain of six dependent additions.
+          e[i] = mask_[i] * (1.0 / 6.0) *
+                 ((r_[i] + (e[i - 1] + e[i + 1])) + ((e[i - sx_] + e[i + sx_]) + (e[i - slab] + e[i + slab])));
         }
       }
   }
@@ -158,12 +186,9 @@ void Laplace3::smoothCoarse(Level& l, bool forward) {
   const auto off = offsets(l.sx, l.sy);
   double* e = l.e.data();
   auto update = [&](size_t i) {
-    const auto& a = l.a[i];
-    const double* centre = e + i;
-    double sum = 0;  // all 27 terms, the centre's added back: no branch in the loop
-#pragma GCC unroll 27
-    for (size_t k = 0; k < 27; ++k) sum += a[k] * centre[off[k]];
-    e[i] = (l.r[i] - sum + a[13] * e[i]) * l.invDiag[i];
+    const auto& a = *l.row[i];
+    // All 27 terms, the centre's added back: no branch in the loop.
+    e[i] = (l.r[i] - stencilDot(a, e + i, off) + a[13] * e[i]) * l.invDiag[i];
   };
   if (forward) {
     for (int z = 0; z < l.d; ++z)
@@ -227,9 +252,7 @@ void Laplace3::vcycle(size_t k) {
         for (int y = 0; y < l.h; ++y)
           for (int x = 0; x < l.w; ++x) {
             const size_t i = (size_t(z + 1) * l.sy + size_t(y + 1)) * l.sx + size_t(x + 1);
-            double s = l.r[i];
-            for (size_t o = 0; o < 27; ++o) s -= l.a[i][o] * l.e[size_t(ptrdiff_t(i) + off[o])];
-            res[i] = s;
+            res[i] = l.r[i] - stencilDot(*l.row[i], l.e.data() + i, off);
           }
     }
     // Restriction P^T: full weighting over the 3x3x3 fine voxels around 2J+1, separably

@@ -1,5 +1,6 @@
 // Seed 002 eqn 4 in 3-D: the boundary potential of the shell around a voxel grid and of its
 // obstacle voxels, by a Barnes-Hut octree (grid.h: VolumeBoundary).
+#include <algorithm>
 #include <cmath>
 
 #include "grid.h"
@@ -13,7 +14,7 @@ constexpr int kLeaf = 4;        // voxels per side of the smallest stored block
 }  // namespace
 
 VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles)
-    : dw_(width + 2), dh_(height + 2), dd_(depth + 2) {
+    : dw_(width + 2), dh_(height + 2), dd_(depth + 2), w_(width), h_(height) {
   charge_.reset(size_t(dw_) * size_t(dh_) * size_t(dd_));
   Level l{(dw_ + kLeaf - 1) / kLeaf, (dh_ + kLeaf - 1) / kLeaf, (dd_ + kLeaf - 1) / kLeaf, {}, {}, {}, {}};
   const size_t n = size_t(l.w) * size_t(l.h) * size_t(l.d);
@@ -66,46 +67,92 @@ VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vect
       if (c.count[b] > 0) c.cx[b] /= c.count[b], c.cy[b] /= c.count[b], c.cz[b] /= c.count[b];
     levels_.push_back(std::move(c));
   }
+  if (size_t(width) * size_t(height) * size_t(depth) <= kMemoVoxels) {
+    memoVoxels_ = size_t(width) * size_t(height) * size_t(depth);
+    memo_.reset(new std::atomic<float>[memoVoxels_]());
+  }
 }
 
-// Sum of 1/r from the charges of block (bx, by, bz) of `level` to the point (domain coordinates).
-double VolumeBoundary::visit(int level, int bx, int by, int bz, double px, double py, double pz) const {
-  const Level& l = levels_[size_t(level)];
-  if (bx >= l.w || by >= l.h || bz >= l.d) return 0.0;
-  const size_t i = (size_t(bz) * size_t(l.h) + size_t(by)) * size_t(l.w) + size_t(bx);
-  const double count = l.count[i];
-  if (count == 0) return 0.0;
-  const double side = double(kLeaf << level);
-  const double r = std::sqrt((l.cx[i] - px) * (l.cx[i] - px) + (l.cy[i] - py) * (l.cy[i] - py) +
-                             (l.cz[i] - pz) * (l.cz[i] - pz));
-  if (side < kTheta * r) return count / r;
-  if (level == 0) {  // voxel by voxel
-    double sum = 0;
-    const int x0 = bx * kLeaf, y0 = by * kLeaf, z0 = bz * kLeaf;
-    for (int z = z0; z < std::min(z0 + kLeaf, dd_); ++z)
-      for (int y = y0; y < std::min(y0 + kLeaf, dh_); ++y)
-        for (int x = x0; x < std::min(x0 + kLeaf, dw_); ++x)
-          if (charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)]) {
-            const double dx = x + 0.5 - px, dy = y + 0.5 - py, dz = z + 0.5 - pz;
-            sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
-          }
-    return sum;
+// Sum of 1/r from the charges of one leaf block (voxel by voxel) to the point.
+double VolumeBoundary::leaf(int bx, int by, int bz, double px, double py, double pz) const {
+  double sum = 0;
+  const int x0 = bx * kLeaf, y0 = by * kLeaf, z0 = bz * kLeaf;
+  for (int z = z0; z < std::min(z0 + kLeaf, dd_); ++z)
+    for (int y = y0; y < std::min(y0 + kLeaf, dh_); ++y)
+      for (int x = x0; x < std::min(x0 + kLeaf, dw_); ++x)
+        if (charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)]) {
+          const double dx = x + 0.5 - px, dy = y + 0.5 - py, dz = z + 0.5 - pz;
+          sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+        }
+  return sum;
+}
+
+// Sum of 1/r from the charges of block (bx, by, bz) of `level` to the point (domain
+// coordinates), the block known to hold charge and to be too near to count as one: its eight
+// children's distances are taken first (independent square roots, which pipeline), then each
+// child counts as one charge or is opened, and the terms are added in child order.
+double VolumeBoundary::open(int level, int bx, int by, int bz, double px, double py, double pz) const {
+  const Level& l = levels_[size_t(level - 1)];
+  const double side = double(kLeaf << (level - 1));
+  size_t idx[8];
+  bool present[8];
+  double r[8];
+  for (int c = 0; c < 8; ++c) {
+    const int x = 2 * bx + (c & 1), y = 2 * by + ((c >> 1) & 1), z = 2 * bz + (c >> 2);
+    present[c] = x < l.w && y < l.h && z < l.d;
+    idx[c] = present[c] ? (size_t(z) * size_t(l.h) + size_t(y)) * size_t(l.w) + size_t(x) : 0;
+    present[c] = present[c] && l.count[idx[c]] != 0;
+    const size_t i = idx[c];
+    r[c] = std::sqrt((l.cx[i] - px) * (l.cx[i] - px) + (l.cy[i] - py) * (l.cy[i] - py) + (l.cz[i] - pz) * (l.cz[i] - pz));
   }
   double sum = 0;
-  for (int c = 0; c < 8; ++c)
-    sum += visit(level - 1, 2 * bx + (c & 1), 2 * by + ((c >> 1) & 1), 2 * bz + (c >> 2), px, py, pz);
+  for (int c = 0; c < 8; ++c) {
+    if (!present[c]) continue;
+    const int x = 2 * bx + (c & 1), y = 2 * by + ((c >> 1) & 1), z = 2 * bz + (c >> 2);
+    if (side < kTheta * r[c])
+      sum += double(l.count[idx[c]]) / r[c];
+    else
+      sum += level == 1 ? leaf(x, y, z, px, py, pz) : open(level - 1, x, y, z, px, py, pz);
+  }
   return sum;
 }
 
 double VolumeBoundary::potential(int x, int y, int z) const {
+  const size_t m = (size_t(z) * size_t(h_) + size_t(y)) * size_t(w_) + size_t(x);
+  if (memo_)
+    if (float v = memo_[m].load(std::memory_order_relaxed); v != 0.0f) return v;
   // Grid voxel (x, y, z) is domain voxel (x + 1, y + 1, z + 1); its centre is + 0.5.
-  return visit(int(levels_.size()) - 1, 0, 0, 0, x + 1.5, y + 1.5, z + 1.5);
+  const double px = x + 1.5, py = y + 1.5, pz = z + 1.5;
+  const int top = int(levels_.size()) - 1;
+  const Level& l = levels_.back();
+  double v = 0.0;
+  if (l.count[0] != 0) {
+    const double r = std::sqrt((l.cx[0] - px) * (l.cx[0] - px) + (l.cy[0] - py) * (l.cy[0] - py) +
+                               (l.cz[0] - pz) * (l.cz[0] - pz));
+    if (double(kLeaf << top) < kTheta * r)
+      v = l.count[0] / r;
+    else
+      v = top == 0 ? leaf(0, 0, 0, px, py, pz) : open(top, 0, 0, 0, px, py, pz);
+  }
+  if (memo_) {
+    memo_[m].store(float(v), std::memory_order_relaxed);
+    return float(v);  // the same value whether it came from the memo or not
+  }
+  return v;
 }
 
 size_t VolumeBoundary::bytes() const {
   size_t b = size_t(dw_) * size_t(dh_) * size_t(dd_);
   for (const Level& l : levels_) b += l.count.size() * 4 * sizeof(float);
-  return b;
+  return b + memoVoxels_ * sizeof(float);
+}
+
+std::shared_ptr<const VolumeBoundary> cachedVolumeBoundary(int width, int height, int depth,
+                                                           const std::vector<uint8_t>& obstacles, bool* hit) {
+  return std::static_pointer_cast<const VolumeBoundary>(cachedMap(
+      width, height, depth, obstacles, hit,
+      [&] { return std::make_shared<const VolumeBoundary>(width, height, depth, obstacles); },
+      [](const void* m) { return static_cast<const VolumeBoundary*>(m)->bytes(); }));
 }
 
 }  // namespace detail

@@ -80,6 +80,7 @@ struct Params {
   double axisGrowth = kCalibratedAxisGrowth8;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]
                                                // (calibratedAxisGrowth() with lifetime 0 meets
                                                // DBM's D, cells and tips)
+  double screening = 1.0;   // kFast: exponent of eqn 6's N (Phi ~ 1 / N^screening), in [0, 8]
   int neighbourhood = 8;    // 8 (diagonals too) or 4: which cells are candidates, which
                             // touch a target, how the A* guide moves, N's range (eqn 6);
                             // in 3-D 26 (faces, edges and corners) or 6 (faces)
