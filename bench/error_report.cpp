@@ -4,7 +4,7 @@
 //   <out>/error-vs-time.json        the same numbers, for tests and tools
 //   <out>/error-vs-time/<name>.png  log-log plots drawn with gnuplot (Debian's gnuplot-nox)
 //
-//   build/bench/error_report [--quick] [--out DIR] [--no-plots] [--only lightning|fog|tangents|film]
+//   build/bench/error_report [--quick] [--out DIR] [--no-plots] [--only lightning|lightning3d|fog|tangents|film]
 // Default DIR is docs/. --quick is the reduced configuration the test suite runs. --only
 // measures one effect and replaces its sections in the existing report (the others keep the
 // numbers of the run that made them).
@@ -87,7 +87,7 @@ struct LightningSetting {
 double dimensionOf(const lt::Bolt& b, int n) {
   std::vector<lt::Cell> cells;
   for (const auto& node : b.nodes) cells.push_back(node.cell);
-  return lt::fractalDimension(cells, n, n);
+  return b.depth ? lt::fractalDimension(cells, n, n, n) : lt::fractalDimension(cells, n, n);
 }
 
 // Mean and sample standard deviation.
@@ -98,11 +98,14 @@ std::pair<double, double> meanSd(const std::vector<double>& v) {
   return {mean, std::sqrt(var)};
 }
 
+// The start-to-target layout of an n^2 grid or, with `volume`, an n^3 one.
+lt::Params layoutOf(int n, bool volume) { return volume ? fixtures::volumeLayout(n) : fixtures::lightningLayout(n); }
+
 // The settings of one grid and neighbourhood: the calibrated default, the paper's constants
-// and the curves through them (lifetime, eqn 8's base), charges, DBM's solver tolerances.
-std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood) {
+// and the curves through them (lifetime, eqn 8's base), charges (2-D), DBM's solver tolerances.
+std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, bool volume) {
   auto layout = [&] {
-    lt::Params p = fixtures::lightningLayout(n);
+    lt::Params p = layoutOf(n, volume);
     p.neighbourhood = hood;
     p.axisGrowth = lt::calibratedAxisGrowth(p);
     return p;
@@ -120,7 +123,7 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood) {
     p.axisGrowth = growth;
     settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3), p});
   }
-  if (n <= 128 || hood == 8) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2
+  if (!volume && (n <= 128 || hood == 8)) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2
     lt::Params c = layout();
     c.method = lt::Method::kCharges;
     settings.push_back({"charges", "charges", c});
@@ -133,7 +136,7 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood) {
   else
     tolerances = {1e-2, 1e-4};
   for (lt::Solver solver : {lt::Solver::kMgpcg, lt::Solver::kCg}) {
-    if (solver == lt::Solver::kCg && (quick || n > 64)) continue;
+    if (solver == lt::Solver::kCg && (quick || volume || n > 64)) continue;
     for (double tol : tolerances) {
       lt::Params p = layout();
       p.method = lt::Method::kDbm;
@@ -148,12 +151,12 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood) {
 // Every setting over 10 seeds (3 in the quick run): D against DBM's (tolerance 1e-8, the
 // same neighbourhood, 10 seeds) and, up to 128^2, the mean per-step total-variation distance
 // (its reference solve every step costs seconds per 256^2 bolt).
-void lightningRows(bool quick, int n, int hood, Section& tv, Section& fd) {
+void lightningRows(bool quick, int n, int hood, bool volume, Section& tv, Section& fd) {
   const int seeds = quick ? 3 : 10;
-  const std::string grid = std::to_string(n) + "², " + std::to_string(hood) + "-nbhd";
+  const std::string grid = std::to_string(n) + (volume ? "³, " : "², ") + std::to_string(hood) + "-nbhd";
   std::vector<double> refD;
   {
-    lt::Params p = fixtures::lightningLayout(n);
+    lt::Params p = layoutOf(n, volume);
     p.neighbourhood = hood;
     p.method = lt::Method::kDbm;
     p.tolerance = 1e-8;
@@ -164,7 +167,7 @@ void lightningRows(bool quick, int n, int hood, Section& tv, Section& fd) {
     }
   }
   const auto [dRef, dRefSd] = meanSd(refD);
-  for (const auto& s : lightningSettings(quick, n, hood)) {
+  for (const auto& s : lightningSettings(quick, n, hood, volume)) {
     std::vector<double> times, dims, tvs;
     for (int seed = 1; seed <= seeds; ++seed) {
       lt::Params p = s.params;
@@ -214,7 +217,32 @@ void lightning(bool quick, Section& tv, Section& fd) {
         {}};
   const std::vector<int> sizes = quick ? std::vector<int>{32} : std::vector<int>{64, 128, 256};
   for (int n : sizes)
-    for (int hood : {8, 4}) lightningRows(quick, n, hood, tv, fd);
+    for (int hood : {8, 4}) lightningRows(quick, n, hood, false, tv, fd);
+}
+
+// The same two sections for 3-D grids (26-neighbourhood): 32^3 (16^3 in the quick run).
+void lightning3d(bool quick, Section& tv, Section& fd) {
+  tv = {
+      "lightning3d-tv",
+      "Lightning in 3-D: per-step candidate distribution against the converged Laplace solution",
+      "the 3-D DBM distribution from a converged solve (7-point Laplacian, MGPCG, relative residual 1e-10) on the "
+      "same bolt state, every step",
+      "mean total-variation distance per step",
+      "ms per bolt (median)",
+      "setting",
+      "sd over seeds",
+      {},
+      {}};
+  fd = {"lightning3d-fd",
+        "Lightning in 3-D: fractal dimension against DBM",
+        "mean box-counting dimension D_ref of 3-D DBM (MGPCG, tolerance 1e-8) at the same size and seeds",
+        "abs(mean D − D_ref)",
+        "ms per bolt (median)",
+        "setting",
+        "mean D +- sd",
+        {},
+        {}};
+  lightningRows(quick, quick ? 16 : 32, 26, true, tv, fd);
 }
 
 // ---- fog --------------------------------------------------------------------------------------
@@ -392,14 +420,14 @@ void conclude(std::vector<Section>& sections) {
     auto show = [&](const Point& p) {
       return p.series + " " + p.setting + " (" + fmt(p.ms * s.timeScale) + unit + ", error " + fmt(p.error) + ")";
     };
-    if (s.id == "lightning-tv") {
+    if (s.id == "lightning-tv" || s.id == "lightning3d-tv") {
       const Point* good = fastestWithin(s, 0.05);
       const Point* fast = fastestWithin(s, 1.0, "fast paper");
       if (good && fast)
         c << "Fastest setting within a TV distance of 0.05 of the converged distribution: " << show(*good)
           << "; the paper's fast method costs " << fmt(fast->ms) << " ms but its distribution is far from DBM's (TV "
           << fmt(fast->error) << "): it is a different growth law, not an approximation that converges.";
-    } else if (s.id == "lightning-fd") {
+    } else if (s.id == "lightning-fd" || s.id == "lightning3d-fd") {
       const Point* best = nullptr;
       for (const auto& p : s.points)
         if (p.ms > 0 && p.series.rfind("dbm", 0) != 0 && (!best || p.error < best->error)) best = &p;
@@ -587,7 +615,7 @@ int main(int argc, char** argv) {
   bool quick = false, plots = true;
   fs::path out = "docs";
   std::string only;  // one effect's sections, spliced into the existing report
-  const std::vector<std::string> effects = {"lightning", "fog", "tangents", "film"};
+  const std::vector<std::string> effects = {"lightning", "lightning3d", "fog", "tangents", "film"};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--quick")
@@ -599,7 +627,7 @@ int main(int argc, char** argv) {
     else if (a == "--only" && i + 1 < argc && std::count(effects.begin(), effects.end(), argv[i + 1]))
       only = argv[++i];
     else {
-      std::fprintf(stderr, "usage: error_report [--quick] [--out DIR] [--no-plots] [--only lightning|fog|tangents|film]\n");
+      std::fprintf(stderr, "usage: error_report [--quick] [--out DIR] [--no-plots] [--only lightning|lightning3d|fog|tangents|film]\n");
       return 2;
     }
   }
@@ -622,6 +650,12 @@ int main(int argc, char** argv) {
     step("lightning");
     Section tv, fd;
     lightning(quick, tv, fd);
+    sections.insert(sections.end(), {tv, fd});
+  }
+  if (wanted("lightning3d")) {
+    step("lightning in 3-D");
+    Section tv, fd;
+    lightning3d(quick, tv, fd);
     sections.insert(sections.end(), {tv, fd});
   }
   if (wanted("fog")) {

@@ -41,7 +41,8 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
   ASSERT_TRUE(fs::exists(out / "error-vs-time.md"));
   std::ifstream in(out / "error-vs-time.json");
   const json r = json::parse(in);
-  for (const char* id : {"lightning-tv", "lightning-fd", "fog-tables", "fog-height-march", "tangents", "thin-film"}) {
+  for (const char* id : {"lightning-tv", "lightning-fd", "lightning3d-tv", "lightning3d-fd", "fog-tables",
+                         "fog-height-march", "tangents", "thin-film"}) {
     SCOPED_TRACE(id);
     ASSERT_TRUE(r.contains(id));
     EXPECT_FALSE(r[id]["conclusion"].get<std::string>().empty());
@@ -57,7 +58,10 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
     EXPECT_EQ(errorsOf(r["lightning-fd"], "fast calibrated " + grid).size(), 1u) << grid;
     EXPECT_EQ(errorsOf(r["lightning-fd"], "fast paper " + grid, "variant paper").size(), 1u) << grid;
   }
-  for (const char* id : {"lightning-tv", "lightning-fd"})
+  // 3-D: the same, on 16^3 in the 26-neighbourhood.
+  expectShrinks(errorsOf(r["lightning3d-tv"], "dbm-mgpcg 16³, 26-nbhd"), "3-D dbm TV over tolerance");
+  EXPECT_EQ(errorsOf(r["lightning3d-fd"], "fast calibrated 16³, 26-nbhd").size(), 1u);
+  for (const char* id : {"lightning-tv", "lightning-fd", "lightning3d-tv", "lightning3d-fd"})
     for (const auto& p : r[id]["points"]) EXPECT_NE(p["note"].get<std::string>().find("(3 seeds)"), std::string::npos) << p;
   // Fog tables: more entries -> smaller interpolation error, for every type.
   for (const char* type :
