@@ -6,7 +6,8 @@
 //
 //   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
 //                         [--seeds S] [--dbm-seeds S] [--neighbourhood 4|8] [--fit]
-//                         [--charges-eta E]... [--screening S]...
+//                         [--charges-eta E]... [--screening S]... [--volume]
+// --volume: N x N x N grids (neighbourhood 26 unless given; 6 is the other 3-D one).
 // --screening: the exponent of eqn 6's N (1 in the paper), one row (or fit) per value.
 // --charges-eta: rows for the charges method (Kim et al. 2007) at these eta, beside DBM's
 // row at each --eta: which charges eta gives DBM's statistics.
@@ -48,7 +49,8 @@ Sample measure(const lt::Params& p) {
     if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
     cells.push_back(n.cell);
   }
-  return {lt::fractalDimension(cells, p.width, p.height), double(b.nodes.size()),
+  return {p.depth ? lt::fractalDimension(cells, p.width, p.height, p.depth) : lt::fractalDimension(cells, p.width, p.height),
+          double(b.nodes.size()),
           double(std::count(hasChild.begin(), hasChild.end(), 0)), ms};
 }
 
@@ -58,7 +60,7 @@ double median(std::vector<double> v) {
 }
 
 // Prints one table row over `seeds` bolts; returns their median cells.
-double row(int n, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
+double row(const std::string& grid, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
   std::vector<double> d, cells, tips;
   double ms = 0;
   for (int s = 1; s <= seeds; ++s) {
@@ -73,7 +75,7 @@ double row(int n, double eta, const char* method, const std::string& setting, co
   double mean = 0, var = 0;
   for (double v : d) mean += v / double(d.size());
   for (double v : d) var += (v - mean) * (v - mean) / std::max<double>(1, double(d.size()) - 1);
-  std::printf("| %d | %g | %s | %s | %.3f ± %.3f | %.0f | %.0f | %.2f |\n", n, eta, method, setting.c_str(), mean,
+  std::printf("| %s | %g | %s | %s | %.3f ± %.3f | %.0f | %.0f | %.2f |\n", grid.c_str(), eta, method, setting.c_str(), mean,
               std::sqrt(var), median(cells), median(tips), ms / seeds);
   std::fflush(stdout);
   return median(cells);
@@ -115,12 +117,12 @@ int main(int argc, char** argv) {
   std::vector<int> grids;
   std::vector<double> etas, axes, chargesEtas, screenings;
   std::vector<int> lifetimes;
-  int seeds = 20, dbmSeeds = 10, neighbourhood = 8;
-  bool fit = false;
+  int seeds = 20, dbmSeeds = 10, neighbourhood = 0;  // 0: 8 in 2-D, 26 in 3-D
+  bool fit = false, volume = false;
   for (int i = 1; i < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--fit") {
-      fit = true;
+    if (flag == "--fit" || flag == "--volume") {
+      (flag == "--fit" ? fit : volume) = true;
       --i;
       continue;
     }
@@ -158,16 +160,21 @@ int main(int argc, char** argv) {
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int n : grids)
     for (double eta : etas) {
+      const std::string grid = std::to_string(n) + (volume ? "³" : "");
       lt::Params base;
       base.width = base.height = n;
       base.start = {n / 2, 0};
       base.targets = {{n / 2, n - 1}};
+      if (volume) {  // n^3, start at the top face's centre, target at the bottom face's
+        base.depth = n;
+        base.start.z = base.targets[0].z = n / 2;
+      }
       base.eta = eta;
-      base.neighbourhood = neighbourhood;
+      base.neighbourhood = neighbourhood ? neighbourhood : volume ? 26 : 8;
       if (dbmSeeds > 0) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;
-        const double dbmCells = row(n, eta, "dbm", "mgpcg", p, dbmSeeds);
+        const double dbmCells = row(grid, eta, "dbm", "mgpcg", p, dbmSeeds);
         if (fit) {
           for (double sc : screenings) {
             lt::Params f = base;
@@ -178,7 +185,7 @@ int main(int argc, char** argv) {
             char setting[128];
             std::snprintf(setting, sizeof setting, "fitted axis %.4f (ln %.4f), lifetime %d%s", axis, std::log(axis),
                           f.lifetime, screeningNote(sc).c_str());
-            row(n, eta, "fast", setting, f, seeds);
+            row(grid, eta, "fast", setting, f, seeds);
           }
           continue;
         }
@@ -189,7 +196,7 @@ int main(int argc, char** argv) {
         p.eta = ce;
         char setting[64];
         std::snprintf(setting, sizeof setting, "charges eta %g", ce);
-        row(n, eta, "charges", setting, p, seeds);
+        row(grid, eta, "charges", setting, p, seeds);
       }
       if (!chargesEtas.empty()) continue;
       if (calibrated) axes = {lt::calibratedAxisGrowth(base)};
@@ -202,7 +209,7 @@ int main(int argc, char** argv) {
             p.screening = sc;
             char setting[96];
             std::snprintf(setting, sizeof setting, "axis %g, lifetime %d%s", a, l, screeningNote(sc).c_str());
-            row(n, eta, "fast", setting, p, seeds);
+            row(grid, eta, "fast", setting, p, seeds);
           }
     }
 }

@@ -49,6 +49,11 @@ std::optional<Error> validate(const Params& p) {
 }
 
 double calibratedAxisGrowth(const Params& p) {
+  if (p.depth) {  // docs/lightning-calibration.md section 10
+    const double longest = std::max({3, p.width, p.height, p.depth});
+    return p.neighbourhood == 6 ? std::exp(0.32 * std::pow(32.0 / longest, 0.55))
+                                : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
+  }
   if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
   const double longer = std::max(3, std::max(p.width, p.height));
   return std::exp((0.2 + 0.025 * std::min(p.eta, 8.0)) * std::pow(128.0 / longer, 0.35));
