@@ -58,13 +58,16 @@ void fill(const Fog& fog, double cameraHeight, Table& t) {
     for (size_t i = 0; i < t.width; ++i) {
       const size_t e = j * t.width + i;
       const double d = distAt(t, double(i));
-      if (!rowDone) t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
       if (fog.directional) t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, d));
-      if (!rgb) continue;
-      const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
+      if (!rgb) {
+        if (!rowDone) t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
+        continue;
+      }
+      const Sample s = sampleAt(fog, cameraHeight, dirY, d);
+      t.factor[e] = static_cast<float>(s.factor);
       for (int c = 0; c < 3; ++c) {
-        t.transmittanceRgb[3 * e + size_t(c)] = static_cast<float>(tr[c]);
-        t.scatteredRgb[3 * e + size_t(c)] = static_cast<float>(sc[c]);
+        t.transmittanceRgb[3 * e + size_t(c)] = static_cast<float>(s.transmittance[c]);
+        t.scatteredRgb[3 * e + size_t(c)] = static_cast<float>(s.scattered[c]);
       }
     }
   }
