@@ -515,6 +515,35 @@ TEST(Fog, AtmosphericPerChannel) {
       EXPECT_EQ(s.transmittance, transmittance(*fog, 0, 0, d)) << d;
       EXPECT_EQ(s.scattered, scattered(*fog, 0, 0, d)) << d;
     }
+  // Large tables (filled by a recurrence along the row) hold sampleAt's values to within one
+  // unit in the last place of the stored float, through the start, the opacity cap and the cutoff.
+  {
+    TableOptions big;
+    big.size = 4096;
+    auto tb = buildTable(f, big);
+    ASSERT_TRUE(tb.ok());
+    const Table& tab = tb.value();
+    auto ulp = [](double x) {
+      const float v = static_cast<float>(x);
+      return double(std::nextafter(v, INFINITY) - v);
+    };
+    size_t off = 0;
+    for (size_t i = 0; i < tab.width; ++i) {
+      const double d = i + 1 == tab.width ? tab.rangeEnd
+                                          : tab.rangeStart + (tab.rangeEnd - tab.rangeStart) * double(i) / double(tab.width - 1);
+      const Sample s = sampleAt(f, 0, 0, d);
+      EXPECT_LE(std::fabs(tab.factor[i] - static_cast<float>(s.factor)), ulp(s.factor)) << d;
+      off += tab.factor[i] != static_cast<float>(s.factor);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(std::fabs(tab.transmittanceRgb[3 * i + size_t(c)] - static_cast<float>(s.transmittance[c])),
+                  ulp(s.transmittance[c]))
+            << d;
+        EXPECT_LE(std::fabs(tab.scatteredRgb[3 * i + size_t(c)] - static_cast<float>(s.scattered[c])), ulp(s.scattered[c]))
+            << d;
+      }
+    }
+    EXPECT_LE(off, tab.width / 100) << "entries one float step off";
+  }
   // Where the last varying channel completes: ln 255 over the smallest positive coefficient.
   Fog g = make(FogType::kAtmospheric);
   g.extinction = {0, 0.02, 0.1};
