@@ -216,23 +216,6 @@ glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distanc
   return (1.0 - channelsLimited(fog, fog.inscattering, distance)) * fog.color;
 }
 
-Sample sampleAt(const Fog& fog, double originY, double dirY, double distance) {
-  if (fog.type != FogType::kAtmospheric) {
-    const double f = factorAtElevation(fog, originY, dirY, distance);
-    return {f, glm::dvec3(f), (1.0 - f) * fog.color};
-  }
-  // modeFactor's mean and channelsLimited's channels from the same exponentials.
-  const double d = std::max(0.0, distance - fog.startDistance);
-  double sum = 0.0;
-  glm::dvec3 t;
-  for (int c = 0; c < 3; ++c) {
-    const double e = std::exp(-mulZero(fog.extinction[c], d));
-    sum += e;
-    t[c] = engineLimits(fog, distance, e);
-  }
-  return {engineLimits(fog, distance, sum / 3.0), t, scattered(fog, originY, dirY, distance)};
-}
-
 double inscatterWeight(const Fog& fog, double originY, double dirY, double distance) {
   if (!fog.directional) return 0.0;
   Fog beyond = fog;  // the same fog, over the ray's part where the glow starts

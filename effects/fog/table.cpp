@@ -49,10 +49,11 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table
 // One row of an ATMOSPHERIC table (f, T and S per channel; no dependence on elevation). Each
 // channel's e^{-k d} over the evenly spaced distances follows e_{i+1} = e_i r, r = e^{-k dt},
 // from an exponential at the first distance past the start and again at the last entry: two
-// multiplications per channel and entry instead of an exponential. The values are sampleAt's
-// up to rounding: over 4096 entries the relative drift stays under 1e-12, far below a float's
-// 6e-8, so the stored floats agree with it to the last bit or one unit in it. Ranges that are
-// not finite take sampleAt per entry (returns false).
+// multiplications per channel and entry instead of an exponential. The values are those of
+// factorAtElevation, transmittance and scattered up to rounding: over 4096 entries the
+// relative drift stays under 1e-12, far below a float's 6e-8, so the stored floats agree with
+// them to the last bit or one unit in it. Ranges that are not finite take the per-entry
+// functions (returns false).
 bool fillAtmosphericRow(const Fog& fog, Table& t, size_t j) {
   const size_t w = t.width;
   if (w < 2 || !std::isfinite(t.rangeStart) || !std::isfinite(t.rangeEnd) || !(t.rangeEnd > t.rangeStart)) return false;
@@ -105,15 +106,12 @@ void fill(const Fog& fog, double cameraHeight, Table& t) {
       const double d = distAt(t, double(i));
       if (fog.directional) t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, d));
       if (rowDone) continue;
-      if (!rgb) {
-        t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
-        continue;
-      }
-      const Sample s = sampleAt(fog, cameraHeight, dirY, d);
-      t.factor[e] = static_cast<float>(s.factor);
+      t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
+      if (!rgb) continue;
+      const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
       for (int c = 0; c < 3; ++c) {
-        t.transmittanceRgb[3 * e + size_t(c)] = static_cast<float>(s.transmittance[c]);
-        t.scatteredRgb[3 * e + size_t(c)] = static_cast<float>(s.scattered[c]);
+        t.transmittanceRgb[3 * e + size_t(c)] = static_cast<float>(tr[c]);
+        t.scatteredRgb[3 * e + size_t(c)] = static_cast<float>(sc[c]);
       }
     }
   }

@@ -164,8 +164,7 @@ class VolumeBoundary {
     int w, h, d;              // blocks per side
     std::vector<float> count, cx, cy, cz;
   };
-  double leaf(int bx, int by, int bz, double px, double py, double pz) const;
-  double open(int level, int bx, int by, int bz, double px, double py, double pz) const;
+  double visit(int level, int bx, int by, int bz, double px, double py, double pz) const;
   int dw_, dh_, dd_;             // domain (grid + shell) size
   Zeroed<uint8_t> charge_;       // per domain voxel
   std::vector<Level> levels_;    // levels_[k]: blocks of 4 * 2^k voxels a side

@@ -56,16 +56,17 @@ Laplace3::Laplace3(int width, int height, int depth)
   findInteriorRows();
 }
 
-// Each coarse level's interior row: the row of its centre voxel while nothing is fixed. Rows
-// are computed the same way everywhere, so a row far from fixed voxels and borders equals it
-// bit for bit, and galerkinRow() points such rows at it.
+// Builds every coarse row while nothing is fixed and takes each level's interior row: the row
+// of its centre voxel. Rows are computed the same way everywhere, so a row far from fixed
+// voxels and borders equals it bit for bit; such rows point at it, here and in galerkinRow().
 void Laplace3::findInteriorRows() {
   updateCoarse();
   for (size_t k = 1; k < levels_.size(); ++k) {
     Level& l = levels_[k];
     l.interior = l.a[(size_t(l.d / 2 + 1) * l.sy + size_t(l.h / 2 + 1)) * l.sx + size_t(l.w / 2 + 1)];
+    for (size_t i = 0; i < l.a.size(); ++i)
+      if (l.a[i] == l.interior) l.row[i] = &l.interior;
   }
-  dirty_ = {0, 0, 0, w_ - 1, h_ - 1, d_ - 1};
 }
 
 size_t Laplace3::bytes() const {

@@ -73,47 +73,32 @@ VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vect
   }
 }
 
-// Sum of 1/r from the charges of one leaf block (voxel by voxel) to the point.
-double VolumeBoundary::leaf(int bx, int by, int bz, double px, double py, double pz) const {
-  double sum = 0;
-  const int x0 = bx * kLeaf, y0 = by * kLeaf, z0 = bz * kLeaf;
-  for (int z = z0; z < std::min(z0 + kLeaf, dd_); ++z)
-    for (int y = y0; y < std::min(y0 + kLeaf, dh_); ++y)
-      for (int x = x0; x < std::min(x0 + kLeaf, dw_); ++x)
-        if (charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)]) {
-          const double dx = x + 0.5 - px, dy = y + 0.5 - py, dz = z + 0.5 - pz;
-          sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
-        }
-  return sum;
-}
-
-// Sum of 1/r from the charges of block (bx, by, bz) of `level` to the point (domain
-// coordinates), the block known to hold charge and to be too near to count as one: its eight
-// children's distances are taken first (independent square roots, which pipeline), then each
-// child counts as one charge or is opened, and the terms are added in child order.
-double VolumeBoundary::open(int level, int bx, int by, int bz, double px, double py, double pz) const {
-  const Level& l = levels_[size_t(level - 1)];
-  const double side = double(kLeaf << (level - 1));
-  size_t idx[8];
-  bool present[8];
-  double r[8];
-  for (int c = 0; c < 8; ++c) {
-    const int x = 2 * bx + (c & 1), y = 2 * by + ((c >> 1) & 1), z = 2 * bz + (c >> 2);
-    present[c] = x < l.w && y < l.h && z < l.d;
-    idx[c] = present[c] ? (size_t(z) * size_t(l.h) + size_t(y)) * size_t(l.w) + size_t(x) : 0;
-    present[c] = present[c] && l.count[idx[c]] != 0;
-    const size_t i = idx[c];
-    r[c] = std::sqrt((l.cx[i] - px) * (l.cx[i] - px) + (l.cy[i] - py) * (l.cy[i] - py) + (l.cz[i] - pz) * (l.cz[i] - pz));
+// Sum of 1/r from the charges of block (bx, by, bz) of `level` to the point (domain coordinates).
+double VolumeBoundary::visit(int level, int bx, int by, int bz, double px, double py, double pz) const {
+  const Level& l = levels_[size_t(level)];
+  if (bx >= l.w || by >= l.h || bz >= l.d) return 0.0;
+  const size_t i = (size_t(bz) * size_t(l.h) + size_t(by)) * size_t(l.w) + size_t(bx);
+  const double count = l.count[i];
+  if (count == 0) return 0.0;
+  const double side = double(kLeaf << level);
+  const double r = std::sqrt((l.cx[i] - px) * (l.cx[i] - px) + (l.cy[i] - py) * (l.cy[i] - py) +
+                             (l.cz[i] - pz) * (l.cz[i] - pz));
+  if (side < kTheta * r) return count / r;
+  if (level == 0) {  // voxel by voxel
+    double sum = 0;
+    const int x0 = bx * kLeaf, y0 = by * kLeaf, z0 = bz * kLeaf;
+    for (int z = z0; z < std::min(z0 + kLeaf, dd_); ++z)
+      for (int y = y0; y < std::min(y0 + kLeaf, dh_); ++y)
+        for (int x = x0; x < std::min(x0 + kLeaf, dw_); ++x)
+          if (charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)]) {
+            const double dx = x + 0.5 - px, dy = y + 0.5 - py, dz = z + 0.5 - pz;
+            sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+          }
+    return sum;
   }
   double sum = 0;
-  for (int c = 0; c < 8; ++c) {
-    if (!present[c]) continue;
-    const int x = 2 * bx + (c & 1), y = 2 * by + ((c >> 1) & 1), z = 2 * bz + (c >> 2);
-    if (side < kTheta * r[c])
-      sum += double(l.count[idx[c]]) / r[c];
-    else
-      sum += level == 1 ? leaf(x, y, z, px, py, pz) : open(level - 1, x, y, z, px, py, pz);
-  }
+  for (int c = 0; c < 8; ++c)
+    sum += visit(level - 1, 2 * bx + (c & 1), 2 * by + ((c >> 1) & 1), 2 * bz + (c >> 2), px, py, pz);
   return sum;
 }
 
@@ -122,18 +107,7 @@ double VolumeBoundary::potential(int x, int y, int z) const {
   if (memo_)
     if (float v = memo_[m].load(std::memory_order_relaxed); v != 0.0f) return v;
   // Grid voxel (x, y, z) is domain voxel (x + 1, y + 1, z + 1); its centre is + 0.5.
-  const double px = x + 1.5, py = y + 1.5, pz = z + 1.5;
-  const int top = int(levels_.size()) - 1;
-  const Level& l = levels_.back();
-  double v = 0.0;
-  if (l.count[0] != 0) {
-    const double r = std::sqrt((l.cx[0] - px) * (l.cx[0] - px) + (l.cy[0] - py) * (l.cy[0] - py) +
-                               (l.cz[0] - pz) * (l.cz[0] - pz));
-    if (double(kLeaf << top) < kTheta * r)
-      v = l.count[0] / r;
-    else
-      v = top == 0 ? leaf(0, 0, 0, px, py, pz) : open(top, 0, 0, 0, px, py, pz);
-  }
+  const double v = visit(int(levels_.size()) - 1, 0, 0, 0, x + 1.5, y + 1.5, z + 1.5);
   if (memo_) {
     memo_[m].store(float(v), std::memory_order_relaxed);
     return float(v);  // the same value whether it came from the memo or not

@@ -128,14 +128,6 @@ double lobe(const Directional& d, double cosTheta);
 // same start, opacity cap (T >= 1 - maxOpacity, S <= maxOpacity * color) and cutoff (T = 1, S = 0).
 glm::dvec3 transmittance(const Fog& fog, double originY, double dirY, double distance);
 glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distance);
-// f, T and S of one ray at once, as a table entry holds them: the values of factorAtElevation,
-// transmittance and scattered, bit for bit (kAtmospheric takes each channel's exponential
-// once for f and T).
-struct Sample {
-  double factor;
-  glm::dvec3 transmittance, scattered;
-};
-Sample sampleAt(const Fog& fog, double originY, double dirY, double distance);
 
 // The colour of an object at `point` seen from `eye` through this fog (one fog, no regions):
 // object * T + S + inscatterWeight * directional.color * lobe.
