@@ -19,13 +19,15 @@ namespace {
 
 constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not zero" bound on UV area
 
+// Plain data, filled in whole by initTriInfo (in parallel, so that the threads first touch the
+// pages of their own range).
 struct TriInfo {
-  dvec3 os{0}, ot{0};  // unit first-order derivatives, sign-adjusted by orientation
-  int neighbor[3] = {-1, -1, -1};  // across edge (i, i+1)
-  bool orientPreserving = false;
-  bool groupWithAny = true;  // UV area or a derivative is zero: joins any group, adds nothing
-  bool zeroUvArea = false;
-  uint8_t grouped = 0;  // bit i: corner i has its group
+  dvec3 os, ot;      // unit first-order derivatives, sign-adjusted by orientation (or zero)
+  int neighbor[3];   // across edge (i, i+1); -1: none
+  bool orientPreserving;
+  bool groupWithAny;  // UV area or a derivative is zero: joins any group, adds nothing
+  bool zeroUvArea;
+  uint8_t grouped;  // bit i: corner i has its group
 };
 
 struct Group {
@@ -96,6 +98,7 @@ class Mikk {
   void initTriInfo(size_t begin, size_t end) {
     for (size_t g = begin; g < end; ++g) {
       TriInfo& ti = info_[g];
+      ti = {dvec3(0), dvec3(0), {-1, -1, -1}, false, true, false, 0};
       dvec3 v1 = pos(corner(g, 0)), v2 = pos(corner(g, 1)), v3 = pos(corner(g, 2));
       dvec2 t1 = uv(corner(g, 0)), t2 = uv(corner(g, 1)), t3 = uv(corner(g, 2));
       double t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
@@ -210,7 +213,7 @@ class Mikk {
   // -1 after); then the group is evaluated once. Otherwise each face's set is built and sets
   // are compared as sorted lists.
   void generateTSpaces() {
-    forRange(parallel_, groups_.size(), kParallelGrain,
+    forRange(parallel_, groups_.size(), kGroupGrain,
              [this](size_t begin, size_t end) { generateTSpaces(begin, end); });
   }
   void generateTSpaces(size_t begin, size_t end) {
@@ -282,15 +285,22 @@ class Mikk {
   }
 
   // Angle-weighted average of the faces' tangents `os` (already projected into n's plane).
+  // The corners' cosines are taken a batch at a time before their arc cosines, so the
+  // projections of one corner overlap the library calls of another.
   dvec3 evalTSpace(const Member* faces, size_t count, const dvec3* os, const dvec3& n) const {
+    constexpr size_t kBatch = 16;
+    double cosine[kBatch];
     dvec3 sum(0);
-    for (size_t a = 0; a < count; ++a) {
-      const uint32_t f = faces[a].face, i = faces[a].corner;
-      if (info_[f].groupWithAny) continue;
-      dvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
-      dvec3 v1 = projected(p0 - p1, n), v2 = projected(p2 - p1, n);
-      double angle = std::acos(std::clamp(glm::dot(v1, v2), -1.0, 1.0));
-      sum += angle * os[a];
+    for (size_t first = 0; first < count; first += kBatch) {
+      const size_t last = std::min(count, first + kBatch);
+      for (size_t a = first; a < last; ++a) {
+        const uint32_t f = faces[a].face, i = faces[a].corner;
+        dvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
+        dvec3 v1 = projected(p0 - p1, n), v2 = projected(p2 - p1, n);
+        cosine[a - first] = std::clamp(glm::dot(v1, v2), -1.0, 1.0);
+      }
+      for (size_t a = first; a < last; ++a)
+        if (!info_[faces[a].face].groupWithAny) sum += std::acos(cosine[a - first]) * os[a];
     }
     return normalizeOrZero(sum);
   }
@@ -324,7 +334,7 @@ class Mikk {
   CornerTangents& out_;
   std::vector<uint32_t> good_;                // triangles that take part, in input order
   std::vector<std::array<uint32_t, 3>> tri_;  // their welded corners
-  std::vector<TriInfo> info_;                 // per good triangle
+  Buffer<TriInfo> info_;                      // per good triangle
   std::vector<Group> groups_;
   std::vector<Member> members_;  // group member lists, contiguous
 };

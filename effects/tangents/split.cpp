@@ -6,7 +6,7 @@
 
 namespace effects::tangents {
 
-void splitVertices(const Mesh& mesh, const std::vector<glm::vec4>& corner, const std::vector<dvec3>& normals,
+void splitVertices(const Mesh& mesh, const Buffer<glm::vec4>& corner, const std::vector<dvec3>& normals,
                    Output& out) {
   const size_t vertCount = mesh.positions.size();
   std::vector<int64_t> nextSplit(vertCount, -1);  // chain of the splits of each input vertex

@@ -8,6 +8,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "effects/parallel.h"
@@ -16,14 +19,40 @@
 
 namespace effects::tangents {
 
+// std::allocator whose resize() leaves new elements default-initialised (for plain data:
+// untouched). For buffers a parallel step fills completely: their pages are first touched by
+// the threads that fill them, not zeroed beforehand by one thread (100k triangles' MikkTSpace
+// buffers are 11 MB of fresh pages a request).
+template <class T>
+struct NoInit : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = NoInit<U>;
+  };
+  NoInit() = default;
+  template <class U>
+  NoInit(const NoInit<U>&) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    if constexpr (sizeof...(Args) == 0)
+      ::new (static_cast<void*>(p)) U;
+    else
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <class T>
+using Buffer = std::vector<T, NoInit<T>>;
+
 // A tangent per triangle corner (3 per triangle), and whether it is a fallback.
 struct CornerTangents {
-  std::vector<glm::vec4> tangent;
+  Buffer<glm::vec4> tangent;  // every element written by the step that makes it
   std::vector<uint8_t> fellBack;
 };
 
 // Work per chunk when a step splits its loop over the caller's threads (effects/parallel.h).
 inline constexpr size_t kParallelGrain = 10000;
+// The same for MikkTSpace's vertex groups, each a few corners' worth of projections and angles.
+inline constexpr size_t kGroupGrain = 1000;
 
 // A unit normal per vertex: given ones normalised; missing ones angle-weighted over every
 // corner at the same position (welded, weld.h); +z where no triangle has area.
@@ -47,7 +76,7 @@ CornerTangents perVertex(const Mesh& mesh, const std::vector<dvec3>& normals, Pa
 
 // Output vertices: vertex v < n is input vertex v; a vertex whose corners disagree is split.
 // Fills out.tangents, out.remap, out.indices.
-void splitVertices(const Mesh& mesh, const std::vector<glm::vec4>& corner, const std::vector<dvec3>& normals,
+void splitVertices(const Mesh& mesh, const Buffer<glm::vec4>& corner, const std::vector<dvec3>& normals,
                    Output& out);
 
 }  // namespace effects::tangents

@@ -13,7 +13,7 @@ namespace effects::tangents {
 namespace {
 
 // Mean and worst angle between the corners' tangents and MikkTSpace's, and handedness flips.
-void measureAgainstMikk(const std::vector<glm::vec4>& corner, const std::vector<glm::vec4>& mikk, Stats& st) {
+void measureAgainstMikk(const Buffer<glm::vec4>& corner, const Buffer<glm::vec4>& mikk, Stats& st) {
   CHECK_EQ(corner.size(), mikk.size());
   double sum = 0, worst = 0;
   size_t flips = 0;

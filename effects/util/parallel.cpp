@@ -39,7 +39,9 @@ void ThreadPool::runChunks(Call& call) {
 
 void ThreadPool::forRange(size_t n, size_t grain, const std::function<void(size_t, size_t)>& fn) {
   grain = std::max<size_t>(grain, 1);
-  const size_t chunks = std::min(workers_.size() + 1, n / grain);
+  // Up to four chunks per thread, taken in turn: a thread that was descheduled, or drew the
+  // slower part of the range, holds up the call by one small chunk, not by half the work.
+  const size_t chunks = workers_.empty() ? 1 : std::min(4 * (workers_.size() + 1), n / grain);
   if (chunks < 2) {
     if (n) fn(0, n);
     return;
