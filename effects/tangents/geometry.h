@@ -13,14 +13,9 @@ using glm::dvec2;
 using glm::dvec3;
 
 inline bool notZero(const dvec3& v) { return glm::dot(v, v) > 1e-300; }
-// v / |v|. x and y share one two-lane division (the same quotients as three scalar ones:
-// division is exact in either form); the divider is what MikkTSpace's evaluation waits on.
 inline dvec3 normalizeOrZero(const dvec3& v) {
-  const double l = glm::length(v);
-  if (!(l > 0 && std::isfinite(l))) return dvec3(0);
-  using Pair = double __attribute__((vector_size(16)));
-  const Pair xy = Pair{v.x, v.y} / Pair{l, l};
-  return {xy[0], xy[1], v.z / l};
+  double l = glm::length(v);
+  return l > 0 && std::isfinite(l) ? v / l : dvec3(0);
 }
 inline dvec3 projectToPlane(const dvec3& v, const dvec3& n) { return v - glm::dot(n, v) * n; }
 
