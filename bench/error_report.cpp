@@ -126,7 +126,9 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
   if (!volume && (n <= 128 || hood == 8)) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2
     lt::Params c = layout();
     c.method = lt::Method::kCharges;
-    settings.push_back({"charges", "charges", c});
+    settings.push_back({"charges calibrated", "default: power " + fmt(lt::calibratedChargesEta(c), 3), c});
+    c.chargesEta = c.eta;  // Kim et al.'s parameter at DBM's eta: space-filling
+    settings.push_back({"charges paper", "variant paper: power " + fmt(c.eta, 3), c});
   }
   std::vector<double> tolerances;
   if (quick)

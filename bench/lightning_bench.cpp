@@ -181,11 +181,13 @@ void fractal() {
     Method method;
     double axisGrowth;
     int lifetime;
+    bool chargesPowerIsEta;  // charges, paper variant: Kim et al.'s parameter = eta
   };
-  const Row rows[] = {{"fast (calibrated default)", Method::kFast, Params{}.axisGrowth, Params{}.lifetime},
-                      {"fast (paper)", Method::kFast, kPaperAxisGrowth, kPaperLifetime},
-                      {"charges", Method::kCharges, 2.0, 0},
-                      {"dbm", Method::kDbm, 2.0, 0}};
+  const Row rows[] = {{"fast (calibrated default)", Method::kFast, Params{}.axisGrowth, Params{}.lifetime, false},
+                      {"fast (paper)", Method::kFast, kPaperAxisGrowth, kPaperLifetime, false},
+                      {"charges (calibrated)", Method::kCharges, 2.0, 0, false},
+                      {"charges (paper)", Method::kCharges, 2.0, 0, true},
+                      {"dbm", Method::kDbm, 2.0, 0, false}};
   for (double eta : {1.0, 2.0}) {
     for (const Row& row : rows) {
       double sum = 0, sum2 = 0;
@@ -194,6 +196,7 @@ void fractal() {
         p.eta = eta;
         p.axisGrowth = row.axisGrowth;
         p.lifetime = row.lifetime;
+        if (row.chargesPowerIsEta) p.chargesEta = eta;
         auto b = grow(p);
         std::vector<Cell> cells;
         for (const auto& n : b.value().nodes) cells.push_back(n.cell);

@@ -9,8 +9,9 @@
 //                         [--charges-eta E]... [--screening S]... [--volume]
 // --volume: N x N x N grids (neighbourhood 26 unless given; 6 is the other 3-D one).
 // --screening: the exponent of eqn 6's N (1 in the paper), one row (or fit) per value.
-// --charges-eta: rows for the charges method (Kim et al. 2007) at these eta, beside DBM's
-// row at each --eta: which charges eta gives DBM's statistics.
+// --charges-eta: rows for the charges method (Kim et al. 2007) with their potential raised to
+// these powers (Params::chargesEta), beside DBM's row at each --eta: which power gives DBM's
+// statistics; 0 is the calibrated power for the row's grid and eta (calibratedChargesEta).
 // --fit: instead of the --axis rows, the base per cell at which the fast method's median
 // cells meet DBM's (bisection), and the statistics it gives.
 // Output: a markdown table, one row per (grid, eta, method, setting): mean +- sd of D,
@@ -193,9 +194,12 @@ int main(int argc, char** argv) {
       for (double ce : chargesEtas) {
         lt::Params p = base;
         p.method = lt::Method::kCharges;
-        p.eta = ce;
+        p.chargesEta = ce;
         char setting[64];
-        std::snprintf(setting, sizeof setting, "charges eta %g", ce);
+        if (ce > 0)
+          std::snprintf(setting, sizeof setting, "charges eta %g", ce);
+        else
+          std::snprintf(setting, sizeof setting, "charges calibrated (power %.2f)", lt::calibratedChargesEta(p));
         row(grid, eta, "charges", setting, p, seeds);
       }
       if (!chargesEtas.empty()) continue;

@@ -191,9 +191,10 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   p.eta = body.value("eta", p.eta);
   p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
   p.axisGrowth = lt::calibratedAxisGrowth(p);
-  if (body.value("variant", "calibrated") == "paper") {
+  if (body.value("variant", "calibrated") == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
     p.lifetime = lt::kPaperLifetime;
     p.axisGrowth = lt::kPaperAxisGrowth;
+    p.chargesEta = p.eta;
   }
   p.lifetime = body.value("lifetime", p.lifetime);
   p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
@@ -237,7 +238,7 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
               {"grid", p.depth ? json::array({p.width, p.height, p.depth}) : json::array({p.width, p.height})}};
   if (request.world.given)
     out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};
-  if (p.method == lt::Method::kFast) out["variant"] = body.value("variant", "calibrated");
+  if (p.method != lt::Method::kDbm) out["variant"] = body.value("variant", "calibrated");
   out["mainChannelLength"] = bolt.mainChannel.size();
   out["cellCount"] = bolt.nodes.size();
   out["steps"] = bolt.nodes.back().step;

@@ -88,6 +88,24 @@ TEST(LightningApi, TimelineParallelToPolylinesAndItsOwnSeed) {
   EXPECT_TRUE(hasPointer(p, "/timeline/leaderPause")) << p.dump();
 }
 
+// charges: the calibrated power by default (named in stats), eta itself in the paper variant.
+TEST(LightningApi, ChargesVariantChoosesThePower) {
+  TestServer s;
+  json req = request(32);
+  req["method"] = "charges";
+  req["include"] = {"stats"};
+  json a = json::parse(s.postJson("/v1/lightning", req)->body);
+  EXPECT_EQ(a["variant"], "calibrated");
+  EXPECT_GT(a["stats"]["counters"]["chargesEta"].get<double>(), 2 * req.value("eta", 2.0)) << a;
+  req["variant"] = "paper";
+  req["eta"] = 3;
+  a = json::parse(s.postJson("/v1/lightning", req)->body);
+  EXPECT_EQ(a["variant"], "paper");
+  EXPECT_EQ(a["stats"]["counters"]["chargesEta"], 3.0) << a;
+  req["method"] = "dbm";
+  EXPECT_FALSE(json::parse(s.postJson("/v1/lightning", req)->body).contains("variant"));
+}
+
 TEST(LightningApi, FourNeighbourhoodGrowsFourConnectedTrees) {
   TestServer s;
   for (const char* method : {"fast", "dbm", "charges"}) {

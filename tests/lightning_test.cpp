@@ -69,6 +69,28 @@ TEST(Fast, DefaultMeetsDbmStatistics) {
   EXPECT_NEAR(f.tips / r.tips, 1.0, 0.5) << f.tips << " vs " << r.tips;
 }
 
+// Kim et al.'s point-charge potential raised to eta is space-filling at DBM's eta (their
+// dimension parameter wants 4-16); the calibrated power meets DBM's D (docs/lightning-
+// calibration.md section 6: within 0.05 over 10 seeds; looser here with 4 DBM seeds).
+TEST(Charges, CalibratedPowerMeetsDbmDimension) {
+  for (double eta : {1.0, 2.0, 3.0}) {
+    Params charges = basic(64, Method::kCharges);
+    charges.eta = eta;
+    Params dbm = charges, paper = charges;
+    dbm.method = Method::kDbm;
+    paper.chargesEta = eta;
+    const BoltStats c = statsOver(charges, 10), r = statsOver(dbm, 4), q = statsOver(paper, 4);
+    EXPECT_NEAR(c.d, r.d, 0.1) << "eta " << eta;
+    EXPECT_GT(q.d - r.d, 0.2) << "eta " << eta;  // the literal parameter: a blob
+  }
+  Params p = basic(64, Method::kCharges);
+  auto r = grow(p);
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(r.value().stats.counters.at("chargesEta"), calibratedChargesEta(p));
+  p.chargesEta = -1;
+  EXPECT_EQ(validate(p)->field, "/chargesEta");
+}
+
 // The bolt is a tree of 8-connected (or 4-connected) cells, free of obstacles, from start to every target.
 void expectWellFormed(const Params& p, const Bolt& b) {
   ASSERT_FALSE(b.nodes.empty());

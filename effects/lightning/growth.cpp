@@ -37,6 +37,7 @@ std::optional<Error> validate(const Params& p) {
   if (!(p.eta >= 0.0 && p.eta <= 50.0)) return invalid("/eta", "must be in [0, 50]");
   if (!(p.axisGrowth >= 1.0 && p.axisGrowth <= 64.0)) return invalid("/axisGrowth", "must be in [1, 64]");
   if (!(p.screening >= 0.0 && p.screening <= 8.0)) return invalid("/screening", "must be in [0, 8]");
+  if (!(p.chargesEta >= 0.0 && p.chargesEta <= 50.0)) return invalid("/chargesEta", "must be in [0, 50]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
@@ -57,6 +58,11 @@ double calibratedAxisGrowth(const Params& p) {
   if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
   const double longer = std::max(3, std::max(p.width, p.height));
   return std::exp((0.2 + 0.025 * std::min(p.eta, 8.0)) * std::pow(128.0 / longer, 0.35));
+}
+
+double calibratedChargesEta(const Params& p) {
+  const double longer = std::max(3, std::max(p.width, p.height));
+  return 5.2 * std::pow(p.eta, 0.7) * std::pow(longer / 128.0, 0.2);
 }
 
 namespace {
@@ -141,6 +147,10 @@ class Grower {
   std::unique_ptr<detail::Potential> laplace_, reference_;
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
+  // The power the candidates' Phi is raised to: eta, or for kCharges the charges exponent.
+  const double exponent_ = p_.method != Method::kCharges ? p_.eta
+                           : p_.chargesEta > 0       ? p_.chargesEta
+                                                     : calibratedChargesEta(p_);
   // kFast: screening * ln n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's
   // 26-neighbourhood), looked up (screening 1: the values std::log gives).
   const std::array<double, 27> logN_ = [s = p_.screening] {
@@ -382,7 +392,7 @@ double Grower::stepError(const std::vector<double>& logPhi) {
   double res = 0;
   reference_->solve(Solver::kMgpcg, 1e-10, &res);
   std::vector<double> p;
-  const double pSum = candidateWeights(logPhi, p_.eta, p);
+  const double pSum = candidateWeights(logPhi, exponent_, p);
   for (double& v : p) v /= pSum;
   // Reference support: every free cell next to a bolt cell.
   std::vector<size_t> cells;
@@ -532,7 +542,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
       pick = sampleFast();
     } else {
       weighCandidates(logPhi);
-      pick = sample(logPhi, p_.eta, rng_, scratch);
+      pick = sample(logPhi, exponent_, rng_, scratch);
     }
     Candidate chosen = cands_[pick];
     last = addNode(chosen.cell, chosen.parent);
@@ -587,6 +597,7 @@ std::optional<Error> Grower::run() {
   s.counters["steps"] = step_;
   s.counters["cells"] = double(bolt_.nodes.size());
   s.counters["candidatesMax"] = double(candidatesMax_);
+  if (p_.method == Method::kCharges) s.counters["chargesEta"] = exponent_;
   if (p_.method == Method::kDbm) {
     s.counters["solverIterations"] = solverIterations_;
     s.counters["residual"] = lastResidual_;

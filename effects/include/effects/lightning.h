@@ -65,6 +65,12 @@ inline constexpr int kPaperLifetime = 4;
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
+// kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
+// gives DBM's dimension at `eta` (docs/lightning-calibration.md section 6, fitted over
+// 64^2-256^2, eta 0.5-4): 5.2 eta^0.7 (L / 128)^0.2, L = the grid's longer side. Used with
+// the parameter itself at eta, their potential is far less screened than DBM's: D 1.73 at 64^2,
+// eta 2, where DBM gives 1.24.
+double calibratedChargesEta(const Params& p);
 
 const char* toString(Method m);
 const char* toString(Solver s);
@@ -83,6 +89,8 @@ struct Params {
                                                // (calibratedAxisGrowth() with lifetime 0 meets
                                                // DBM's D, cells and tips)
   double screening = 1.0;   // kFast: exponent of eqn 6's N (Phi ~ 1 / N^screening), in [0, 8]
+  double chargesEta = 0;    // kCharges: the power of Kim et al.'s potential, in [0, 50]; 0 =
+                            // calibratedChargesEta() (the `paper` variant sends eta itself)
   int neighbourhood = 8;    // 8 (diagonals too) or 4: which cells are candidates, which
                             // touch a target, how the A* guide moves, N's range (eqn 6);
                             // in 3-D 26 (faces, edges and corners) or 6 (faces)
