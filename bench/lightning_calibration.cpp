@@ -117,7 +117,7 @@ std::string screeningNote(double s) {
 int main(int argc, char** argv) {
   std::vector<int> grids;
   std::vector<double> etas, axes, chargesEtas, screenings;
-  std::vector<int> lifetimes;
+  std::vector<int> lifetimes, radii;
   int seeds = 20, dbmSeeds = 10, neighbourhood = 0;  // 0: 8 in 2-D, 26 in 3-D
   bool fit = false, volume = false;
   for (int i = 1; i < argc; i += 2) {
@@ -139,6 +139,8 @@ int main(int argc, char** argv) {
       screenings.push_back(std::atof(v));
     else if (flag == "--lifetime")
       lifetimes.push_back(std::atoi(v));
+    else if (flag == "--radius")
+      radii.push_back(std::atoi(v));
     else if (flag == "--seeds")
       seeds = std::atoi(v);
     else if (flag == "--dbm-seeds")
@@ -157,6 +159,7 @@ int main(int argc, char** argv) {
   const bool calibrated = axes.empty();  // each row at calibratedAxisGrowth() of its grid and eta
   if (lifetimes.empty()) lifetimes = {lt::Params{}.lifetime};
   if (screenings.empty()) screenings = {lt::Params{}.screening};
+  if (radii.empty()) radii = {lt::Params{}.screeningRadius};
   std::printf("| grid | eta | method | setting | D | cells (median) | tips (median) | ms/bolt |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int n : grids)
@@ -206,14 +209,18 @@ int main(int argc, char** argv) {
       if (calibrated) axes = {lt::calibratedAxisGrowth(base)};
       for (double a : axes)
         for (int l : lifetimes)
-          for (double sc : screenings) {
-            lt::Params p = base;
-            p.axisGrowth = a;
-            p.lifetime = l;
-            p.screening = sc;
-            char setting[96];
-            std::snprintf(setting, sizeof setting, "axis %g, lifetime %d%s", a, l, screeningNote(sc).c_str());
-            row(grid, eta, "fast", setting, p, seeds);
-          }
+          for (double sc : screenings)
+            for (int rad : radii) {
+              lt::Params p = base;
+              p.axisGrowth = a;
+              p.lifetime = l;
+              p.screening = sc;
+              p.screeningRadius = rad;
+              char setting[128];
+              const int r = rad > 0 ? rad : lt::calibratedScreeningRadius(p);
+              std::snprintf(setting, sizeof setting, "axis %g, lifetime %d%s%s", a, l, screeningNote(sc).c_str(),
+                            r > 1 ? (", radius " + std::to_string(r)).c_str() : "");
+              row(grid, eta, "fast", setting, p, seeds);
+            }
     }
 }

@@ -195,6 +195,7 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
     p.lifetime = lt::kPaperLifetime;
     p.axisGrowth = lt::kPaperAxisGrowth;
     p.chargesEta = p.eta;
+    p.screeningRadius = 1;  // eqn 6's N: the adjacent cells
   }
   p.lifetime = body.value("lifetime", p.lifetime);
   p.axisGrowth = body.value("axisGrowth", p.axisGrowth);

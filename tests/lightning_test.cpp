@@ -69,6 +69,21 @@ TEST(Fast, DefaultMeetsDbmStatistics) {
   EXPECT_NEAR(f.tips / r.tips, 1.0, 0.5) << f.tips << " vs " << r.tips;
 }
 
+// From 256^2 up the calibrated default counts N within radius 3 (docs/lightning-calibration.md
+// section 11: D within 0.03, cells and tips within 15 % of DBM at 256^2 and 512^2 over 20
+// seeds).
+TEST(Fast, LargeGridsCountScreeningWithinRadius3) {
+  Params fast = basic(256), dbm = basic(256, Method::kDbm);
+  EXPECT_EQ(calibratedScreeningRadius(fast), 3);
+  EXPECT_EQ(calibratedScreeningRadius(basic(128)), 1);
+  const BoltStats f = statsOver(fast, 10), r = statsOver(dbm, 3);
+  EXPECT_NEAR(f.d, r.d, 0.08);
+  EXPECT_NEAR(f.cells / r.cells, 1.0, 0.35) << f.cells << " vs " << r.cells;
+  EXPECT_NEAR(f.tips / r.tips, 1.0, 0.4) << f.tips << " vs " << r.tips;
+  fast.screeningRadius = 8;
+  EXPECT_EQ(validate(fast)->field, "/screeningRadius");
+}
+
 // Kim et al.'s point-charge potential raised to eta is space-filling at DBM's eta (their
 // dimension parameter wants 4-16); the calibrated power meets DBM's D (docs/lightning-
 // calibration.md section 6: within 0.05 over 10 seeds; looser here with 4 DBM seeds).

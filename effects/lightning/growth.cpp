@@ -38,6 +38,7 @@ std::optional<Error> validate(const Params& p) {
   if (!(p.axisGrowth >= 1.0 && p.axisGrowth <= 64.0)) return invalid("/axisGrowth", "must be in [1, 64]");
   if (!(p.screening >= 0.0 && p.screening <= 8.0)) return invalid("/screening", "must be in [0, 8]");
   if (!(p.chargesEta >= 0.0 && p.chargesEta <= 50.0)) return invalid("/chargesEta", "must be in [0, 50]");
+  if (p.screeningRadius < 0 || p.screeningRadius > 7) return invalid("/screeningRadius", "must be in [0, 7]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
   if (p.targets.empty()) return invalid("/targets", "needs at least one target");
@@ -55,9 +56,20 @@ double calibratedAxisGrowth(const Params& p) {
     return p.neighbourhood == 6 ? std::exp(0.32 * std::pow(32.0 / longest, 0.55))
                                 : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
   }
-  if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
   const double longer = std::max(3, std::max(p.width, p.height));
+  if (p.neighbourhood != 4) {
+    if (longer < 256) return kCalibratedAxisGrowth8;
+    // Section 11: the base that meets DBM with N counted within radius 3, at 256^2, 512^2 and
+    // 1024^2; linear in log L between, held beyond (extrapolated: DBM is minutes a bolt there).
+    const double t = std::log2(longer / 256.0);
+    return t <= 1 ? 1.13 + (1.095 - 1.13) * t : t <= 2 ? 1.095 + (1.09 - 1.095) * (t - 1) : 1.09;
+  }
   return std::exp((0.2 + 0.025 * std::min(p.eta, 8.0)) * std::pow(128.0 / longer, 0.35));
+}
+
+int calibratedScreeningRadius(const Params& p) {
+  const int longer = std::max(p.width, p.height);
+  return p.method == Method::kFast && !p.depth && p.neighbourhood == 8 && longer >= 256 ? 3 : 1;
 }
 
 double calibratedChargesEta(const Params& p) {
@@ -74,7 +86,8 @@ constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 struct Candidate {
   Cell cell;
   int born;        // step at which it last gained a bolt neighbour
-  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8 (1..4 in a 4-neighbourhood, 1..26 in 3-D)
+  int neighbours;  // N of seed 002 eqn 6: adjacent bolt cells, 1..8 (1..4 in a 4-neighbourhood, 1..26 in
+                   // 3-D); with a screening radius r > 1, the bolt cells within r (1..(2r+1)^2)
   int parent;      // node it attaches to if chosen: its newest bolt neighbour
   double charge;   // kCharges: sum over bolt cells of 1/r
   // kFast: log(2^G / (B * P)), fixed while the segment's axis stands, and Phi^eta relative
@@ -95,6 +108,7 @@ class Grower {
     nodeOf_ = detail::CellIndex(cells);
     candidateOf_ = detail::CellIndex(cells);
     reserved_.reset(cells);
+    if (radius_ > 1) near_.reset(cells);
     for (const Cell& t : p.targets)
       if (g_.inside(t.x, t.y, t.z)) reserved_[g_.index(t)] = 1;
   }
@@ -116,6 +130,7 @@ class Grower {
   void logWeights(std::vector<double>& out);
   double fastLogStatic(const Candidate& c) const;
   double fastLogPhi(const Candidate& c) const { return c.logStatic - logN_[size_t(c.neighbours)]; }
+  void screenAround(Cell c);
   void refreshFastWeight(Candidate& c);
   void restartFastWeights();
   size_t sampleFast();
@@ -153,11 +168,15 @@ class Grower {
                                                      : calibratedChargesEta(p_);
   // kFast: screening * ln n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's
   // 26-neighbourhood), looked up (screening 1: the values std::log gives).
-  const std::array<double, 27> logN_ = [s = p_.screening] {
-    std::array<double, 27> t{};
-    for (int i = 1; i < 27; ++i) t[size_t(i)] = s * std::log(double(i));
+  const int radius_ = p_.method != Method::kFast || p_.depth ? 1
+                      : p_.screeningRadius > 0                ? p_.screeningRadius
+                                                              : calibratedScreeningRadius(p_);
+  const std::vector<double> logN_ = [s = p_.screening, r = radius_] {
+    std::vector<double> t(size_t(std::max(27, (2 * r + 1) * (2 * r + 1))));
+    for (size_t i = 1; i < t.size(); ++i) t[i] = s * std::log(double(i));
     return t;
   }();
+  detail::Zeroed<uint8_t> near_;  // radius_ > 1: bolt cells within radius_ of each cell (<= 15^2)
   int step_ = 0;
   Cell anchor_, attractor_;    // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
   double weightRef_ = 0;       // kFast: weights are exp(eta * log Phi - weightRef_)
@@ -170,11 +189,28 @@ class Grower {
   size_t candidatesMax_ = 0;
 };
 
+// A new bolt cell screens every cell within radius_: their counts rise, candidates among them
+// are weighed again.
+void Grower::screenAround(Cell c) {
+  for (int y = std::max(0, c.y - radius_); y <= std::min(p_.height - 1, c.y + radius_); ++y)
+    for (int x = std::max(0, c.x - radius_); x <= std::min(p_.width - 1, c.x + radius_); ++x) {
+      const size_t i = g_.index(x, y, 0);
+      ++near_[i];
+      if (const int32_t slot = candidateOf_.get(i); slot >= 0) {
+        Candidate& cand = cands_[size_t(slot)];
+        cand.neighbours = near_[i];
+        refreshFastWeight(cand);
+        markWeight(size_t(slot));
+      }
+    }
+}
+
 int Grower::addNode(Cell c, int parent) {
   int id = int(bolt_.nodes.size());
   bolt_.nodes.push_back({c, parent, step_});
   nodeOf_.set(g_.index(c), id);
   if (int slot = candidateOf_.get(g_.index(c)); slot >= 0) removeCandidate(size_t(slot));
+  if (radius_ > 1) screenAround(c);
   if (laplace_) laplace_->fix(c, 0.0);
   if (reference_) reference_->fix(c, 0.0);
   if (p_.method == Method::kCharges) {  // Kim et al. 2007: one new term per candidate
@@ -202,15 +238,15 @@ void Grower::addCandidatesAround(int node) {
     size_t i = g_.index(x, y, z);
     if (const int32_t slot = candidateOf_.get(i); slot >= 0) {
       Candidate& cand = cands_[size_t(slot)];
-      cand.neighbours = std::min(cand.neighbours + 1, stencil_.size);
+      cand.neighbours = radius_ > 1 ? near_[i] : std::min(cand.neighbours + 1, stencil_.size);
       cand.born = step_;
       cand.parent = node;
       if (p_.method == Method::kFast) refreshFastWeight(cand);
       markWeight(size_t(slot));
       continue;
     }
-    Candidate cand{{x, y, z}, step_, 0, node, 0.0};
-    for (int j = 0; j < stencil_.size; ++j) {
+    Candidate cand{{x, y, z}, step_, radius_ > 1 ? int(near_[i]) : 0, node, 0.0};
+    for (int j = 0; j < stencil_.size && radius_ == 1; ++j) {
       int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j], nz = z + stencil_.dz[j];
       if (g_.inside(nx, ny, nz) && nodeOf_.get(g_.index(nx, ny, nz)) >= 0) ++cand.neighbours;
     }

@@ -65,6 +65,12 @@ inline constexpr int kPaperLifetime = 4;
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
+// eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
+// the paper). From 256^2 up (8-neighbourhood, 2-D) the calibrated default counts them within
+// radius 3, with a base per cell of 1.13 at 256^2, 1.095 at 512^2 and 1.09 from 1024^2 up
+// (interpolated in log L between): with adjacent cells only, no base meets DBM's dimension and
+// its mass together there (docs/lightning-calibration.md sections 7 and 11).
+int calibratedScreeningRadius(const Params& p);
 // kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
 // gives DBM's dimension at `eta` (docs/lightning-calibration.md section 6, fitted over
 // 64^2-256^2, eta 0.5-4): 5.2 eta^0.7 (L / 128)^0.2, L = the grid's longer side. Used with
@@ -87,8 +93,11 @@ struct Params {
   int lifetime = 0;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
   double axisGrowth = kCalibratedAxisGrowth8;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]
                                                // (calibratedAxisGrowth() with lifetime 0 meets
-                                               // DBM's D, cells and tips)
+                                               // DBM's D, cells and tips; set it from there for
+                                               // grids of 256^2 and more, as the server does)
   double screening = 1.0;   // kFast: exponent of eqn 6's N (Phi ~ 1 / N^screening), in [0, 8]
+  int screeningRadius = 0;  // kFast, 2-D: N counts the bolt cells within this Chebyshev radius,
+                            // in [0, 7]; 1: eqn 6's adjacent cells; 0: calibratedScreeningRadius()
   double chargesEta = 0;    // kCharges: the power of Kim et al.'s potential, in [0, 50]; 0 =
                             // calibratedChargesEta() (the `paper` variant sends eta itself)
   int neighbourhood = 8;    // 8 (diagonals too) or 4: which cells are candidates, which
