@@ -64,7 +64,7 @@ double calibratedAxisGrowth(const Params& p) {
     const double t = std::log2(longer / 256.0);
     return t <= 1 ? 1.13 + (1.095 - 1.13) * t : t <= 2 ? 1.095 + (1.09 - 1.095) * (t - 1) : 1.09;
   }
-  return std::exp((0.2 + 0.025 * std::min(p.eta, 8.0)) * std::pow(128.0 / longer, 0.35));
+  return std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35));
 }
 
 int calibratedScreeningRadius(const Params& p) {

@@ -56,10 +56,10 @@ enum class Guide { kAuto, kAstar, kNone };
 inline constexpr double kPaperAxisGrowth = 2.0;
 inline constexpr int kPaperLifetime = 4;
 // The base per cell (lifetime 0) that meets DBM's statistics (docs/lightning-calibration.md):
-// 1.2 in the 8-neighbourhood for every grid and eta measured up to 256^2 (eta 0.5-4; at 512^2
-// it meets D at eta 2-3 but grows fewer cells than DBM); in the 4-neighbourhood the fitted base
+// 1.2 in the 8-neighbourhood below 256^2 (from 256^2 see calibratedScreeningRadius); in the
+// 4-neighbourhood the fitted base
 // falls with the grid and rises with eta, as
-// ln a = (0.2 + 0.025 eta) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
+// ln a = (0.155 + 0.06 min(eta, 3)) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
 // the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
 // longest side).
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
