@@ -166,8 +166,9 @@ class Grower {
   const double exponent_ = p_.method != Method::kCharges ? p_.eta
                            : p_.chargesEta > 0       ? p_.chargesEta
                                                      : calibratedChargesEta(p_);
-  // kFast: screening * ln n for the bolt-neighbour counts 1..26 (26 in a 3-D grid's
-  // 26-neighbourhood), looked up (screening 1: the values std::log gives).
+  // kFast: N counted within radius_ (1: the adjacent cells), and screening * ln n for the
+  // counts 1..26 (26 in a 3-D grid's 26-neighbourhood) or 1..(2 radius_ + 1)^2, looked up
+  // (screening 1: the values std::log gives).
   const int radius_ = p_.method != Method::kFast || p_.depth ? 1
                       : p_.screeningRadius > 0                ? p_.screeningRadius
                                                               : calibratedScreeningRadius(p_);
