@@ -50,6 +50,12 @@ std::optional<Error> validate(const Params& p) {
   return std::nullopt;
 }
 
+namespace {
+// The grid side from which N is counted within radius 3 (section 11): 256 in the
+// 8-neighbourhood, 512 in the 4-neighbourhood (whose adjacent-cell law still meets DBM at 256^2).
+int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
+}  // namespace
+
 double calibratedAxisGrowth(const Params& p) {
   if (p.depth) {  // docs/lightning-calibration.md section 10
     const double longest = std::max({3, p.width, p.height, p.depth});
@@ -57,19 +63,19 @@ double calibratedAxisGrowth(const Params& p) {
                                 : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
   }
   const double longer = std::max(3, std::max(p.width, p.height));
-  if (p.neighbourhood != 4) {
-    if (longer < 256) return kCalibratedAxisGrowth8;
+  if (longer >= radiusFrom(p)) {
     // Section 11: the base that meets DBM with N counted within radius 3, at 256^2, 512^2 and
     // 1024^2; linear in log L between, held beyond (extrapolated: DBM is minutes a bolt there).
     const double t = std::log2(longer / 256.0);
     return t <= 1 ? 1.13 + (1.095 - 1.13) * t : t <= 2 ? 1.095 + (1.09 - 1.095) * (t - 1) : 1.09;
   }
+  if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
   return std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35));
 }
 
 int calibratedScreeningRadius(const Params& p) {
   const int longer = std::max(p.width, p.height);
-  return p.method == Method::kFast && !p.depth && p.neighbourhood == 8 && longer >= 256 ? 3 : 1;
+  return p.method == Method::kFast && !p.depth && longer >= radiusFrom(p) ? 3 : 1;
 }
 
 double calibratedChargesEta(const Params& p) {

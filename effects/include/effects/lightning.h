@@ -66,10 +66,11 @@ inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
 // eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
-// the paper). From 256^2 up (8-neighbourhood, 2-D) the calibrated default counts them within
-// radius 3, with a base per cell of 1.13 at 256^2, 1.095 at 512^2 and 1.09 from 1024^2 up
-// (interpolated in log L between): with adjacent cells only, no base meets DBM's dimension and
-// its mass together there (docs/lightning-calibration.md sections 7 and 11).
+// the paper). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) the calibrated
+// default counts them within radius 3, with a base per cell of 1.13 at 256^2, 1.095 at 512^2
+// and 1.09 from 1024^2 up (interpolated in log L between): with adjacent cells only, no base
+// meets DBM's dimension and its mass together there (docs/lightning-calibration.md sections 7
+// and 11).
 int calibratedScreeningRadius(const Params& p);
 // kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
 // gives DBM's dimension at `eta` (docs/lightning-calibration.md section 6, fitted over
