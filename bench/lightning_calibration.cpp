@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
               p.screening = sc;
               p.screeningRadius = rad;
               char setting[128];
-              const int r = rad > 0 ? rad : lt::calibratedScreeningRadius(p);
+              const int r = lt::screeningRadius(p);
               std::snprintf(setting, sizeof setting, "axis %g, lifetime %d%s%s", a, l, screeningNote(sc).c_str(),
                             r > 1 ? (", radius " + std::to_string(r)).c_str() : "");
               row(grid, eta, "fast", setting, p, seeds);

@@ -78,6 +78,11 @@ int calibratedScreeningRadius(const Params& p) {
   return p.method == Method::kFast && !p.depth && longer >= radiusFrom(p) ? 3 : 1;
 }
 
+int screeningRadius(const Params& p) {
+  if (p.method != Method::kFast || p.depth) return 1;
+  return p.screeningRadius > 0 ? p.screeningRadius : calibratedScreeningRadius(p);
+}
+
 double calibratedChargesEta(const Params& p) {
   const double longer = std::max(3, std::max(p.width, p.height));
   return 5.2 * std::pow(p.eta, 0.7) * std::pow(longer / 128.0, 0.2);
@@ -175,9 +180,7 @@ class Grower {
   // kFast: N counted within radius_ (1: the adjacent cells), and screening * ln n for the
   // counts 1..26 (26 in a 3-D grid's 26-neighbourhood) or 1..(2 radius_ + 1)^2, looked up
   // (screening 1: the values std::log gives).
-  const int radius_ = p_.method != Method::kFast || p_.depth ? 1
-                      : p_.screeningRadius > 0                ? p_.screeningRadius
-                                                              : calibratedScreeningRadius(p_);
+  const int radius_ = screeningRadius(p_);
   const std::vector<double> logN_ = [s = p_.screening, r = radius_] {
     std::vector<double> t(size_t(std::max(27, (2 * r + 1) * (2 * r + 1))));
     for (size_t i = 1; i < t.size(); ++i) t[i] = s * std::log(double(i));
@@ -245,18 +248,21 @@ void Grower::addCandidatesAround(int node) {
     size_t i = g_.index(x, y, z);
     if (const int32_t slot = candidateOf_.get(i); slot >= 0) {
       Candidate& cand = cands_[size_t(slot)];
-      cand.neighbours = radius_ > 1 ? near_[i] : std::min(cand.neighbours + 1, stencil_.size);
       cand.born = step_;
       cand.parent = node;
-      if (p_.method == Method::kFast) refreshFastWeight(cand);
+      if (radius_ == 1) {  // with a wider radius, screenAround() has counted and weighed it
+        cand.neighbours = std::min(cand.neighbours + 1, stencil_.size);
+        if (p_.method == Method::kFast) refreshFastWeight(cand);
+      }
       markWeight(size_t(slot));
       continue;
     }
     Candidate cand{{x, y, z}, step_, radius_ > 1 ? int(near_[i]) : 0, node, 0.0};
-    for (int j = 0; j < stencil_.size && radius_ == 1; ++j) {
-      int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j], nz = z + stencil_.dz[j];
-      if (g_.inside(nx, ny, nz) && nodeOf_.get(g_.index(nx, ny, nz)) >= 0) ++cand.neighbours;
-    }
+    if (radius_ == 1)
+      for (int j = 0; j < stencil_.size; ++j) {
+        int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j], nz = z + stencil_.dz[j];
+        if (g_.inside(nx, ny, nz) && nodeOf_.get(g_.index(nx, ny, nz)) >= 0) ++cand.neighbours;
+      }
     if (p_.method == Method::kCharges)
       for (const Node& n : bolt_.nodes) cand.charge += 1.0 / std::hypot(double(x - n.cell.x), double(y - n.cell.y));
     if (p_.method == Method::kFast) {

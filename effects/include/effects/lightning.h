@@ -72,6 +72,9 @@ double calibratedAxisGrowth(const Params& p);
 // meets DBM's dimension and its mass together there (docs/lightning-calibration.md sections 7
 // and 11).
 int calibratedScreeningRadius(const Params& p);
+// The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
+// one; 1 for every method but 2-D fast.
+int screeningRadius(const Params& p);
 // kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
 // gives DBM's dimension at `eta` (docs/lightning-calibration.md section 6, fitted over
 // 64^2-256^2, eta 0.5-4): 5.2 eta^0.7 (L / 128)^0.2, L = the grid's longer side. Used with
