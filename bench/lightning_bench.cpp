@@ -58,7 +58,16 @@ void run(benchmark::State& state, Params p, const std::function<void(Params&)>& 
 
 void BM_Fast(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kFast)); }
 void BM_Charges(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kCharges)); }
-void BM_DbmMgpcg(benchmark::State& s) { run(s, lightningLayout(int(s.range(0)), Method::kDbm)); }
+void BM_DbmMgpcg(benchmark::State& s) {
+  Params p = lightningLayout(int(s.range(0)), Method::kDbm);
+  p.solver = Solver::kMgpcg;
+  run(s, p);
+}
+void BM_DbmCapacitance(benchmark::State& s) {
+  Params p = lightningLayout(int(s.range(0)), Method::kDbm);
+  p.solver = Solver::kCapacitance;
+  run(s, p);
+}
 void BM_DbmCg(benchmark::State& s) {
   Params p = lightningLayout(int(s.range(0)), Method::kDbm);
   p.solver = Solver::kCg;
@@ -94,6 +103,7 @@ BENCHMARK(BM_Fast)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Fast)->Arg(4096)->Iterations(3)->Unit(benchmark::kMillisecond);  // the default grid limit
 BENCHMARK(BM_Charges)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmMgpcg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DbmCapacitance)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DbmCg)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_Fast1024Obstacles)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 

@@ -199,7 +199,8 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   }
   p.lifetime = body.value("lifetime", p.lifetime);
   p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
-  p.solver = body.value("solver", "mgpcg") == "cg" ? lt::Solver::kCg : lt::Solver::kMgpcg;
+  const std::string solver = body.value("solver", "capacitance");  // the schema's enum
+  p.solver = solver == "cg" ? lt::Solver::kCg : solver == "mgpcg" ? lt::Solver::kMgpcg : lt::Solver::kCapacitance;
   p.tolerance = body.value("tolerance", p.tolerance);
   const std::string guide = body.value("guide", "auto");
   p.guide = guide == "astar" ? lt::Guide::kAstar : guide == "none" ? lt::Guide::kNone : lt::Guide::kAuto;

@@ -9,6 +9,7 @@
 #include "api_fog.h"
 #include "api_lightning.h"
 #include "api_tangents.h"
+#include "effects/lightning.h"
 
 namespace effectd {
 
@@ -54,6 +55,12 @@ Cost lightningCost(const json& body, const Config& config) {
   // parent (9 bytes), the obstacle and octree charge bytes; a typical bolt touches ~2 bytes
   // per voxel (bench/lightning_bench BM_VolumeFast).
   const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 12 : 24);
+  // 2-D dbm's default capacitance solver adds its Cholesky factor, rows and table.
+  const bool capacitance = method == "dbm" && !depth && body.value("solver", "capacitance") == "capacitance";
+  const int width = body["grid"]["width"].get<int>(), height = body["grid"]["height"].get<int>();
+  const bool clamped = size_t(width) * size_t(height) > cells;  // refused by the handler
+  const int side = int(std::sqrt(double(cells)));
+  const size_t direct = capacitance ? effects::lightning::capacitanceBytes(clamped ? side : width, clamped ? side : height) : 0;
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps =
       std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
@@ -63,7 +70,7 @@ Cost lightningCost(const json& body, const Config& config) {
   if (include.has("polylines")) numbersPerCell += 5;
   if (include.has("cells")) numbersPerCell += 2;
   if (include.has("tree")) numbersPerCell += 3;
-  return {kBase + cells * perCell + boltCells * (96 + numbersPerCell * kAnswerNumber),
+  return {kBase + cells * perCell + direct + boltCells * (96 + numbersPerCell * kAnswerNumber),
           solver || cells >= kHeavyGridCells};
 }
 

@@ -88,6 +88,28 @@ TEST(LightningApi, TimelineParallelToPolylinesAndItsOwnSeed) {
   EXPECT_TRUE(hasPointer(p, "/timeline/leaderPause")) << p.dump();
 }
 
+// dbm: the exact capacitance solver by default, MGPCG or CG on request; the answer names the
+// solver that ran and the steps solved directly.
+TEST(LightningApi, DbmNamesTheSolverThatRan) {
+  TestServer s;
+  json req = request(40);
+  req["method"] = "dbm";
+  req["include"] = {"stats", "cells"};
+  json direct = json::parse(s.postJson("/v1/lightning", req)->body);
+  EXPECT_EQ(direct["method"], "dbm-capacitance") << direct;
+  EXPECT_GT(direct["stats"]["counters"]["directSteps"].get<double>(), 10) << direct;
+  EXPECT_LE(direct["stats"]["counters"]["residual"].get<double>(), 1e-12) << direct;
+  req["solver"] = "mgpcg";
+  req["tolerance"] = 1e-10;
+  json iterative = json::parse(s.postJson("/v1/lightning", req)->body);
+  EXPECT_EQ(iterative["method"], "dbm-mgpcg");
+  EXPECT_EQ(iterative["stats"]["counters"]["directSteps"], 0);
+  EXPECT_EQ(iterative["cells"], direct["cells"]) << "the same bolt: both solve the same problem";
+  req["solver"] = "direct";
+  json p = expectProblem(s.postJson("/v1/lightning", req), 400);
+  EXPECT_TRUE(hasPointer(p, "/solver")) << p.dump();
+}
+
 // charges: the calibrated power by default (named in stats), eta itself in the paper variant.
 TEST(LightningApi, ChargesVariantChoosesThePower) {
   TestServer s;

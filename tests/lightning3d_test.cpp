@@ -152,6 +152,7 @@ TEST(Lightning3d, DbmSolveConvergesToTheLaplaceSolution) {
   auto mg = grow(p);
   ASSERT_TRUE(mg.ok());
   EXPECT_LE(mg.value().stats.counters.at("residual"), 1e-9);
+  EXPECT_EQ(mg.value().stats.method, "dbm-mgpcg") << "the capacitance solver is 2-D only";
   p.solver = Solver::kCg;
   auto cg = grow(p);
   ASSERT_TRUE(cg.ok());

@@ -139,7 +139,7 @@ TEST(Lightning, EveryMethodReachesTheTarget) {
     auto b = grow(p);
     ASSERT_TRUE(b.ok()) << b.error().message;
     expectWellFormed(p, b.value());
-    EXPECT_EQ(b.value().stats.method, m == Method::kDbm ? "dbm-mgpcg" : toString(m));
+    EXPECT_EQ(b.value().stats.method, m == Method::kDbm ? "dbm-capacitance" : toString(m));
   }
 }
 
@@ -354,6 +354,97 @@ TEST(Lightning, SolversAgree) {
   EXPECT_EQ(at(16, 1), 0.0);
 }
 
+TEST(Lightning, CapacitanceIsTheExactSolution) {
+  // Square, wide and tall grids with a wandering bolt and scattered obstacles: the direct
+  // solution equals MGPCG converged to 1e-13 and is discrete harmonic off the fixed cells to
+  // rounding.
+  effects::Rng rng(11);
+  for (auto [w, h] : {std::pair{32, 32}, {97, 41}, {30, 200}}) {
+    std::vector<uint8_t> obstacles(size_t(w) * size_t(h), 0);
+    for (int k = 0; k < 40; ++k) obstacles[size_t(rng.uniform() * w * (h - 2))] = 1;
+    std::vector<Cell> bolt;
+    Cell c{w / 2, 0};
+    for (int k = 0; k < 3 * h / 4; ++k) {
+      bolt.push_back(c);
+      obstacles[size_t(c.y) * size_t(w) + size_t(c.x)] = 0;
+      c.x = std::clamp(c.x + int(rng.uniform() * 3) - 1, 0, w - 1);
+      c.y = std::min(c.y + (rng.uniform() < 0.7 ? 1 : 0), h - 2);
+    }
+    const Cell target{w / 3, h - 1};
+    obstacles[size_t(target.y) * size_t(w) + size_t(target.x)] = 0;
+    int it = -1;
+    double res = 1, resMg = 1;
+    auto a = solveLaplace(w, h, obstacles, bolt, target, Solver::kCapacitance, 1e-6, &it, &res);
+    auto b = solveLaplace(w, h, obstacles, bolt, target, Solver::kMgpcg, 1e-13, nullptr, &resMg);
+    EXPECT_EQ(it, 0) << "direct, no iterations";
+    EXPECT_LE(res, 1e-12) << w << "x" << h;
+    double worst = 0, harmonic = 0;
+    std::vector<uint8_t> fixed = obstacles;
+    for (const Cell& f : bolt) fixed[size_t(f.y) * size_t(w) + size_t(f.x)] = 1;
+    fixed[size_t(target.y) * size_t(w) + size_t(target.x)] = 1;
+    auto at = [&](int x, int y) { return (x < 0 || y < 0 || x >= w || y >= h) ? 0.0 : a[size_t(y) * size_t(w) + size_t(x)]; };
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y) * size_t(w) + size_t(x);
+        worst = std::max(worst, std::fabs(a[i] - b[i]));
+        if (!fixed[i])
+          harmonic = std::max(harmonic, std::fabs(4 * at(x, y) - at(x - 1, y) - at(x + 1, y) - at(x, y - 1) - at(x, y + 1)));
+        else
+          EXPECT_EQ(a[i], obstacles[i] || !(x == target.x && y == target.y) ? 0.0 : 1.0);
+      }
+    EXPECT_LE(worst, 1e-11) << w << "x" << h;
+    EXPECT_LE(harmonic, 1e-12) << w << "x" << h;
+  }
+}
+
+TEST(Lightning, CapacitanceGrowsMgpcgsBolts) {
+  // The default dbm solver is exact: seed for seed it grows the bolts MGPCG grows converged
+  // to 1e-10 (a draw could only differ where that solve's own error tips it).
+  int same = 0, runs = 0;
+  for (int n : {48, 96})
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      Params p = basic(n, Method::kDbm, seed);
+      auto direct = grow(p);
+      p.solver = Solver::kMgpcg;
+      p.tolerance = 1e-10;
+      auto iterative = grow(p);
+      ASSERT_TRUE(direct.ok() && iterative.ok());
+      const Bolt& a = direct.value();
+      EXPECT_EQ(a.stats.method, "dbm-capacitance");
+      EXPECT_EQ(a.stats.counters.at("directSteps"), a.stats.counters.at("steps") - 1);  // the last cell is the target
+      EXPECT_LE(a.stats.counters.at("residual"), 1e-12);
+      bool equal = a.nodes.size() == iterative.value().nodes.size();
+      for (size_t i = 0; equal && i < a.nodes.size(); ++i)
+        equal = a.nodes[i].cell == iterative.value().nodes[i].cell && a.nodes[i].parent == iterative.value().nodes[i].parent;
+      same += equal;
+      ++runs;
+    }
+  EXPECT_GE(same, runs - 1) << same << " of " << runs << " bolts equal";
+}
+
+TEST(Lightning, CapacitanceHandsOverWhereItWouldBeSlower) {
+  // 24^2: direct up to 4.5 * 24 = 108 fixed cells. eta 0 grows far more cells than that: MGPCG
+  // takes over mid-bolt and the bolt still reaches its target.
+  Params p = basic(24, Method::kDbm, 3);
+  p.eta = 0;
+  auto b = grow(p);
+  ASSERT_TRUE(b.ok());
+  expectWellFormed(p, b.value());
+  ASSERT_GT(b.value().nodes.size(), 108u);
+  EXPECT_EQ(b.value().stats.method, "dbm-capacitance+mgpcg");
+  EXPECT_GT(b.value().stats.counters.at("directSteps"), 100);
+  EXPECT_LE(b.value().stats.counters.at("residual"), p.tolerance);
+  // More obstacle cells than half the limit: iterative from the start.
+  p = basic(24, Method::kDbm);
+  p.obstacles.assign(24 * 24, 0);
+  for (int x = 0; x < 20; ++x)
+    for (int y = 10; y < 13; ++y) p.obstacles[size_t(y) * 24 + size_t(x)] = 1;
+  b = grow(p);
+  ASSERT_TRUE(b.ok());
+  EXPECT_EQ(b.value().stats.method, "dbm-mgpcg");
+  EXPECT_EQ(b.value().stats.counters.at("directSteps"), 0);
+}
+
 TEST(Lightning, MultigridConvergesIndependentlyOfGridAndObstacles) {
   // The Galerkin multigrid preconditioner: a handful of iterations to 1e-10 whatever the grid
   // shape, with a bolt and scattered obstacles inside (plain CG needs O(width) iterations).
@@ -380,6 +471,7 @@ TEST(Lightning, MultigridConvergesIndependentlyOfGridAndObstacles) {
   // Warm-started growth: the coarse operators are patched near each new bolt cell, not
   // rebuilt; a wrong patch would show as many iterations per step.
   Params p = basic(96, Method::kDbm);
+  p.solver = Solver::kMgpcg;
   auto b = grow(p);
   ASSERT_TRUE(b.ok());
   EXPECT_LE(b.value().stats.counters.at("solverIterations") / b.value().stats.counters.at("steps"), 5.0);

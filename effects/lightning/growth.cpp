@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "capacitance.h"
 #include "grid.h"
 #include "laplace.h"
 #include "laplace3.h"
@@ -23,7 +24,9 @@ const char* toString(Method m) {
   }
   return "?";
 }
-const char* toString(Solver s) { return s == Solver::kCg ? "cg" : "mgpcg"; }
+const char* toString(Solver s) {
+  return s == Solver::kCg ? "cg" : s == Solver::kCapacitance ? "capacitance" : "mgpcg";
+}
 
 std::optional<Error> validate(const Params& p) {
   if (p.width < 3 || p.height < 3) return invalid("/grid", "width and height must be >= 3");
@@ -152,7 +155,7 @@ class Grower {
   double boundary(Cell c);
   std::optional<Error> growSegment(size_t k);
   std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
-  std::unique_ptr<detail::Potential> dbmProblem(Cell target) const;
+  std::unique_ptr<detail::Potential> dbmProblem(Cell target, Solver solver) const;
   void reviveFrontier(int from, size_t segmentFirstNode);
   void weighCandidates(std::vector<double>& logPhi);
   void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
@@ -195,6 +198,7 @@ class Grower {
   std::vector<size_t> dirty_;  // kFast: slots whose weight changed since the tree last saw them
   size_t treeUpdates_ = 0;     // since the last rebuild (which also clears rounding drift)
   double solverIterations_ = 0, lastResidual_ = 0, errorSum_ = 0;
+  size_t directSteps_ = 0, iterativeSteps_ = 0;  // kDbm: steps solved by each kind of solver
   int errorSteps_ = 0;
   size_t candidatesMax_ = 0;
 };
@@ -438,8 +442,7 @@ size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vect
 double Grower::stepError(const std::vector<double>& logPhi) {
   // Total-variation distance between this method's candidate distribution and the one the
   // converged Laplace solution gives on the same bolt state (over all free bolt neighbours).
-  double res = 0;
-  reference_->solve(Solver::kMgpcg, 1e-10, &res);
+  reference_->solve(Solver::kMgpcg, 1e-10);
   std::vector<double> p;
   const double pSum = candidateWeights(logPhi, exponent_, p);
   for (double& v : p) v /= pSum;
@@ -493,10 +496,16 @@ std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
 }
 
 // The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1.
-std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target) const {
+// The capacitance solver takes 2-D problems whose fixed cells (obstacles, bolt, target) leave
+// room for the bolt to grow within its direct limit; the rest go to the iterative solvers.
+std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target, Solver solver) const {
   std::unique_ptr<detail::Potential> lap;
+  size_t fixedCells = bolt_.nodes.size() + 1;
+  for (uint8_t o : p_.obstacles) fixedCells += o != 0;
   if (p_.depth)
     lap = std::make_unique<detail::Laplace3>(p_.width, p_.height, p_.depth);
+  else if (solver == Solver::kCapacitance && fixedCells <= detail::Capacitance::maxFixed(p_.width, p_.height) / 2)
+    lap = std::make_unique<detail::Capacitance>(p_.width, p_.height);
   else
     lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
   for (size_t i = 0; i < g_.cells(); ++i)
@@ -518,9 +527,8 @@ void Grower::reviveFrontier(int from, size_t segmentFirstNode) {
 // converged solution when measured.
 void Grower::weighCandidates(std::vector<double>& logPhi) {
   if (laplace_) {
-    double res = 0;
-    solverIterations_ += laplace_->solve(p_.solver, p_.tolerance, &res);
-    lastResidual_ = res;
+    solverIterations_ += laplace_->solve(p_.solver, p_.tolerance);
+    (laplace_->direct() ? directSteps_ : iterativeSteps_) += 1;
   }
   logWeights(logPhi);
   if (reference_) {
@@ -566,8 +574,8 @@ std::optional<Error> Grower::growSegment(size_t k) {
   size_t wp = 0;
   anchor_ = fromCell;
   attractor_ = waypoints[0];
-  if (p_.method == Method::kDbm) laplace_ = dbmProblem(target);
-  if (p_.measureError) reference_ = dbmProblem(target);
+  if (p_.method == Method::kDbm) laplace_ = dbmProblem(target, p_.solver);
+  if (p_.measureError) reference_ = dbmProblem(target, Solver::kMgpcg);
 
   // Chain lightning: the new segment grows from the previous target only.
   for (size_t i = cands_.size(); i-- > 0;) removeCandidate(i);
@@ -598,6 +606,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
     addCandidatesAround(last);
     followWaypoints(chosen.cell, waypoints, wp);
   }
+  if (laplace_) lastResidual_ = laplace_->residual();
   ++step_;
   reserved_[g_.index(target)] = 0;
   addNode(target, last);
@@ -650,6 +659,10 @@ std::optional<Error> Grower::run() {
   if (p_.method == Method::kDbm) {
     s.counters["solverIterations"] = solverIterations_;
     s.counters["residual"] = lastResidual_;
+    s.counters["directSteps"] = double(directSteps_);
+    // The solver that ran: the capacitance method hands a bolt that outgrows it to MGPCG.
+    const std::string iterative = toString(p_.solver == Solver::kCg ? Solver::kCg : Solver::kMgpcg);
+    s.method = "dbm-" + (!directSteps_ ? iterative : !iterativeSteps_ ? "capacitance" : "capacitance+" + iterative);
   }
   if (p_.measureError && errorSteps_ > 0) {
     s.error = errorSum_ / errorSteps_;
@@ -670,8 +683,7 @@ Result<Bolt> grow(const Params& params) {
   bolt.depth = params.depth;
   Grower grower(params, bolt);
   if (auto e = grower.run()) return *e;
-  bolt.stats.method =
-      params.method == Method::kDbm ? std::string("dbm-") + toString(params.solver) : toString(params.method);
+  if (bolt.stats.method.empty()) bolt.stats.method = toString(params.method);  // dbm's names its solver
   bolt.stats.elapsedMs = watch.ms();
   return bolt;
 }

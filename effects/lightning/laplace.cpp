@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+
+#include "capacitance.h"
 
 namespace effects::lightning::detail {
 
@@ -233,7 +236,7 @@ void Laplace::precondition() {
   vcycle(0);
 }
 
-int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
+int Laplace::solve(Solver solver, double tolerance) {
   const size_t n = phi_.size();
   const size_t s = size_t(stride_);
   // r = b - A phi = (sum of 4 neighbours) - 4 phi on unknowns (fixed neighbours carry b).
@@ -244,7 +247,7 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
   }
   const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
-  const bool mg = solver == Solver::kMgpcg;
+  const bool mg = solver != Solver::kCg;
   const int maxIt = 20 * (w_ + h_) + 1000;  // CG converges in O(sqrt(cond)) ~ O(n) iterations
   const int it = conjugateGradients(
       phi_, r_, z_, p_, ap_, goal, maxIt, rr,
@@ -262,7 +265,7 @@ int Laplace::solve(Solver solver, double tolerance, double* relResidual) {
         }
         return pap;
       });
-  if (relResidual) *relResidual = std::sqrt(rr) / bnorm;
+  residual_ = std::sqrt(rr) / bnorm;
   return it;
 }
 
@@ -273,17 +276,22 @@ namespace effects::lightning {
 std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
                                  const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
                                  int* iterations, double* residual) {
-  detail::Laplace lap(width, height);
+  std::unique_ptr<detail::Potential> lap;
+  if (solver == Solver::kCapacitance)
+    lap = std::make_unique<detail::Capacitance>(width, height);
+  else
+    lap = std::make_unique<detail::Laplace>(width, height);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
-      if (!obstacles.empty() && obstacles[size_t(y) * width + x]) lap.fix(x, y, 0.0);
-  for (const Cell& c : bolt) lap.fix(c.x, c.y, 0.0);
-  lap.fix(target.x, target.y, 1.0);
-  int it = lap.solve(solver, tolerance, residual);
+      if (!obstacles.empty() && obstacles[size_t(y) * width + x]) lap->fix({x, y}, 0.0);
+  for (const Cell& c : bolt) lap->fix(c, 0.0);
+  lap->fix(target, 1.0);
+  int it = lap->solve(solver, tolerance);
   if (iterations) *iterations = it;
+  if (residual) *residual = lap->residual();
   std::vector<double> out(size_t(width) * height);
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) out[size_t(y) * width + x] = lap.phi(x, y);
+    for (int x = 0; x < width; ++x) out[size_t(y) * width + x] = lap->phi({x, y});
   return out;
 }
 

@@ -78,8 +78,12 @@ class Potential {
   // Fix a cell at a value (it stops being an unknown).
   virtual void fix(Cell c, double value) = 0;
   // Solves to ||r|| <= tolerance * ||b|| from the current potential; returns iterations.
-  virtual int solve(Solver solver, double tolerance, double* relResidual) = 0;
+  virtual int solve(Solver solver, double tolerance) = 0;
   virtual double phi(Cell c) const = 0;
+  // The relative residual the last solve reached.
+  virtual double residual() const = 0;
+  // Whether the last solve was direct (capacitance.h) rather than iterative.
+  virtual bool direct() const { return false; }
 };
 
 class Laplace final : public Potential {
@@ -87,9 +91,10 @@ class Laplace final : public Potential {
   Laplace(int width, int height);
   void fix(int x, int y, double value);
   void fix(Cell c, double value) override { fix(c.x, c.y, value); }
-  int solve(Solver solver, double tolerance, double* relResidual) override;
+  int solve(Solver solver, double tolerance) override;
   double phi(int x, int y) const { return phi_[at(x, y)]; }
   double phi(Cell c) const override { return phi(c.x, c.y); }
+  double residual() const override { return residual_; }
 
  private:
   size_t at(int x, int y) const { return size_t(y + 1) * stride_ + size_t(x + 1); }
@@ -115,6 +120,7 @@ class Laplace final : public Potential {
   std::vector<double> phi_, bvec_, mask_;  // mask_: 1 on unknowns, 0 on fixed and pad cells
   std::vector<uint8_t> unknown_;           // padded; the pad is fixed at 0
   double bb_ = 0;                          // ||b||^2, kept up to date by fix()
+  double residual_ = 0;                    // ||r|| / ||b|| after the last solve
   std::vector<double> r_, z_, p_, ap_, e0_, rowTmp_;
   std::vector<Level> levels_;  // levels_[0] is unused: the fine level lives in the members
   Box dirty_;                  // fine cells fixed since the coarse operators were built

@@ -315,7 +315,7 @@ void Laplace3::residualFine(std::vector<double>& out) const {
     }
 }
 
-int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
+int Laplace3::solve(Solver solver, double tolerance) {
   // r = b - A phi = (sum of 6 neighbours) - 6 phi on unknowns (fixed neighbours carry b).
   residualFine(r_);
   const size_t n = phi_.size();
@@ -323,7 +323,7 @@ int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
   for (size_t i = 0; i < n; ++i) rr += r_[i] * r_[i];
   const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
-  const bool mg = solver == Solver::kMgpcg && levels_.size() > 1;
+  const bool mg = solver != Solver::kCg && levels_.size() > 1;
   const int maxIt = 20 * (w_ + h_ + d_) + 1000;
   auto precondition = [&] {
     if (mg) {
@@ -334,7 +334,7 @@ int Laplace3::solve(Solver solver, double tolerance, double* relResidual) {
     }
   };
   const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, precondition, [&] { return apply(p_, ap_); });
-  if (relResidual) *relResidual = std::sqrt(rr) / bnorm;
+  residual_ = std::sqrt(rr) / bnorm;
   return it;
 }
 

@@ -20,8 +20,9 @@ class Laplace3 final : public Potential {
   Laplace3(const Laplace3&) = delete;  // levels point into themselves
   Laplace3& operator=(const Laplace3&) = delete;
   void fix(Cell c, double value) override;
-  int solve(Solver solver, double tolerance, double* relResidual) override;
+  int solve(Solver solver, double tolerance) override;
   double phi(Cell c) const override { return phi_[at(c.x, c.y, c.z)]; }
+  double residual() const override { return residual_; }
   size_t bytes() const;
 
  private:
@@ -55,6 +56,7 @@ class Laplace3 final : public Potential {
   size_t sx_, sy_;
   std::vector<double> phi_, bvec_, mask_, r_, z_, p_, ap_, res_;
   double bb_ = 0;  // ||b||^2, kept up to date by fix()
+  double residual_ = 0;  // ||r|| / ||b|| after the last solve
   std::vector<uint8_t> unknown_;
   std::vector<Level> levels_;  // levels_[0] unused: the fine level lives in the members
   Box dirty_;

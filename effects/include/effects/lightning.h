@@ -16,8 +16,11 @@
 //            Defaults calibrated to DBM (docs/lightning-calibration.md): a = 1.2 per cell,
 //            candidates never expire; the paper's literal a = 2, lifetime 4 are kPaper*.
 //   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
-//            Phi = 1), warm-started; solver kMgpcg (multigrid-preconditioned CG) or kCg
-//            (plain CG, the baseline of Kim & Lin 2004 and of seed 002's comparison).
+//            Phi = 1). Solver kCapacitance (the default; 2-D): the exact solution by the
+//            capacitance-matrix method, one Cholesky row per step, while the fixed cells are
+//            few (about 4.5 sqrt(cells), at most 1024); past that, and in 3-D, MGPCG.
+//            kMgpcg: multigrid-preconditioned CG warm-started to `tolerance`; kCg: plain CG
+//            (the baseline of Kim & Lin 2004 and of seed 002's comparison).
 //   kCharges Kim et al. 2007: incremental point-charge potential, no linear solve.
 // Obstacles are cells the bolt may not enter. With guide kAstar (kAuto: when obstacles exist)
 // the fast and charges methods follow the turning points of an 8-connected A* path (seed
@@ -49,7 +52,7 @@ struct Cell {
 };
 
 enum class Method { kFast, kDbm, kCharges };
-enum class Solver { kMgpcg, kCg };
+enum class Solver { kMgpcg, kCg, kCapacitance };
 enum class Guide { kAuto, kAstar, kNone };
 
 // Seed 002's literal eqn 8 and lifetime (the `paper` variant): bolts thinner than DBM's.
@@ -84,6 +87,9 @@ double calibratedChargesEta(const Params& p);
 
 const char* toString(Method m);
 const char* toString(Solver s);
+// Working memory kDbm's capacitance solver may take on a 2-D grid beyond the iterative
+// solver's (its Cholesky factor, rows of G, the grid's table of G), for admission estimates.
+size_t capacitanceBytes(int width, int height);
 
 struct Params {
   int width = 128, height = 128;
@@ -108,8 +114,8 @@ struct Params {
                             // touch a target, how the A* guide moves, N's range (eqn 6);
                             // in 3-D 26 (faces, edges and corners) or 6 (faces)
   Guide guide = Guide::kAuto;
-  Solver solver = Solver::kMgpcg;  // kDbm
-  double tolerance = 1e-6;         // kDbm: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
+  Solver solver = Solver::kCapacitance;  // kDbm
+  double tolerance = 1e-6;  // kDbm, iterative solvers: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
   uint64_t seed = 1;
   size_t maxSteps = 2'000'000;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
@@ -144,7 +150,8 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height, i
 
 // ---- for tests and the error report --------------------------------------------------
 // Converged potential of the DBM problem for a given bolt (Phi = 0 on bolt, obstacles and
-// outside; 1 on target). Returns the full grid, row-major.
+// outside; 1 on target) by the given solver (kCapacitance: direct while its limit allows).
+// Returns the full grid, row-major.
 std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
                                  const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
                                  int* iterations = nullptr, double* residual = nullptr);

@@ -1,0 +1,213 @@
+// DBM's 2-D potential by the capacitance-matrix method (capacitance.h).
+#include "capacitance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace effects::lightning::detail {
+
+// The series runs over the n cells of the shorter axis (coordinate s = 1..n with the pad at 0
+// and n + 1): the 5-point operator's eigenvectors there are sin(theta_k s), theta_k =
+// pi k / (n + 1), k = 1..n, with squared norm (n + 1) / 2. Along the other axis (t = 1..m)
+// each mode leaves the 1-D operator d_k u_t - u_(t-1) - u_(t+1), d_k = 2 + 2 (1 - cos theta_k)
+// = 2 cosh mu_k, whose Green's function is
+//   g_k(t, t') = [cosh(mu_k (M - |t - t'|)) - cosh(mu_k (M - (t + t')))] / (2 sinh mu_k sinh(mu_k M)),
+// M = m + 1. With sin a sin b = [cos(a - b) - cos(a + b)] / 2,
+//   G = K(|s - s'|, |t - t'|) - K(s + s', |t - t'|) - K(|s - s'|, t + t') + K(s + s', t + t'),
+//   K(ds, dt) = 1 / (n + 1) sum_k cos(theta_k ds) h_k(dt),
+//   h_k(d) = cosh(mu_k (M - d)) / (2 sinh mu_k sinh(mu_k M))
+//          = (e^(-mu_k d) + e^(-mu_k (2M - d))) / (2 sinh mu_k (1 - e^(-2 mu_k M)))  (no overflow).
+BoxGreen::BoxGreen(int width, int height)
+    : transposed_(height < width),
+      n_(std::min(width, height)),
+      m_(std::max(width, height)),
+      stride_(size_t(2 * m_ + 1)) {
+  const int n = n_, m = m_, M = m + 1, period = 2 * (n + 1);
+  std::vector<double> cosine(static_cast<size_t>(period));
+  for (int j = 0; j < period; ++j) cosine[size_t(j)] = std::cos(M_PI * j / (n + 1));
+  std::vector<double> h(stride_);
+  k_.assign(size_t(2 * n + 1) * stride_, 0.0);
+  for (int k = 1; k <= n; ++k) {
+    // cosh mu = 2 - cos theta = 1 + delta, delta = 2 sin^2(theta / 2) (no cancellation).
+    const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
+    const double delta = 2 * half * half;
+    const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
+    const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
+    for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
+    for (int ds = 0; ds <= 2 * n; ++ds) {
+      const double c = cosine[size_t((k * ds) % period)] / (n + 1);
+      double* row = &k_[size_t(ds) * stride_];
+      for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
+    }
+  }
+}
+
+double BoxGreen::operator()(Cell a, Cell b) const {
+  const int sa = (transposed_ ? a.y : a.x) + 1, sb = (transposed_ ? b.y : b.x) + 1;
+  const int ta = (transposed_ ? a.x : a.y) + 1, tb = (transposed_ ? b.x : b.y) + 1;
+  const size_t ds = size_t(std::abs(sa - sb)) * stride_, ss = size_t(sa + sb) * stride_;
+  const size_t dt = size_t(std::abs(ta - tb)), st = size_t(ta + tb);
+  return (k_[ds + dt] - k_[ss + dt]) - (k_[ds + st] - k_[ss + st]);
+}
+
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height) {
+  // Keyed as a map of depth -1 with no obstacles: a table depends on the grid size only.
+  return std::static_pointer_cast<const BoxGreen>(cachedMap(
+      width, height, -1, {}, nullptr, [&] { return std::make_shared<const BoxGreen>(width, height); },
+      [](const void* t) { return static_cast<const BoxGreen*>(t)->bytes(); }));
+}
+
+namespace {
+// a . b. Two vectors of four partial sums (AVX2 where the CPU has it, chosen at load time):
+// a sum's additions no longer wait on each other. The order is fixed, so the value is too.
+using Four = double __attribute__((vector_size(32)));
+__attribute__((target_clones("avx2", "default"))) double dot(const double* a, const double* b, size_t n) {
+  Four s0{}, s1{};
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    Four a0, a1, b0, b1;
+    std::memcpy(&a0, a + i, sizeof a0), std::memcpy(&a1, a + i + 4, sizeof a1);
+    std::memcpy(&b0, b + i, sizeof b0), std::memcpy(&b1, b + i + 4, sizeof b1);
+    s0 += a0 * b0, s1 += a1 * b1;
+  }
+  s0 += s1;
+  double s = (s0[0] + s0[1]) + (s0[2] + s0[3]);
+  for (; i < n; ++i) s += a[i] * b[i];
+  return s;
+}
+size_t rowStart(size_t i) { return i * (i + 1) / 2; }
+}  // namespace
+
+size_t Capacitance::maxFixed(int width, int height) {
+  return std::clamp<size_t>(size_t(4.5 * std::sqrt(double(width) * double(height))), 64, 1024);
+}
+
+size_t Capacitance::maxBytes(int width, int height) {
+  const size_t m = maxFixed(width, height);
+  return 6 * m * m * sizeof(double);
+}
+
+Capacitance::Capacitance(int width, int height)
+    : w_(width),
+      h_(height),
+      maxFixed_(maxFixed(width, height)),
+      green_(cachedBoxGreen(width, height)),
+      fixedIndex_(size_t(width) * size_t(height)),
+      rowOf_(size_t(width) * size_t(height)) {}
+
+Capacitance::Row& Capacitance::row(Cell c) const {
+  const size_t i = size_t(c.y) * size_t(w_) + size_t(c.x);
+  int slot = rowOf_.get(i);
+  if (slot < 0) {
+    slot = int(rows_.size());
+    rowOf_.set(i, slot);
+    rows_.emplace_back();
+  }
+  Row& r = rows_[size_t(slot)];
+  for (; r.size < fixed_.size(); ++r.size) {
+    if (r.size % kBlock == 0) {
+      if (blocks_ % kBlocksPerPage == 0) pages_.emplace_back(new double[kBlocksPerPage * kBlock]);
+      r.blocks.push_back(blocks_++);
+    }
+    block(r.blocks.back())[r.size % kBlock] = (*green_)(c, fixed_[r.size]);
+  }
+  return r;
+}
+
+double Capacitance::dotQ(const Row& r, size_t n) const {
+  double s = 0;
+  for (size_t b = 0; b * kBlock < n; ++b) s += dot(block(r.blocks[b]), &q_[b * kBlock], std::min(kBlock, n - b * kBlock));
+  return s;
+}
+
+void Capacitance::handOver() {
+  fallback_ = std::make_unique<Laplace>(w_, h_);
+  for (size_t j = 0; j < fixed_.size(); ++j) fallback_->fix(fixed_[j], value_[j]);
+  // What only the direct solve needed goes.
+  for (auto* v : {&lower_, &y_, &q_}) std::vector<double>().swap(*v);
+  std::vector<Row>().swap(rows_);
+  std::vector<std::unique_ptr<double[]>>().swap(pages_);
+  rowOf_ = CellIndex();
+}
+
+void Capacitance::fix(Cell c, double value) {
+  if (fallback_) return fallback_->fix(c, value);
+  const size_t cell = size_t(c.y) * size_t(w_) + size_t(c.x);
+  if (const int j = fixedIndex_.get(cell); j >= 0) {  // a new value: y again from v
+    value_[size_t(j)] = value;
+    for (size_t i = 0; i < fixed_.size(); ++i)
+      y_[i] = (value_[i] - dot(&lower_[rowStart(i)], y_.data(), i)) / lower_[rowStart(i) + i];
+    return;
+  }
+  if (fixed_.size() >= maxFixed_ || (size_t(blocks_) * kBlock + lower_.capacity()) * sizeof(double) > maxBytes(w_, h_)) {
+    handOver();
+    return fallback_->fix(c, value);
+  }
+  // C gains the row g = G(c, fixed cells) and the diagonal G(c, c): L's new row l solves
+  // L l = g, its diagonal is sqrt(G(c, c) - l . l), and y gains (v - l . y) / that.
+  const size_t m = fixed_.size();
+  const Row& g = row(c);
+  if (lower_.empty()) lower_.reserve(rowStart(maxFixed_ + 1));  // no copies as it grows
+  lower_.resize(rowStart(m + 1));
+  double* l = &lower_[rowStart(m)];
+  for (size_t i = 0; i < m; ++i)
+    l[i] = (block(g.blocks[i / kBlock])[i % kBlock] - dot(&lower_[rowStart(i)], l, i)) / lower_[rowStart(i) + i];
+  const double d = (*green_)(c, c) - dot(l, l, m);
+  // C is positive definite (G is the inverse of a positive definite operator); d is G of c
+  // with the other fixed cells grounded, positive for any cell not yet fixed.
+  if (!(d > 1e-12 * (*green_)(c, c))) {
+    lower_.resize(rowStart(m));
+    handOver();
+    return fallback_->fix(c, value);
+  }
+  l[m] = std::sqrt(d);
+  y_.push_back((value - dot(l, y_.data(), m)) / l[m]);
+  fixed_.push_back(c);
+  value_.push_back(value);
+  fixedIndex_.set(cell, int(m));
+}
+
+int Capacitance::solve(Solver solver, double tolerance) {
+  if (fallback_) return fallback_->solve(solver, tolerance);
+  // L^T q = y by columns of L^T, i.e. rows of L: q_p, then y_i -= L_pi q_p for i < p.
+  const size_t m = fixed_.size();
+  q_ = y_;
+  for (size_t p = m; p-- > 0;) {
+    const double* l = &lower_[rowStart(p)];
+    const double qp = q_[p] /= l[p];
+    for (size_t i = 0; i < p; ++i) q_[i] -= l[i] * qp;
+  }
+  return 0;
+}
+
+double Capacitance::phi(Cell c) const {
+  if (fallback_) return fallback_->phi(c);
+  const size_t cell = size_t(c.y) * size_t(w_) + size_t(c.x);
+  if (const int j = fixedIndex_.get(cell); j >= 0) return value_[size_t(j)];
+  return dotQ(row(c), q_.size());
+}
+
+// ||C q - v|| / ||v|| over the fixed cells: the grid equations elsewhere hold by
+// construction of G, to its rounding.
+double Capacitance::residual() const {
+  if (fallback_) return fallback_->residual();
+  double rr = 0, vv = 0;
+  for (size_t j = 0; j < q_.size(); ++j) {
+    const double e = dotQ(row(fixed_[j]), q_.size()) - value_[j];
+    rr += e * e;
+    vv += value_[j] * value_[j];
+  }
+  return vv > 0 ? std::sqrt(rr / vv) : std::sqrt(rr);
+}
+
+}  // namespace effects::lightning::detail
+
+namespace effects::lightning {
+
+size_t capacitanceBytes(int width, int height) {
+  const size_t table = size_t(2 * std::min(width, height) + 1) * size_t(2 * std::max(width, height) + 1);
+  return detail::Capacitance::maxBytes(width, height) + table * sizeof(double);
+}
+
+}  // namespace effects::lightning

@@ -1,0 +1,91 @@
+// Private to effects/lightning: DBM's 2-D Dirichlet problem (laplace.h) solved directly by
+// the capacitance-matrix method (Buzbee, Dorr, George & Golub 1971; Proskurowski & Widlund
+// 1976): the potential is a sum of point sources at the fixed cells,
+//   phi(x) = sum_j q_j G(x, x_j),
+// with G the Green's function of the 5-point Laplacian on the whole box (0 outside), which is
+// known in closed form. The charges q solve C q = v, C_ij = G(x_i, x_j), v the fixed values,
+// so phi is the exact solution of the same discrete problem Laplace solves iteratively. DBM
+// fixes one cell a step: C grows by a row, its Cholesky factor by a row (O(m^2)), and phi at
+// the candidates is a dot product over the m fixed cells. docs/effects.md section 1.3.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "grid.h"
+#include "laplace.h"
+
+namespace effects::lightning::detail {
+
+// G(a, b) of a width x height grid, A G(., b) = e_b with A the 5-point operator (4 on the
+// diagonal) and 0 outside. A sine series along the shorter axis times the other axis's 1-D
+// Green's functions in closed form; the products of sines and of hyperbolic functions fold
+// into one table K(ds, dt) of (2n + 1) x (2m + 1) entries, so that G is four lookups.
+class BoxGreen {
+ public:
+  BoxGreen(int width, int height);
+  double operator()(Cell a, Cell b) const;
+  size_t bytes() const { return k_.size() * sizeof(double); }
+
+ private:
+  bool transposed_;  // the series runs along y (the shorter axis)
+  int n_, m_;        // series axis length, closed-form axis length
+  size_t stride_;    // 2 m + 1
+  std::vector<double> k_;
+};
+
+// The table of a grid size, kept beside the boundary maps (grid.h: cachedMap).
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height);
+
+class Capacitance final : public Potential {
+ public:
+  // A step costs O(m^2) here (phi at ~3 m candidates, each a dot product over the m fixed
+  // cells) and O(cells) in MGPCG: past maxFixed() fixed cells the problem goes to Laplace
+  // (MGPCG at the request's tolerance). About 4.5 sqrt(cells), where the two measured even
+  // (bench/lightning_bench at 64^2-256^2), and at most 1024.
+  static size_t maxFixed(int width, int height);
+  // Working memory at most: the Cholesky factor (maxFixed^2 / 2 entries) and the rows (about
+  // 4 maxFixed^2 at the limit: ~3 candidates and the cell itself per fixed cell), 6 maxFixed^2
+  // entries in all; rows beyond that hand over too.
+  static size_t maxBytes(int width, int height);
+
+  Capacitance(int width, int height);
+  void fix(Cell c, double value) override;
+  int solve(Solver solver, double tolerance) override;
+  double phi(Cell c) const override;
+  double residual() const override;
+  bool direct() const override { return !fallback_; }
+
+ private:
+  // G from a cell to the fixed cells, in the order they were fixed, kept per cell asked about
+  // (candidates and fixed cells) and extended as cells are fixed; stored in blocks of kBlock
+  // entries from a pool that only grows (no copies as rows lengthen).
+  static constexpr size_t kBlock = 64;
+  struct Row {
+    std::vector<uint32_t> blocks;  // pool blocks holding entries kBlock b .. kBlock (b + 1) - 1
+    size_t size = 0;
+  };
+  Row& row(Cell c) const;
+  double* block(uint32_t b) const { return pages_[b / kBlocksPerPage].get() + (b % kBlocksPerPage) * kBlock; }
+  // Row . q over the first n fixed cells.
+  double dotQ(const Row& r, size_t n) const;
+  void handOver();
+  static constexpr size_t kBlocksPerPage = 64;
+
+  int w_, h_;
+  size_t maxFixed_;
+  std::shared_ptr<const BoxGreen> green_;
+  std::vector<Cell> fixed_;
+  std::vector<double> value_;
+  CellIndex fixedIndex_;
+  std::vector<double> lower_;   // Cholesky factor of C, row by row (row i has i + 1 entries)
+  std::vector<double> y_;       // L y = v
+  std::vector<double> q_;       // L^T q = y, from the last solve
+  mutable CellIndex rowOf_;
+  mutable std::vector<Row> rows_;
+  mutable std::vector<std::unique_ptr<double[]>> pages_;
+  mutable uint32_t blocks_ = 0;  // pool blocks handed out
+  std::unique_ptr<Laplace> fallback_;
+};
+
+}  // namespace effects::lightning::detail
