@@ -189,15 +189,24 @@ double Capacitance::phi(Cell c) const {
 }
 
 // ||C q - v|| / ||v|| over the fixed cells: the grid equations elsewhere hold by
-// construction of G, to its rounding.
+// construction of G, to its rounding. C is symmetric and the row of the k-th fixed cell holds
+// C_kj for j < k (what it had when it was fixed), so C q needs no new values of G but the
+// diagonal.
 double Capacitance::residual() const {
   if (fallback_) return fallback_->residual();
-  double rr = 0, vv = 0;
-  for (size_t j = 0; j < q_.size(); ++j) {
-    const double e = dotQ(row(fixed_[j]), q_.size()) - value_[j];
-    rr += e * e;
-    vv += value_[j] * value_[j];
+  const size_t m = q_.size();
+  std::vector<double> cq(m, 0.0);
+  for (size_t k = 0; k < m; ++k) {
+    const Row& r = rows_[size_t(rowOf_.get(size_t(fixed_[k].y) * size_t(w_) + size_t(fixed_[k].x)))];
+    for (size_t j = 0; j < std::min(k, r.size); ++j) {
+      const double c = block(r.blocks[j / kBlock])[j % kBlock];
+      cq[j] += c * q_[k];
+      cq[k] += c * q_[j];
+    }
+    cq[k] += (*green_)(fixed_[k], fixed_[k]) * q_[k];
   }
+  double rr = 0, vv = 0;
+  for (size_t j = 0; j < m; ++j) rr += (cq[j] - value_[j]) * (cq[j] - value_[j]), vv += value_[j] * value_[j];
   return vv > 0 ? std::sqrt(rr / vv) : std::sqrt(rr);
 }
 

@@ -67,7 +67,7 @@ BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obst
   }
   if (size_t(width) * size_t(height) <= kMemoCells) {
     memoCells_ = size_t(width) * size_t(height);
-    memo_.reset(new std::atomic<float>[memoCells_]());
+    memo_.reset(memoCells_);
   }
 }
 
@@ -111,12 +111,12 @@ double BoundaryMap::visit(int level, int bx, int by, double px, double py) const
 
 double BoundaryMap::potential(int x, int y) const {
   const size_t i = size_t(y) * size_t(dw_ - 2) + size_t(x);
-  if (memo_)
-    if (float v = memo_[i].load(std::memory_order_relaxed); v != 0.0f) return v;
+  if (memoCells_)
+    if (float v = std::atomic_ref<float>(memo_[i]).load(std::memory_order_relaxed); v != 0.0f) return v;
   double px = x + 1.5, py = y + 1.5;  // domain coordinates of the cell centre
   const double v = visit(int(levels_.size()) + 1, 0, 0, px, py);
-  if (memo_) {
-    memo_[i].store(float(v), std::memory_order_relaxed);
+  if (memoCells_) {
+    std::atomic_ref<float>(memo_[i]).store(float(v), std::memory_order_relaxed);
     return float(v);  // the same value whether it came from the memo or not
   }
   return v;

@@ -132,7 +132,9 @@ class BoundaryMap {
   std::vector<uint8_t> quads_;
   std::vector<Level> levels_;  // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2
   size_t memoCells_ = 0;
-  std::unique_ptr<std::atomic<float>[]> memo_;  // 0 = not computed yet (a potential is > 0)
+  // 0 = not computed yet (a potential is > 0); read and written through std::atomic_ref by
+  // concurrent requests; calloc'd, so only the cells a bolt asks about are ever paged in.
+  mutable Zeroed<float> memo_;
 };
 
 // The boundary maps of recent (size, obstacle set) pairs, 2-D (depth 0) and 3-D, kept within
@@ -170,7 +172,7 @@ class VolumeBoundary {
   std::vector<Level> levels_;    // levels_[k]: blocks of 4 * 2^k voxels a side
   int w_, h_;                    // grid width and height (the memo's rows)
   size_t memoVoxels_ = 0;
-  std::unique_ptr<std::atomic<float>[]> memo_;  // 0 = not computed yet (a potential is > 0)
+  mutable Zeroed<float> memo_;  // as BoundaryMap's: 0 = not computed yet, atomic_ref, calloc'd
 };
 std::shared_ptr<const VolumeBoundary> cachedVolumeBoundary(int width, int height, int depth,
                                                            const std::vector<uint8_t>& obstacles, bool* hit);

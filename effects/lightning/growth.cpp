@@ -170,7 +170,7 @@ class Grower {
   detail::CellIndex nodeOf_, candidateOf_;
   detail::Zeroed<uint8_t> reserved_;
   std::vector<Candidate> cands_;
-  std::vector<float> boundaryMemo_;
+  detail::Zeroed<float> boundaryMemo_;  // kFast 2-D: B per cell once computed (0 = not yet)
   std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
   std::shared_ptr<const detail::VolumeBoundary> volumeMap_;  // 3-D
   std::unique_ptr<detail::Potential> laplace_, reference_;
@@ -641,7 +641,7 @@ std::optional<Error> Grower::run() {
     boundaryMap_ = detail::cachedBoundaryMap(p_.width, p_.height, p_.obstacles, &hit);
     bolt_.stats.counters["boundaryMapMs"] = w.ms();
     bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
-    boundaryMemo_.assign(g_.cells(), 0.0f);
+    boundaryMemo_.reset(g_.cells());
   }
   addNode(p_.start, -1);
   for (size_t k = 0; k < p_.targets.size(); ++k) {

@@ -69,7 +69,7 @@ VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vect
   }
   if (size_t(width) * size_t(height) * size_t(depth) <= kMemoVoxels) {
     memoVoxels_ = size_t(width) * size_t(height) * size_t(depth);
-    memo_.reset(new std::atomic<float>[memoVoxels_]());
+    memo_.reset(memoVoxels_);
   }
 }
 
@@ -104,12 +104,12 @@ double VolumeBoundary::visit(int level, int bx, int by, int bz, double px, doubl
 
 double VolumeBoundary::potential(int x, int y, int z) const {
   const size_t m = (size_t(z) * size_t(h_) + size_t(y)) * size_t(w_) + size_t(x);
-  if (memo_)
-    if (float v = memo_[m].load(std::memory_order_relaxed); v != 0.0f) return v;
+  if (memoVoxels_)
+    if (float v = std::atomic_ref<float>(memo_[m]).load(std::memory_order_relaxed); v != 0.0f) return v;
   // Grid voxel (x, y, z) is domain voxel (x + 1, y + 1, z + 1); its centre is + 0.5.
   const double v = visit(int(levels_.size()) - 1, 0, 0, 0, x + 1.5, y + 1.5, z + 1.5);
-  if (memo_) {
-    memo_[m].store(float(v), std::memory_order_relaxed);
+  if (memoVoxels_) {
+    std::atomic_ref<float>(memo_[m]).store(float(v), std::memory_order_relaxed);
     return float(v);  // the same value whether it came from the memo or not
   }
   return v;
