@@ -27,6 +27,9 @@ BUILD = os.environ.get("BUILD_DIR", os.path.join(ROOT, "build"))
 
 
 REPETITIONS = 3  # each figure is the median of 3 repetitions: this machine's timings wander
+# The server's allocator settings (server/idle_trim.cpp): freed blocks up to 32 MB stay in one
+# heap between calls instead of being faulted in again by the next one.
+ALLOCATOR = {"MALLOC_MMAP_THRESHOLD_": str(32 << 20), "MALLOC_TRIM_THRESHOLD_": str(1 << 30), "MALLOC_ARENA_MAX": "1"}
 
 
 def bench(name, filt):
@@ -34,7 +37,7 @@ def bench(name, filt):
     cmd = [os.path.join(BUILD, "bench", name), "--benchmark_format=json", f"--benchmark_filter={filt}",
            f"--benchmark_repetitions={REPETITIONS}", "--benchmark_report_aggregates_only=true"]
     print("running", " ".join(cmd[0:1] + cmd[2:3]), file=sys.stderr)
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True, env={**os.environ, **ALLOCATOR}).stdout
     return {b["run_name"]: b for b in json.loads(out)["benchmarks"] if b.get("aggregate_name") == "median"}
 
 
@@ -126,7 +129,8 @@ def main():
     except (OSError, AttributeError):
         pass
     lines = [f"Measured {when} by `scripts/bench-table.py` on {os.cpu_count()} × {cpu} ({platform.system()}), "
-             "Release build, medians of 3 repetitions; every ratio is between two figures of that one run.", "",
+             "Release build, medians of 3 repetitions, the server's allocator settings (docs/architecture.md, "
+             "memory between requests); every ratio is between two figures of that one run.", "",
              "| figure | effectd | baseline or peer (same run) | ratio | goal |", "|---|---|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     films = sorted((int(n.split("/")[1]), b) for n, b in bb.items() if n.startswith("BM_ThinFilm256/"))

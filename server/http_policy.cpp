@@ -4,7 +4,6 @@
 // metrics and the access log; the admission and cache gauges on /metrics.
 #include <httplib.h>
 
-#include <malloc.h>
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -23,8 +22,6 @@ namespace {
 // half empty: ~4x the text for arrays of short numbers), and the canonical text for the ETag.
 constexpr size_t kJsonBodyFactor = 6;
 constexpr size_t kBinaryBodyFactor = 2;  // the bytes and the buffers decoded from them
-// After a request that reserved this much, free heap pages go back to the system at once.
-constexpr size_t kTrimAfterBytes = 32u << 20;
 // Headers a browser on another origin may read (CORS), and may send.
 constexpr const char* kExposedHeaders =
     "ETag, Server-Timing, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, X-Render-Passes, "
@@ -273,11 +270,9 @@ void Service::finishRequest(const httplib::Request& req, const httplib::Response
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tl.start).count();
   metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
   if (config_.accessLog) writeAccessLog(req, res, tl.requestId, seconds);
-  const bool large = tl.bodyTicket.bytes() + tl.workTicket.bytes() >= kTrimAfterBytes;
+  const bool reserved = tl.bodyTicket.bytes() + tl.workTicket.bytes() > 0;  // GETs (/metrics) reserve none
   tl = RequestState{};  // releases the reservations: the answer has been written
-  // glibc keeps freed heap pages in its per-thread arenas; after a large request, hand
-  // them back now rather than holding the burst's peak for good.
-  if (large) malloc_trim(0);
+  if (reserved) idleTrim_->noteFinished();  // its memory goes back once the server is idle (idle_trim.h)
 }
 
 }  // namespace effectd

@@ -2,7 +2,6 @@
 //   effectd [serve] [flags]                          serve HTTP until SIGTERM/SIGINT
 //   effectd render SCENE.json -o OUT.png [flags]     render a scene without a server
 //   effectd --help
-#include <malloc.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -15,6 +14,7 @@
 
 #include "config.h"
 #include "endpoints.h"
+#include "idle_trim.h"
 #include "playground.h"
 #include "scene.h"
 #include "service.h"
@@ -155,12 +155,7 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
 
-  // glibc raises its mmap threshold each time a large block is freed (up to 32 MB), after which
-  // big request buffers come from the per-thread arenas and stay there: after a burst of 10 MB
-  // bodies, level-7 meshes and 4096^2 bolts RSS sat at 389 MB from a 206 MB start. A fixed
-  // threshold keeps blocks over 256 KB in mmap, returned on free (230 MB five seconds after
-  // the same burst; tests/memory_test.py). malloc_trim after large requests does the rest.
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+  effectd::IdleTrim::configureAllocator();  // freed memory kept while busy, returned when idle
 
   effectd::Service service(config);
   effectd::addEffectEndpoints(service);

@@ -171,13 +171,20 @@ Service::Service(Config config)
       admission_(std::make_unique<Admission>(admissionOptions(config_))),
       cache_(config_.responseCacheMb << 20),
       http_(std::make_unique<httplib::Server>()),
-      compute_(std::make_unique<effects::ThreadPool>(std::max(1u, std::thread::hardware_concurrency()) - 1)) {
+      compute_(std::make_unique<effects::ThreadPool>(std::max(1u, std::thread::hardware_concurrency()) - 1)),
+      idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())
     if (name.rfind("schemas/", 0) == 0) docs[name.substr(8)] = std::string(data);
   schemas_ = std::make_unique<SchemaRegistry>(docs);
   installCore();
   installHttpPolicy();
+  metrics_.addSource([this] {
+    return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
+           "# TYPE effectd_memory_trims_total counter\n"
+           "effectd_memory_trims_total " +
+           std::to_string(idleTrim_->trims()) + "\n";
+  });
 }
 
 Service::~Service() = default;

@@ -16,6 +16,7 @@
 
 #include "admission.h"
 #include "config.h"
+#include "idle_trim.h"
 #include "metrics.h"
 #include "problem.h"
 #include "response_cache.h"
@@ -134,6 +135,7 @@ class Service {
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
+  std::unique_ptr<IdleTrim> idleTrim_;
   int listenSocket_ = -1;                         // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
