@@ -359,7 +359,8 @@ TEST(Lightning, CapacitanceIsTheExactSolution) {
   // solution equals MGPCG converged to 1e-13 and is discrete harmonic off the fixed cells to
   // rounding.
   effects::Rng rng(11);
-  for (auto [w, h] : {std::pair{32, 32}, {97, 41}, {30, 200}}) {
+  for (const auto& size : {std::pair{32, 32}, {97, 41}, {30, 200}}) {
+    const int w = size.first, h = size.second;  // not a structured binding: lambdas capture them below
     std::vector<uint8_t> obstacles(size_t(w) * size_t(h), 0);
     for (int k = 0; k < 40; ++k) obstacles[size_t(rng.uniform() * w * (h - 2))] = 1;
     std::vector<Cell> bolt;
