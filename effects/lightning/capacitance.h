@@ -42,7 +42,7 @@ class Capacitance final : public Potential {
   // A step costs O(m^2) here (phi at ~3 m candidates, each a dot product over the m fixed
   // cells) and O(cells) in MGPCG: past maxFixed() fixed cells the problem goes to Laplace
   // (MGPCG at the request's tolerance). About 4.5 sqrt(cells), where the two measured even
-  // (bench/lightning_bench at 64^2-256^2), and at most 1024.
+  // (bolts at 64^2-256^2 handed over at several limits), and at most 1024.
   static size_t maxFixed(int width, int height);
   // Working memory at most: the Cholesky factor (maxFixed^2 / 2 entries) and the rows (about
   // 4 maxFixed^2 at the limit: ~3 candidates and the cell itself per fixed cell), 6 maxFixed^2
