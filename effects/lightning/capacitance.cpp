@@ -92,12 +92,13 @@ Capacitance::Capacitance(int width, int height)
     : w_(width),
       h_(height),
       maxFixed_(maxFixed(width, height)),
+      maxBytes_(maxBytes(width, height)),
       green_(cachedBoxGreen(width, height)),
       fixedIndex_(size_t(width) * size_t(height)),
       rowOf_(size_t(width) * size_t(height)) {}
 
 Capacitance::Row& Capacitance::row(Cell c) const {
-  const size_t i = size_t(c.y) * size_t(w_) + size_t(c.x);
+  const size_t i = at(c);
   int slot = rowOf_.get(i);
   if (slot < 0) {
     slot = int(rows_.size());
@@ -133,14 +134,14 @@ void Capacitance::handOver() {
 
 void Capacitance::fix(Cell c, double value) {
   if (fallback_) return fallback_->fix(c, value);
-  const size_t cell = size_t(c.y) * size_t(w_) + size_t(c.x);
+  const size_t cell = at(c);
   if (const int j = fixedIndex_.get(cell); j >= 0) {  // a new value: y again from v
     value_[size_t(j)] = value;
     for (size_t i = 0; i < fixed_.size(); ++i)
       y_[i] = (value_[i] - dot(&lower_[rowStart(i)], y_.data(), i)) / lower_[rowStart(i) + i];
     return;
   }
-  if (fixed_.size() >= maxFixed_ || (size_t(blocks_) * kBlock + lower_.capacity()) * sizeof(double) > maxBytes(w_, h_)) {
+  if (fixed_.size() >= maxFixed_ || (size_t(blocks_) * kBlock + lower_.capacity()) * sizeof(double) > maxBytes_) {
     handOver();
     return fallback_->fix(c, value);
   }
@@ -152,7 +153,7 @@ void Capacitance::fix(Cell c, double value) {
   lower_.resize(rowStart(m + 1));
   double* l = &lower_[rowStart(m)];
   for (size_t i = 0; i < m; ++i)
-    l[i] = (block(g.blocks[i / kBlock])[i % kBlock] - dot(&lower_[rowStart(i)], l, i)) / lower_[rowStart(i) + i];
+    l[i] = (entry(g, i) - dot(&lower_[rowStart(i)], l, i)) / lower_[rowStart(i) + i];
   const double d = (*green_)(c, c) - dot(l, l, m);
   // C is positive definite (G is the inverse of a positive definite operator); d is G of c
   // with the other fixed cells grounded, positive for any cell not yet fixed.
@@ -183,8 +184,7 @@ int Capacitance::solve(Solver solver, double tolerance) {
 
 double Capacitance::phi(Cell c) const {
   if (fallback_) return fallback_->phi(c);
-  const size_t cell = size_t(c.y) * size_t(w_) + size_t(c.x);
-  if (const int j = fixedIndex_.get(cell); j >= 0) return value_[size_t(j)];
+  if (const int j = fixedIndex_.get(at(c)); j >= 0) return value_[size_t(j)];
   return dotQ(row(c), q_.size());
 }
 
@@ -197,9 +197,9 @@ double Capacitance::residual() const {
   const size_t m = q_.size();
   std::vector<double> cq(m, 0.0);
   for (size_t k = 0; k < m; ++k) {
-    const Row& r = rows_[size_t(rowOf_.get(size_t(fixed_[k].y) * size_t(w_) + size_t(fixed_[k].x)))];
+    const Row& r = rows_[size_t(rowOf_.get(at(fixed_[k])))];
     for (size_t j = 0; j < std::min(k, r.size); ++j) {
-      const double c = block(r.blocks[j / kBlock])[j % kBlock];
+      const double c = entry(r, j);
       cq[j] += c * q_[k];
       cq[k] += c * q_[j];
     }

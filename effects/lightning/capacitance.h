@@ -67,13 +67,15 @@ class Capacitance final : public Potential {
   };
   Row& row(Cell c) const;
   double* block(uint32_t b) const { return pages_[b / kBlocksPerPage].get() + (b % kBlocksPerPage) * kBlock; }
+  double entry(const Row& r, size_t j) const { return block(r.blocks[j / kBlock])[j % kBlock]; }
+  size_t at(Cell c) const { return size_t(c.y) * size_t(w_) + size_t(c.x); }
   // Row . q over the first n fixed cells.
   double dotQ(const Row& r, size_t n) const;
   void handOver();
   static constexpr size_t kBlocksPerPage = 64;
 
   int w_, h_;
-  size_t maxFixed_;
+  size_t maxFixed_, maxBytes_;
   std::shared_ptr<const BoxGreen> green_;
   std::vector<Cell> fixed_;
   std::vector<double> value_;
