@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <list>
 #include <mutex>
@@ -10,17 +11,20 @@
 namespace effects::lightning {
 namespace detail {
 
-BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles)
+BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>* obstacles)
     : dw_(width + 2), dh_(height + 2), qw_((dw_ + 1) / 2), qh_((dh_ + 1) / 2) {
   quads_.assign(size_t(qw_) * size_t(qh_), 0);
   auto put = [&](int dx, int dy) {
     quads_[size_t(dy / 2) * size_t(qw_) + size_t(dx / 2)] |= uint8_t(1u << ((dx & 1) + 2 * (dy & 1)));
   };
-  for (int dy = 0; dy < dh_; ++dy)
-    for (int dx = 0; dx < dw_; ++dx)
-      if (dx == 0 || dy == 0 || dx == dw_ - 1 || dy == dh_ - 1 ||
-          (!obstacles.empty() && obstacles[size_t(dy - 1) * size_t(width) + size_t(dx - 1)]))
-        put(dx, dy);
+  if (obstacles) {
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        if ((*obstacles)[size_t(y) * size_t(width) + size_t(x)]) put(x + 1, y + 1);
+  } else {
+    for (int dx = 0; dx < dw_; ++dx) put(dx, 0), put(dx, dh_ - 1);
+    for (int dy = 1; dy + 1 < dh_; ++dy) put(0, dy), put(dw_ - 1, dy);
+  }
   // 4x4 blocks straight from the cells, then 2x2 of the level below.
   Level l{(dw_ + 3) / 4, (dh_ + 3) / 4, {}, {}, {}};
   const size_t n = size_t(l.w) * size_t(l.h);
@@ -109,7 +113,8 @@ double BoundaryMap::visit(int level, int bx, int by, double px, double py) const
   return sum;
 }
 
-double BoundaryMap::potential(int x, int y) const {
+double BoundaryMap::potential(Cell c) const {
+  const int x = c.x, y = c.y;
   const size_t i = size_t(y) * size_t(dw_ - 2) + size_t(x);
   if (memoCells_)
     if (float v = std::atomic_ref<float>(memo_[i]).load(std::memory_order_relaxed); v != 0.0f) return v;
@@ -122,17 +127,33 @@ double BoundaryMap::potential(int x, int y) const {
   return v;
 }
 
-std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
+std::vector<uint64_t> obstacleBits(const std::vector<uint8_t>& obstacles) {
+  std::vector<uint64_t> bits((obstacles.size() + 63) / 64, 0);
+  uint64_t any = 0;
+  for (size_t i = 0; i < obstacles.size(); i += 8) {
+    uint64_t v = 0;
+    std::memcpy(&v, obstacles.data() + i, std::min<size_t>(8, obstacles.size() - i));
+    // 0x80 in each non-zero byte, then byte k's to bit k (the products do not overlap).
+    const uint64_t nonzero = (((v & 0x7f7f7f7f7f7f7f7full) + 0x7f7f7f7f7f7f7f7full) | v) & 0x8080808080808080ull;
+    const uint64_t byte = ((nonzero >> 7) * 0x0102040810204080ull) >> 56;
+    bits[i / 64] |= byte << (i % 64);
+    any |= byte;
+  }
+  if (!any) bits.clear();
+  return bits;
+}
+
+std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint64_t>& obstacleKey,
                                       bool* hit, const std::function<std::shared_ptr<const void>()>& build,
                                       size_t (*mapBytes)(const void*)) {
   // Least recently used first out, bounded in bytes (maps and their keys); 2-D and 3-D maps
   // share the budget.
   struct Entry {
     int w, h, d;
-    std::vector<uint8_t> obstacles;  // compared with memcmp: a millisecond at 4096^2
+    std::vector<uint64_t> key;
     std::shared_ptr<const void> map;
     size_t mapBytes;
-    size_t bytes() const { return obstacles.size() + mapBytes; }
+    size_t bytes() const { return key.size() * sizeof(uint64_t) + mapBytes; }
   };
   static std::mutex mu;
   static std::list<Entry> lru;  // most recent first
@@ -140,7 +161,7 @@ std::shared_ptr<const void> cachedMap(int width, int height, int depth, const st
   {
     std::lock_guard<std::mutex> lock(mu);
     for (auto it = lru.begin(); it != lru.end(); ++it) {
-      if (it->w == width && it->h == height && it->d == depth && it->obstacles == obstacles) {
+      if (it->w == width && it->h == height && it->d == depth && it->key == obstacleKey) {
         lru.splice(lru.begin(), lru, it);
         if (hit) *hit = true;
         return lru.front().map;
@@ -149,7 +170,7 @@ std::shared_ptr<const void> cachedMap(int width, int height, int depth, const st
   }
   if (hit) *hit = false;
   std::shared_ptr<const void> map = build();  // built outside the lock
-  Entry entry{width, height, depth, obstacles, map, mapBytes(map.get())};
+  Entry entry{width, height, depth, obstacleKey, map, mapBytes(map.get())};
   if (entry.bytes() > kBudgetBytes) return map;  // used by this request only
   std::lock_guard<std::mutex> lock(mu);
   lru.push_front(std::move(entry));
@@ -164,12 +185,37 @@ std::shared_ptr<const void> cachedMap(int width, int height, int depth, const st
   return map;
 }
 
-std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
-                                                     bool* hit) {
-  return std::static_pointer_cast<const BoundaryMap>(cachedMap(
-      width, height, 0, obstacles, hit,
-      [&] { return std::make_shared<const BoundaryMap>(width, height, obstacles); },
-      [](const void* m) { return static_cast<const BoundaryMap*>(m)->bytes(); }));
+namespace {
+// The border's map (key: no obstacles) and, where any cell is blocked, the obstacles' map,
+// of a 2-D (depth 0) or 3-D grid.
+template <class Map, class Make>
+SceneBoundary<Map> sceneBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
+                                 const Make& make) {
+  SceneBoundary<Map> b;
+  auto bytes = [](const void* m) { return static_cast<const Map*>(m)->bytes(); };
+  auto get = [&](const std::vector<uint64_t>& key, const std::vector<uint8_t>* cells) {
+    bool hit = false;
+    auto map = std::static_pointer_cast<const Map>(
+        cachedMap(width, height, depth, key, &hit, [&] { return make(cells); }, bytes));
+    b.cached = b.cached && hit;
+    return map;
+  };
+  b.border = get({}, nullptr);
+  if (std::vector<uint64_t> key = obstacleBits(obstacles); !key.empty()) b.obstacles = get(key, &obstacles);
+  return b;
+}
+}  // namespace
+
+SceneBoundary<BoundaryMap> cachedBoundary(int width, int height, const std::vector<uint8_t>& obstacles) {
+  return sceneBoundary<BoundaryMap>(width, height, 0, obstacles, [&](const std::vector<uint8_t>* cells) {
+    return std::make_shared<const BoundaryMap>(width, height, cells);
+  });
+}
+
+SceneBoundary<VolumeBoundary> cachedBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles) {
+  return sceneBoundary<VolumeBoundary>(width, height, depth, obstacles, [&](const std::vector<uint8_t>* cells) {
+    return std::make_shared<const VolumeBoundary>(width, height, depth, cells);
+  });
 }
 
 bool lineOfSight(const Grid& g, Cell a, Cell b) {
@@ -231,10 +277,11 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
   detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
   const detail::Stencil st = detail::stencil(neighbourhood);
   const size_t n = g.cells();
-  // Zeroed: a 3-D search touches the pages around its path only. cost[j] holds only once seen[j].
-  detail::Zeroed<float> cost(n);
-  detail::Zeroed<uint8_t> seen(n);
-  detail::CellIndex parent(n);
+  struct Visit {
+    float cost;
+    int32_t parent;  // + 1; 0: not seen yet
+  };
+  detail::CellMap<Visit> visits(n);  // a search on a large grid touches the cells around its path only
   const bool manhattan = st.size == 4 || st.size == 6;
   auto h = [&](Cell c) {
     double dx = std::abs(c.x - to.x), dy = std::abs(c.y - to.y), dz = std::abs(c.z - to.z);
@@ -250,38 +297,41 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
   using Item = std::pair<double, int32_t>;  // f, index (ties: smaller index first: deterministic)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
   size_t s = g.index(from), t = g.index(to);
-  cost[s] = 0;
-  seen[s] = 1;
+  visits.at(s) = {0.0f, int32_t(s) + 1};  // the start is its own parent: the walk back stops there
   open.push({h(from), int32_t(s)});
   while (!open.empty()) {
     auto [f, i] = open.top();
     open.pop();
     const Cell c = g.cellAt(size_t(i));
-    if (f > cost[size_t(i)] + h(c) + 1e-6) continue;  // stale entry
+    const float ci = visits.get(size_t(i)).cost;
+    if (f > ci + h(c) + 1e-6) continue;  // stale entry
     if (size_t(i) == t) break;
     for (int k = 0; k < st.size; ++k) {
       const Cell m{c.x + st.dx[k], c.y + st.dy[k], c.z + st.dz[k]};
       if (!g.inside(m.x, m.y, m.z) || g.blocked(m.x, m.y, m.z)) continue;
       size_t j = g.index(m);
       float step = kStep[(st.dx[k] != 0) + (st.dy[k] != 0) + (st.dz[k] != 0)];
-      float cj = cost[size_t(i)] + step;
-      if (!seen[j] || cj < cost[j]) {
-        seen[j] = 1;
-        cost[j] = cj;
-        parent.set(j, i);
+      float cj = ci + step;
+      if (Visit& v = visits.at(j); v.parent == 0 || cj < v.cost) {
+        v = {cj, i + 1};
         open.push({cj + h(m), int32_t(j)});
       }
     }
   }
-  if (parent.get(t) < 0 && s != t) return {};
+  if (visits.get(t).parent == 0) return {};
   std::vector<Cell> path;
-  for (int32_t i = int32_t(t); i >= 0; i = parent.get(size_t(i))) path.push_back(g.cellAt(size_t(i)));
+  for (size_t i = t;; i = size_t(visits.get(i).parent - 1)) {
+    path.push_back(g.cellAt(i));
+    if (i == s) break;
+  }
   std::reverse(path.begin(), path.end());
   return path;
 }
 
 double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c) {
-  return detail::BoundaryMap(width, height, obstacles).potential(c.x, c.y);
+  const detail::BoundaryMap border(width, height, nullptr);
+  if (detail::obstacleBits(obstacles).empty()) return border.potential(c);
+  return border.potential(c) + detail::BoundaryMap(width, height, &obstacles).potential(c);
 }
 
 }  // namespace effects::lightning

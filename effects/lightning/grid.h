@@ -35,15 +35,87 @@ class Zeroed {
   std::unique_ptr<T[], Free> p_;
 };
 
-// A per-cell index, -1 where unset, over Zeroed memory (stored + 1).
+// A value per cell, zero until set, for the bookkeeping of one request (bolt and candidate
+// cells, A*'s search). A bolt touches a sliver of a large grid, and a flat array of a 4096^2
+// or 128^3 grid costs more to clear (or to fault in) than growing the bolt. So on grids of
+// more than kDenseCells it starts as an open-addressed hash table of the cells set, and turns
+// into the flat array once the table would outgrow half that array (a search that floods the
+// grid): at most 1.5 times the array's memory, while both exist.
+template <class T>
+class CellMap {
+ public:
+  static constexpr size_t kDenseCells = size_t(1) << 18;
+  explicit CellMap(size_t cells = 0) : cells_(cells) {
+    if (cells <= kDenseCells) {
+      dense_.reset(cells);
+      isDense_ = true;
+    } else {
+      rehash(1024);
+    }
+  }
+  T get(size_t i) const {
+    if (isDense_) return dense_[i];
+    for (size_t s = slot(i);; s = (s + 1) & (keys_.size() - 1)) {
+      if (keys_[s] == i) return values_[s];
+      if (keys_[s] == kEmpty) return T{};
+    }
+  }
+  T& at(size_t i) {  // the cell's value, set from now on
+    if (isDense_) return dense_[i];
+    size_t s = slot(i);
+    for (; keys_[s] != kEmpty; s = (s + 1) & (keys_.size() - 1))
+      if (keys_[s] == i) return values_[s];
+    if (2 * (size_ + 1) > keys_.size()) {
+      grow();
+      return at(i);
+    }
+    ++size_;
+    keys_[s] = uint32_t(i);
+    values_[s] = T{};
+    return values_[s];
+  }
+
+ private:
+  static constexpr uint32_t kEmpty = UINT32_MAX;  // grids have fewer than 2^30 cells
+  size_t slot(size_t i) const { return size_t((uint64_t(i) * 0x9E3779B97F4A7C15ull) >> shift_); }
+  void rehash(size_t capacity) {
+    std::vector<uint32_t> keys(capacity, kEmpty);
+    std::vector<T> values(capacity);
+    keys_.swap(keys);
+    values_.swap(values);
+    shift_ = 64 - __builtin_ctzll(capacity);
+    size_ = 0;
+    for (size_t s = 0; s < keys.size(); ++s)
+      if (keys[s] != kEmpty) at(keys[s]) = values[s];
+  }
+  void grow() {
+    const size_t capacity = 2 * keys_.size();
+    if (2 * capacity * (sizeof(uint32_t) + sizeof(T)) <= cells_ * sizeof(T)) return rehash(capacity);
+    dense_.reset(cells_);
+    for (size_t s = 0; s < keys_.size(); ++s)
+      if (keys_[s] != kEmpty) dense_[keys_[s]] = values_[s];
+    isDense_ = true;
+    std::vector<uint32_t>().swap(keys_);
+    std::vector<T>().swap(values_);
+  }
+  size_t cells_;
+  bool isDense_ = false;
+  Zeroed<T> dense_{0};
+  std::vector<uint32_t> keys_;
+  std::vector<T> values_;
+  size_t size_ = 0;
+  int shift_ = 0;
+};
+
+// A per-cell index, -1 where unset (stored + 1).
 class CellIndex {
  public:
   explicit CellIndex(size_t n = 0) : v_(n) {}
-  int32_t get(size_t i) const { return v_[i] - 1; }
-  void set(size_t i, int32_t value) { v_[i] = value + 1; }
+  int32_t get(size_t i) const { return v_.get(i) - 1; }
+  void set(size_t i, int32_t value) { v_.at(i) = value + 1; }
 
  private:
-  Zeroed<int32_t> v_;
+  CellMap<int32_t> v_;
 };
 
 struct Grid {
@@ -101,19 +173,20 @@ inline bool touching(Cell a, Cell b, int neighbourhood) {
 }
 
 // Seed 002 eqn 4: potential of the negative charges on the grid border (a ring of cells just
-// outside the grid) and on obstacle cells, sum of 1/r. A pyramid of charge counts and
-// centroids answers a query in O(log n) blocks (Barnes-Hut), so 1024^2 grids with 20 %
-// obstacles cost milliseconds; the pyramid depends only on the grid and obstacles and is
-// cached per (size, obstacle set) within 64 MB. Memory: a 4-bit charge mask per 2x2 cells
-// (cells and 2x2 blocks are derived from it on the fly) and stored floats from 4x4 blocks up,
-// about 1 byte per cell (17 MB at 4096^2); the cache keeps the obstacle grid as its key.
+// outside the grid) and on obstacle cells, sum of 1/r. A scene's B adds two maps
+// (SceneBoundary): the border's, which depends on the grid size only, and its obstacles'.
+// A map is a pyramid of charge counts and centroids that answers a query in O(log n) blocks
+// (Barnes-Hut), so 1024^2 grids with 20 % obstacles cost milliseconds. Memory: a 4-bit
+// charge mask per 2x2 cells (cells and 2x2 blocks are derived from it on the fly) and stored
+// floats from 4x4 blocks up, about 1 byte per cell (17 MB at 4096^2).
 class BoundaryMap {
  public:
-  BoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles);
+  // obstacles == nullptr: the border's charges; otherwise the obstacle cells' alone.
+  BoundaryMap(int width, int height, const std::vector<uint8_t>* obstacles);
   // Thread-safe; on grids up to kMemoCells the value of each cell is kept once computed, so
   // every request on a cached map shares the work (stores are of the same value: races are
   // benign, the atomics make them defined).
-  double potential(int x, int y) const;
+  double potential(Cell c) const;
   static constexpr size_t kMemoCells = size_t(1) << 20;
   size_t bytes() const;
 
@@ -137,27 +210,19 @@ class BoundaryMap {
   mutable Zeroed<float> memo_;
 };
 
-// The boundary maps of recent (size, obstacle set) pairs, 2-D (depth 0) and 3-D, kept within
-// 64 MB in all, least recently used first out: build() makes a missing one; *hit says whether
-// it was there.
-std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
-                                      bool* hit, const std::function<std::shared_ptr<const void>()>& build,
-                                      size_t (*mapBytes)(const void*));
-std::shared_ptr<const BoundaryMap> cachedBoundaryMap(int width, int height, const std::vector<uint8_t>& obstacles,
-                                                     bool* hit);
-
 // Seed 002 eqn 4 in 3-D: sum of 1/r over the shell of voxels around the grid and the obstacle
-// voxels. An octree of charge counts and centroids (blocks of 4^3 voxels and up) answers a
-// query in O(log n) blocks with the opening angle of the 2-D map; blocks nearer than two of
-// their sides are summed voxel by voxel. Memory: one byte per voxel of the padded grid and
-// 16 bytes per 4^3 block (about 1.3 bytes per voxel), and on grids up to kMemoVoxels the
-// memo of 4 bytes per voxel (as BoundaryMap's: each voxel's value kept once computed, shared
-// by every request on a cached map; the value is then a float's whether it came from the memo
-// or not).
+// voxels, as in 2-D two maps that add: the shell's and the obstacles'. An octree of charge
+// counts and centroids (blocks of 4^3 voxels and up) answers a query in O(log n) blocks with
+// the opening angle of the 2-D map; blocks nearer than two of their sides are summed voxel by
+// voxel. Memory: one byte per voxel of the padded grid and 16 bytes per 4^3 block (about 1.3
+// bytes per voxel), and on grids up to kMemoVoxels the memo of 4 bytes per voxel (as
+// BoundaryMap's: each voxel's value kept once computed, shared by every request on a cached
+// map; the value is then a float's whether it came from the memo or not).
 class VolumeBoundary {
  public:
-  VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles);
-  double potential(int x, int y, int z) const;  // thread-safe
+  // obstacles == nullptr: the shell's charges; otherwise the obstacle voxels' alone.
+  VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>* obstacles);
+  double potential(Cell c) const;  // thread-safe
   static constexpr size_t kMemoVoxels = size_t(1) << 21;  // 128^3
   size_t bytes() const;
 
@@ -174,8 +239,30 @@ class VolumeBoundary {
   size_t memoVoxels_ = 0;
   mutable Zeroed<float> memo_;  // as BoundaryMap's: 0 = not computed yet, atomic_ref, calloc'd
 };
-std::shared_ptr<const VolumeBoundary> cachedVolumeBoundary(int width, int height, int depth,
-                                                           const std::vector<uint8_t>& obstacles, bool* hit);
+
+// The cache's key for an obstacle grid: one bit a cell (an obstacle is any non-zero byte),
+// empty where no cell is blocked.
+std::vector<uint64_t> obstacleBits(const std::vector<uint8_t>& obstacles);
+
+// Maps and tables of recent keys (size, obstacle bits), 2-D (depth 0), 3-D and others (the
+// caller's choice of depth), kept within 64 MB in all, least recently used first out:
+// build() makes a missing one; *hit says whether it was there.
+std::shared_ptr<const void> cachedMap(int width, int height, int depth, const std::vector<uint64_t>& obstacleKey,
+                                      bool* hit, const std::function<std::shared_ptr<const void>()>& build,
+                                      size_t (*mapBytes)(const void*));
+
+// A scene's B: the border's map, cached per grid size and shared by every scene of that size,
+// plus the obstacles' map, cached per obstacle set (none where nothing is blocked). A scene
+// with new obstacles builds only their map; the border's, which every query visits, answers
+// from its memo.
+template <class Map>
+struct SceneBoundary {
+  std::shared_ptr<const Map> border, obstacles;
+  bool cached = true;  // neither map had to be built
+  double potential(Cell c) const { return border->potential(c) + (obstacles ? obstacles->potential(c) : 0.0); }
+};
+SceneBoundary<BoundaryMap> cachedBoundary(int width, int height, const std::vector<uint8_t>& obstacles);
+SceneBoundary<VolumeBoundary> cachedBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles);
 
 bool lineOfSight(const Grid& g, Cell a, Cell b);
 // Turning points of a path (direction changes), ending with its last cell.

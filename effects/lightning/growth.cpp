@@ -121,10 +121,10 @@ class Grower {
     const size_t cells = g_.cells();
     nodeOf_ = detail::CellIndex(cells);
     candidateOf_ = detail::CellIndex(cells);
-    reserved_.reset(cells);
-    if (radius_ > 1) near_.reset(cells);
+    reserved_ = detail::CellMap<uint8_t>(cells);
+    if (radius_ > 1) near_ = detail::CellMap<uint8_t>(cells);
     for (const Cell& t : p.targets)
-      if (g_.inside(t.x, t.y, t.z)) reserved_[g_.index(t)] = 1;
+      if (g_.inside(t.x, t.y, t.z)) reserved_.at(g_.index(t)) = 1;
   }
 
   std::optional<Error> run();
@@ -135,7 +135,7 @@ class Grower {
   bool free(int x, int y, int z) const {
     if (!g_.inside(x, y, z) || g_.blocked(x, y, z)) return false;
     size_t i = g_.index(x, y, z);
-    return nodeOf_.get(i) < 0 && !reserved_[i];
+    return nodeOf_.get(i) < 0 && !reserved_.get(i);
   }
   int addNode(Cell c, int parent);
   void addCandidatesAround(int node);
@@ -168,11 +168,11 @@ class Grower {
   detail::Stencil stencil_;
   Bolt& bolt_;
   detail::CellIndex nodeOf_, candidateOf_;
-  detail::Zeroed<uint8_t> reserved_;
+  detail::CellMap<uint8_t> reserved_;
   std::vector<Candidate> cands_;
-  detail::Zeroed<float> boundaryMemo_;  // kFast 2-D: B per cell once computed (0 = not yet)
-  std::shared_ptr<const detail::BoundaryMap> boundaryMap_;
-  std::shared_ptr<const detail::VolumeBoundary> volumeMap_;  // 3-D
+  detail::CellMap<float> boundaryMemo_;  // kFast 2-D: B per cell once computed (0 = not yet)
+  detail::SceneBoundary<detail::BoundaryMap> boundaryMap_;
+  detail::SceneBoundary<detail::VolumeBoundary> volumeMap_;  // 3-D
   std::unique_ptr<detail::Potential> laplace_, reference_;
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
@@ -189,7 +189,7 @@ class Grower {
     for (size_t i = 1; i < t.size(); ++i) t[i] = s * std::log(double(i));
     return t;
   }();
-  detail::Zeroed<uint8_t> near_;  // radius_ > 1: bolt cells within radius_ of each cell (<= 15^2)
+  detail::CellMap<uint8_t> near_;  // radius_ > 1: bolt cells within radius_ of each cell (<= 15^2)
   int step_ = 0;
   Cell anchor_, attractor_;    // current sub-bolt axis: anchor -> attractor (seed 002 eqn 8's G)
   double weightRef_ = 0;       // kFast: weights are exp(eta * log Phi - weightRef_)
@@ -209,10 +209,10 @@ void Grower::screenAround(Cell c) {
   for (int y = std::max(0, c.y - radius_); y <= std::min(p_.height - 1, c.y + radius_); ++y)
     for (int x = std::max(0, c.x - radius_); x <= std::min(p_.width - 1, c.x + radius_); ++x) {
       const size_t i = g_.index(x, y, 0);
-      ++near_[i];
+      ++near_.at(i);
       if (const int32_t slot = candidateOf_.get(i); slot >= 0) {
         Candidate& cand = cands_[size_t(slot)];
-        cand.neighbours = near_[i];
+        cand.neighbours = near_.get(i);
         refreshFastWeight(cand);
         markWeight(size_t(slot));
       }
@@ -261,7 +261,7 @@ void Grower::addCandidatesAround(int node) {
       markWeight(size_t(slot));
       continue;
     }
-    Candidate cand{{x, y, z}, step_, radius_ > 1 ? int(near_[i]) : 0, node, 0.0};
+    Candidate cand{{x, y, z}, step_, radius_ > 1 ? int(near_.get(i)) : 0, node, 0.0};
     if (radius_ == 1)
       for (int j = 0; j < stencil_.size; ++j) {
         int nx = x + stencil_.dx[j], ny = y + stencil_.dy[j], nz = z + stencil_.dz[j];
@@ -289,9 +289,10 @@ void Grower::expireCandidates() {
 }
 
 double Grower::boundary(Cell c) {
-  if (volumeMap_) return volumeMap_->potential(c.x, c.y, c.z);  // memoised in the map (up to 128^3)
-  float& memo = boundaryMemo_[g_.index(c)];
-  if (memo == 0.0f) memo = float(boundaryMap_->potential(c.x, c.y));
+  if (p_.depth) return volumeMap_.potential(c);  // memoised in the maps (up to 128^3)
+  const size_t i = g_.index(c);
+  float memo = boundaryMemo_.get(i);
+  if (memo == 0.0f) boundaryMemo_.at(i) = memo = float(boundaryMap_.potential(c));
   return memo;
 }
 
@@ -483,12 +484,14 @@ double Grower::stepError(const std::vector<double>& logPhi) {
 // The path from the segment's start to its target on the grid with the bolt so far blocked,
 // except the start: empty when the target cannot be reached. Its turns guide the growth.
 std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
-  std::vector<uint8_t> blocked = p_.obstacles;
+  std::vector<uint8_t> withBolt;  // the first segment searches the obstacles as they are (no copy)
   if (k > 0) {
-    if (blocked.empty()) blocked.assign(g_.cells(), 0);
-    for (const Node& n : bolt_.nodes) blocked[g_.index(n.cell)] = 1;
-    blocked[g_.index(fromCell)] = 0;
+    withBolt = p_.obstacles;
+    if (withBolt.empty()) withBolt.assign(g_.cells(), 0);
+    for (const Node& n : bolt_.nodes) withBolt[g_.index(n.cell)] = 1;
+    withBolt[g_.index(fromCell)] = 0;
   }
+  const std::vector<uint8_t>& blocked = k > 0 ? withBolt : p_.obstacles;
   Stopwatch guideWatch;
   std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
@@ -608,7 +611,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
   }
   if (laplace_) lastResidual_ = laplace_->residual();
   ++step_;
-  reserved_[g_.index(target)] = 0;
+  reserved_.at(g_.index(target)) = 0;
   addNode(target, last);
   return std::nullopt;
 }
@@ -631,17 +634,15 @@ std::optional<Error> Grower::run() {
   }
   if (p_.method == Method::kFast && p_.depth) {
     Stopwatch w;
-    bool hit = false;
-    volumeMap_ = detail::cachedVolumeBoundary(p_.width, p_.height, p_.depth, p_.obstacles, &hit);
+    volumeMap_ = detail::cachedBoundary(p_.width, p_.height, p_.depth, p_.obstacles);
     bolt_.stats.counters["boundaryMapMs"] = w.ms();
-    bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
+    bolt_.stats.counters["boundaryMapCached"] = volumeMap_.cached ? 1 : 0;
   } else if (p_.method == Method::kFast) {
     Stopwatch w;
-    bool hit = false;
-    boundaryMap_ = detail::cachedBoundaryMap(p_.width, p_.height, p_.obstacles, &hit);
+    boundaryMap_ = detail::cachedBoundary(p_.width, p_.height, p_.obstacles);
     bolt_.stats.counters["boundaryMapMs"] = w.ms();
-    bolt_.stats.counters["boundaryMapCached"] = hit ? 1 : 0;
-    boundaryMemo_.reset(g_.cells());
+    bolt_.stats.counters["boundaryMapCached"] = boundaryMap_.cached ? 1 : 0;
+    boundaryMemo_ = detail::CellMap<float>(g_.cells());
   }
   addNode(p_.start, -1);
   for (size_t k = 0; k < p_.targets.size(); ++k) {

@@ -13,7 +13,7 @@ constexpr double kTheta = 0.5;  // opening angle: a block of side s counts as on
 constexpr int kLeaf = 4;        // voxels per side of the smallest stored block
 }  // namespace
 
-VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>& obstacles)
+VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>* obstacles)
     : dw_(width + 2), dh_(height + 2), dd_(depth + 2), w_(width), h_(height) {
   charge_.reset(size_t(dw_) * size_t(dh_) * size_t(dd_));
   Level l{(dw_ + kLeaf - 1) / kLeaf, (dh_ + kLeaf - 1) / kLeaf, (dd_ + kLeaf - 1) / kLeaf, {}, {}, {}, {}};
@@ -29,21 +29,23 @@ VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vect
     l.cy[b] += float(y) + 0.5f;
     l.cz[b] += float(z) + 0.5f;
   };
-  // The shell: the six faces of the domain.
-  for (int z = 0; z < dd_; ++z)
-    for (int y = 0; y < dh_; ++y) {
-      const bool face = z == 0 || z == dd_ - 1 || y == 0 || y == dh_ - 1;
-      if (face)
-        for (int x = 0; x < dw_; ++x) put(x, y, z);
-      else
-        put(0, y, z), put(dw_ - 1, y, z);
-    }
-  if (!obstacles.empty())
-    for (size_t i = 0; i < obstacles.size(); ++i)
-      if (obstacles[i]) {
-        const Cell c = Grid{width, height, &obstacles, depth}.cellAt(i);
+  if (obstacles) {
+    const Grid grid{width, height, obstacles, depth};
+    for (size_t i = 0; i < obstacles->size(); ++i)
+      if ((*obstacles)[i]) {
+        const Cell c = grid.cellAt(i);
         put(c.x + 1, c.y + 1, c.z + 1);
       }
+  } else {  // the six faces of the domain
+    for (int z = 0; z < dd_; ++z)
+      for (int y = 0; y < dh_; ++y) {
+        const bool face = z == 0 || z == dd_ - 1 || y == 0 || y == dh_ - 1;
+        if (face)
+          for (int x = 0; x < dw_; ++x) put(x, y, z);
+        else
+          put(0, y, z), put(dw_ - 1, y, z);
+      }
+  }
   for (size_t b = 0; b < n; ++b)
     if (l.count[b] > 0) l.cx[b] /= l.count[b], l.cy[b] /= l.count[b], l.cz[b] /= l.count[b];
   levels_.push_back(std::move(l));
@@ -102,7 +104,8 @@ double VolumeBoundary::visit(int level, int bx, int by, int bz, double px, doubl
   return sum;
 }
 
-double VolumeBoundary::potential(int x, int y, int z) const {
+double VolumeBoundary::potential(Cell c) const {
+  const int x = c.x, y = c.y, z = c.z;
   const size_t m = (size_t(z) * size_t(h_) + size_t(y)) * size_t(w_) + size_t(x);
   if (memoVoxels_)
     if (float v = std::atomic_ref<float>(memo_[m]).load(std::memory_order_relaxed); v != 0.0f) return v;
@@ -121,18 +124,12 @@ size_t VolumeBoundary::bytes() const {
   return b + memoVoxels_ * sizeof(float);
 }
 
-std::shared_ptr<const VolumeBoundary> cachedVolumeBoundary(int width, int height, int depth,
-                                                           const std::vector<uint8_t>& obstacles, bool* hit) {
-  return std::static_pointer_cast<const VolumeBoundary>(cachedMap(
-      width, height, depth, obstacles, hit,
-      [&] { return std::make_shared<const VolumeBoundary>(width, height, depth, obstacles); },
-      [](const void* m) { return static_cast<const VolumeBoundary*>(m)->bytes(); }));
-}
-
 }  // namespace detail
 
 double boundaryPotential(int width, int height, int depth, const std::vector<uint8_t>& obstacles, Cell c) {
-  return detail::VolumeBoundary(width, height, depth, obstacles).potential(c.x, c.y, c.z);
+  const detail::VolumeBoundary shell(width, height, depth, nullptr);
+  if (detail::obstacleBits(obstacles).empty()) return shell.potential(c);
+  return shell.potential(c) + detail::VolumeBoundary(width, height, depth, &obstacles).potential(c);
 }
 
 }  // namespace effects::lightning
