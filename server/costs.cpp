@@ -50,11 +50,10 @@ Cost lightningCost(const json& body, const Config& config) {
                       : config.limits.maxGridCells);
   // Working set per cell: fast keeps the obstacle grid, candidate and potential state and
   // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils: 27-point
-  // ones in 3-D). 3-D fast keeps its per-voxel state in hash tables of the voxels the bolt
-  // and the A* search touch (effects/lightning/grid.h: CellMap): at worst (a search that
-  // floods the volume) A*'s cost and parent, 8 bytes a voxel and half that again while its
-  // table turns into the flat array, and the obstacle and octree charge bytes.
-  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 14 : 24);
+  // ones in 3-D). 3-D fast keeps its per-voxel state in pages of the voxels the bolt and the
+  // A* search touch (effects/lightning/grid.h: CellMap): at worst (a search that floods the
+  // volume) A*'s cost and parent (8 bytes), the obstacle and octree charge bytes.
+  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 12 : 24);
   // 2-D dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = method == "dbm" && !depth && body.value("solver", "capacitance") == "capacitance";
   const int width = body["grid"]["width"].get<int>(), height = body["grid"]["height"].get<int>();

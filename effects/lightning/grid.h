@@ -36,75 +36,39 @@ class Zeroed {
 };
 
 // A value per cell, zero until set, for the bookkeeping of one request (bolt and candidate
-// cells, A*'s search). A bolt touches a sliver of a large grid, and a flat array of a 4096^2
-// or 128^3 grid costs more to clear (or to fault in) than growing the bolt. So on grids of
-// more than kDenseCells it starts as an open-addressed hash table of the cells set, and turns
-// into the flat array once the table would outgrow half that array (a search that floods the
-// grid): at most 1.5 times the array's memory, while both exist.
+// cells, A*'s search). A bolt touches a sliver of a large grid, and clearing (or faulting in)
+// a flat array of a 4096^2 or 128^3 grid cost more than growing the bolt. So the cells come
+// in pages of kPage consecutive cells, each made (zeroed) when a cell of it is first set;
+// reads of a page never set are zero. Neighbours along a row share a page, so a search that
+// floods a region reads memory as a flat array would. Memory: the pages touched, and a
+// pointer per page of the grid.
 template <class T>
 class CellMap {
  public:
-  static constexpr size_t kDenseCells = size_t(1) << 18;
-  explicit CellMap(size_t cells = 0) : cells_(cells) {
-    if (cells <= kDenseCells) {
-      dense_.reset(cells);
-      isDense_ = true;
-    } else {
-      rehash(1024);
-    }
-  }
+  static constexpr size_t kPageBits = 8, kPage = size_t(1) << kPageBits;
+  explicit CellMap(size_t cells = 0) : dir_((cells + kPage - 1) >> kPageBits) {}
   T get(size_t i) const {
-    if (isDense_) return dense_[i];
-    for (size_t s = slot(i);; s = (s + 1) & (keys_.size() - 1)) {
-      if (keys_[s] == i) return values_[s];
-      if (keys_[s] == kEmpty) return T{};
-    }
+    const T* p = dir_[i >> kPageBits];
+    return p ? p[i & (kPage - 1)] : T{};
   }
-  T& at(size_t i) {  // the cell's value, set from now on
-    if (isDense_) return dense_[i];
-    size_t s = slot(i);
-    for (; keys_[s] != kEmpty; s = (s + 1) & (keys_.size() - 1))
-      if (keys_[s] == i) return values_[s];
-    if (2 * (size_ + 1) > keys_.size()) {
-      grow();
-      return at(i);
-    }
-    ++size_;
-    keys_[s] = uint32_t(i);
-    values_[s] = T{};
-    return values_[s];
+  T& at(size_t i) {  // the cell's value, to set
+    T*& p = dir_[i >> kPageBits];
+    if (!p) p = newPage();
+    return p[i & (kPage - 1)];
   }
 
  private:
-  static constexpr uint32_t kEmpty = UINT32_MAX;  // grids have fewer than 2^30 cells
-  size_t slot(size_t i) const { return size_t((uint64_t(i) * 0x9E3779B97F4A7C15ull) >> shift_); }
-  void rehash(size_t capacity) {
-    std::vector<uint32_t> keys(capacity, kEmpty);
-    std::vector<T> values(capacity);
-    keys_.swap(keys);
-    values_.swap(values);
-    shift_ = 64 - __builtin_ctzll(capacity);
-    size_ = 0;
-    for (size_t s = 0; s < keys.size(); ++s)
-      if (keys[s] != kEmpty) at(keys[s]) = values[s];
+  static constexpr size_t kChunkPages = 16;  // pages come from chunks of this many
+  T* newPage() {
+    if (used_ == kChunkPages || chunks_.empty()) {
+      chunks_.push_back(std::make_unique<T[]>(kChunkPages * kPage));  // value-initialised: zero
+      used_ = 0;
+    }
+    return chunks_.back().get() + kPage * used_++;
   }
-  void grow() {
-    const size_t capacity = 2 * keys_.size();
-    if (2 * capacity * (sizeof(uint32_t) + sizeof(T)) <= cells_ * sizeof(T)) return rehash(capacity);
-    dense_.reset(cells_);
-    for (size_t s = 0; s < keys_.size(); ++s)
-      if (keys_[s] != kEmpty) dense_[keys_[s]] = values_[s];
-    isDense_ = true;
-    std::vector<uint32_t>().swap(keys_);
-    std::vector<T>().swap(values_);
-  }
-  size_t cells_;
-  bool isDense_ = false;
-  Zeroed<T> dense_{0};
-  std::vector<uint32_t> keys_;
-  std::vector<T> values_;
-  size_t size_ = 0;
-  int shift_ = 0;
+  std::vector<T*> dir_;
+  std::vector<std::unique_ptr<T[]>> chunks_;
+  size_t used_ = 0;  // pages handed out from the last chunk
 };
 
 // A per-cell index, -1 where unset (stored + 1).
