@@ -12,7 +12,12 @@ namespace effects::lightning {
 namespace detail {
 
 BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>* obstacles)
-    : dw_(width + 2), dh_(height + 2), qw_((dw_ + 1) / 2), qh_((dh_ + 1) / 2) {
+    : dw_(width + 2),
+      dh_(height + 2),
+      qw_((dw_ + 1) / 2),
+      qh_((dh_ + 1) / 2),
+      memoCells_(size_t(width) * size_t(height) <= kMemoCells ? size_t(width) * size_t(height) : 0),
+      memo_(memoCells_) {
   quads_.assign(size_t(qw_) * size_t(qh_), 0);
   auto put = [&](int dx, int dy) {
     quads_[size_t(dy / 2) * size_t(qw_) + size_t(dx / 2)] |= uint8_t(1u << ((dx & 1) + 2 * (dy & 1)));
@@ -69,14 +74,10 @@ BoundaryMap::BoundaryMap(int width, int height, const std::vector<uint8_t>* obst
       }
     levels_.push_back(std::move(c));
   }
-  if (size_t(width) * size_t(height) <= kMemoCells) {
-    memoCells_ = size_t(width) * size_t(height);
-    memo_.reset(memoCells_);
-  }
 }
 
 size_t BoundaryMap::bytes() const {
-  size_t b = quads_.size() + memoCells_ * sizeof(float);
+  size_t b = quads_.size() + memo_.bytes();
   for (const Level& l : levels_) b += l.count.size() * 3 * sizeof(float);
   return b;
 }
@@ -117,11 +118,11 @@ double BoundaryMap::potential(Cell c) const {
   const int x = c.x, y = c.y;
   const size_t i = size_t(y) * size_t(dw_ - 2) + size_t(x);
   if (memoCells_)
-    if (float v = std::atomic_ref<float>(memo_[i]).load(std::memory_order_relaxed); v != 0.0f) return v;
+    if (float v = memo_.get(i); v != 0.0f) return v;
   double px = x + 1.5, py = y + 1.5;  // domain coordinates of the cell centre
   const double v = visit(int(levels_.size()) + 1, 0, 0, px, py);
   if (memoCells_) {
-    std::atomic_ref<float>(memo_[i]).store(float(v), std::memory_order_relaxed);
+    memo_.put(i, float(v));
     return float(v);  // the same value whether it came from the memo or not
   }
   return v;

@@ -82,6 +82,45 @@ class CellIndex {
   CellMap<int32_t> v_;
 };
 
+// A boundary map's memo: a float per cell, 0 until stored, shared by the concurrent requests
+// on a cached map. Pages of kPage cells are made on a cell's first store (one compare-and-swap
+// on the page's pointer; the loser frees its page), so a map costs only the pages its bolts
+// asked about, and making a map clears no per-cell array. Values are read and written through
+// std::atomic_ref: stores are of the same value, so races are benign and the atomics make
+// them defined.
+class SharedMemo {
+ public:
+  static constexpr size_t kPageBits = 10, kPage = size_t(1) << kPageBits;
+  explicit SharedMemo(size_t cells = 0) : pages_((cells + kPage - 1) >> kPageBits), dir_(pages_ ? pages_ : 1) {}
+  ~SharedMemo() {
+    for (size_t p = 0; p < pages_; ++p) std::free(std::atomic_ref<float*>(dir_[p]).load(std::memory_order_relaxed));
+  }
+  SharedMemo(const SharedMemo&) = delete;
+  SharedMemo& operator=(const SharedMemo&) = delete;
+  float get(size_t i) const {
+    float* page = std::atomic_ref<float*>(dir_[i >> kPageBits]).load(std::memory_order_acquire);
+    return page ? std::atomic_ref<float>(page[i & (kPage - 1)]).load(std::memory_order_relaxed) : 0.0f;
+  }
+  void put(size_t i, float v) const {
+    std::atomic_ref<float*> slot(dir_[i >> kPageBits]);
+    float* page = slot.load(std::memory_order_acquire);
+    if (!page) {
+      float* made = static_cast<float*>(std::calloc(kPage, sizeof(float)));
+      if (!made) return;  // the value is only not kept
+      if (slot.compare_exchange_strong(page, made, std::memory_order_acq_rel))
+        page = made;
+      else
+        std::free(made);  // another request made it: page now holds theirs
+    }
+    std::atomic_ref<float>(page[i & (kPage - 1)]).store(v, std::memory_order_relaxed);
+  }
+  size_t bytes() const { return pages_ * (kPage * sizeof(float) + sizeof(float*)); }  // all pages made
+
+ private:
+  size_t pages_;
+  mutable Zeroed<float*> dir_;
+};
+
 struct Grid {
   int width, height;
   const std::vector<uint8_t>* obstacles;  // may be empty
@@ -169,17 +208,15 @@ class BoundaryMap {
   std::vector<uint8_t> quads_;
   std::vector<Level> levels_;  // levels_[k - 2]: blocks of 2^k x 2^k cells, k >= 2
   size_t memoCells_ = 0;
-  // 0 = not computed yet (a potential is > 0); read and written through std::atomic_ref by
-  // concurrent requests; calloc'd, so only the cells a bolt asks about are ever paged in.
-  mutable Zeroed<float> memo_;
+  SharedMemo memo_;  // 0 = not computed yet (a potential is > 0)
 };
 
 // Seed 002 eqn 4 in 3-D: sum of 1/r over the shell of voxels around the grid and the obstacle
 // voxels, as in 2-D two maps that add: the shell's and the obstacles'. An octree of charge
 // counts and centroids (blocks of 4^3 voxels and up) answers a query in O(log n) blocks with
 // the opening angle of the 2-D map; blocks nearer than two of their sides are summed voxel by
-// voxel. Memory: one byte per voxel of the padded grid and 16 bytes per 4^3 block (about 1.3
-// bytes per voxel), and on grids up to kMemoVoxels the memo of 4 bytes per voxel (as
+// voxel. Memory: 24 bytes per 4^3 block of the padded grid (a charge bit per voxel, count and
+// centroid; about 0.4 bytes per voxel), and on grids up to kMemoVoxels the memo's pages (as
 // BoundaryMap's: each voxel's value kept once computed, shared by every request on a cached
 // map; the value is then a float's whether it came from the memo or not).
 class VolumeBoundary {
@@ -197,11 +234,11 @@ class VolumeBoundary {
   };
   double visit(int level, int bx, int by, int bz, double px, double py, double pz) const;
   int dw_, dh_, dd_;             // domain (grid + shell) size
-  Zeroed<uint8_t> charge_;       // per domain voxel
+  std::vector<uint64_t> leafCharges_;  // per 4^3 block of levels_[0]: bit (dz * 4 + dy) * 4 + dx
   std::vector<Level> levels_;    // levels_[k]: blocks of 4 * 2^k voxels a side
   int w_, h_;                    // grid width and height (the memo's rows)
   size_t memoVoxels_ = 0;
-  mutable Zeroed<float> memo_;  // as BoundaryMap's: 0 = not computed yet, atomic_ref, calloc'd
+  SharedMemo memo_;  // as BoundaryMap's
 };
 
 // The cache's key for an obstacle grid: one bit a cell (an obstacle is any non-zero byte),

@@ -14,16 +14,24 @@ constexpr int kLeaf = 4;        // voxels per side of the smallest stored block
 }  // namespace
 
 VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vector<uint8_t>* obstacles)
-    : dw_(width + 2), dh_(height + 2), dd_(depth + 2), w_(width), h_(height) {
-  charge_.reset(size_t(dw_) * size_t(dh_) * size_t(dd_));
+    : dw_(width + 2),
+      dh_(height + 2),
+      dd_(depth + 2),
+      w_(width),
+      h_(height),
+      memoVoxels_(size_t(width) * size_t(height) * size_t(depth) <= kMemoVoxels
+                      ? size_t(width) * size_t(height) * size_t(depth)
+                      : 0),
+      memo_(memoVoxels_) {
   Level l{(dw_ + kLeaf - 1) / kLeaf, (dh_ + kLeaf - 1) / kLeaf, (dd_ + kLeaf - 1) / kLeaf, {}, {}, {}, {}};
   const size_t n = size_t(l.w) * size_t(l.h) * size_t(l.d);
   for (auto* v : {&l.count, &l.cx, &l.cy, &l.cz}) v->assign(n, 0.0f);
+  leafCharges_.assign(n, 0);
   auto put = [&](int x, int y, int z) {  // domain coordinates
-    uint8_t& c = charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)];
-    if (c) return;
-    c = 1;
     const size_t b = (size_t(z / kLeaf) * size_t(l.h) + size_t(y / kLeaf)) * size_t(l.w) + size_t(x / kLeaf);
+    const uint64_t bit = uint64_t(1) << (((z % kLeaf) * kLeaf + y % kLeaf) * kLeaf + x % kLeaf);
+    if (leafCharges_[b] & bit) return;
+    leafCharges_[b] |= bit;
     l.count[b] += 1.0f;
     l.cx[b] += float(x) + 0.5f;  // at most 64 half-integers below 2^13 per block: exact
     l.cy[b] += float(y) + 0.5f;
@@ -69,10 +77,6 @@ VolumeBoundary::VolumeBoundary(int width, int height, int depth, const std::vect
       if (c.count[b] > 0) c.cx[b] /= c.count[b], c.cy[b] /= c.count[b], c.cz[b] /= c.count[b];
     levels_.push_back(std::move(c));
   }
-  if (size_t(width) * size_t(height) * size_t(depth) <= kMemoVoxels) {
-    memoVoxels_ = size_t(width) * size_t(height) * size_t(depth);
-    memo_.reset(memoVoxels_);
-  }
 }
 
 // Sum of 1/r from the charges of block (bx, by, bz) of `level` to the point (domain coordinates).
@@ -86,16 +90,15 @@ double VolumeBoundary::visit(int level, int bx, int by, int bz, double px, doubl
   const double r = std::sqrt((l.cx[i] - px) * (l.cx[i] - px) + (l.cy[i] - py) * (l.cy[i] - py) +
                              (l.cz[i] - pz) * (l.cz[i] - pz));
   if (side < kTheta * r) return count / r;
-  if (level == 0) {  // voxel by voxel
+  if (level == 0) {  // voxel by voxel, in z, y, x order
     double sum = 0;
     const int x0 = bx * kLeaf, y0 = by * kLeaf, z0 = bz * kLeaf;
-    for (int z = z0; z < std::min(z0 + kLeaf, dd_); ++z)
-      for (int y = y0; y < std::min(y0 + kLeaf, dh_); ++y)
-        for (int x = x0; x < std::min(x0 + kLeaf, dw_); ++x)
-          if (charge_[(size_t(z) * size_t(dh_) + size_t(y)) * size_t(dw_) + size_t(x)]) {
-            const double dx = x + 0.5 - px, dy = y + 0.5 - py, dz = z + 0.5 - pz;
-            sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
-          }
+    for (uint64_t bits = leafCharges_[i]; bits; bits &= bits - 1) {
+      const int k = __builtin_ctzll(bits);
+      const double dx = x0 + k % kLeaf + 0.5 - px, dy = y0 + k / kLeaf % kLeaf + 0.5 - py,
+                   dz = z0 + k / (kLeaf * kLeaf) + 0.5 - pz;
+      sum += 1.0 / std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
     return sum;
   }
   double sum = 0;
@@ -108,20 +111,20 @@ double VolumeBoundary::potential(Cell c) const {
   const int x = c.x, y = c.y, z = c.z;
   const size_t m = (size_t(z) * size_t(h_) + size_t(y)) * size_t(w_) + size_t(x);
   if (memoVoxels_)
-    if (float v = std::atomic_ref<float>(memo_[m]).load(std::memory_order_relaxed); v != 0.0f) return v;
+    if (float v = memo_.get(m); v != 0.0f) return v;
   // Grid voxel (x, y, z) is domain voxel (x + 1, y + 1, z + 1); its centre is + 0.5.
   const double v = visit(int(levels_.size()) - 1, 0, 0, 0, x + 1.5, y + 1.5, z + 1.5);
   if (memoVoxels_) {
-    std::atomic_ref<float>(memo_[m]).store(float(v), std::memory_order_relaxed);
+    memo_.put(m, float(v));
     return float(v);  // the same value whether it came from the memo or not
   }
   return v;
 }
 
 size_t VolumeBoundary::bytes() const {
-  size_t b = size_t(dw_) * size_t(dh_) * size_t(dd_);
+  size_t b = leafCharges_.size() * sizeof(uint64_t);
   for (const Level& l : levels_) b += l.count.size() * 4 * sizeof(float);
-  return b + memoVoxels_ * sizeof(float);
+  return b + memo_.bytes();
 }
 
 }  // namespace detail
