@@ -137,7 +137,7 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
     tolerances = {1e-2, 1e-4, 1e-6, 1e-8};
   else
     tolerances = {1e-2, 1e-4};
-  if (!volume) {  // the exact solve (2-D): direct while the fixed cells are few, then MGPCG
+  {  // the exact solve: direct while the fixed cells are few, then MGPCG
     lt::Params p = layout();
     p.method = lt::Method::kDbm;
     p.solver = lt::Solver::kCapacitance;
@@ -157,7 +157,8 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
 }
 
 // Every setting over 10 seeds (3 in the quick run): D against DBM's (the default solver at
-// tolerance 1e-8: exact in 2-D while the capacitance method runs; the same neighbourhood, 10 seeds) and, up to 128^2, the mean per-step total-variation distance
+// tolerance 1e-8: exact while the capacitance method runs; the same neighbourhood, 10 seeds)
+// and, up to 128^2, the mean per-step total-variation distance
 // (its reference solve every step costs seconds per 256^2 bolt).
 void lightningRows(bool quick, int n, int hood, bool volume, Section& tv, Section& fd) {
   const int seeds = quick ? 3 : 10;
@@ -243,7 +244,8 @@ void lightning3d(bool quick, Section& tv, Section& fd) {
       {}};
   fd = {"lightning3d-fd",
         "Lightning in 3-D: fractal dimension against DBM",
-        "mean box-counting dimension D_ref of 3-D DBM (MGPCG, tolerance 1e-8) at the same size and seeds",
+        "mean box-counting dimension D_ref of 3-D DBM (the default solver: exact while the capacitance method runs, "
+        "MGPCG at tolerance 1e-8 past it) at the same size and seeds",
         "abs(mean D − D_ref)",
         "ms per bolt (median)",
         "setting",

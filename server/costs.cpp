@@ -54,12 +54,15 @@ Cost lightningCost(const json& body, const Config& config) {
   // A* search touch (effects/lightning/grid.h: CellMap): at worst (a search that floods the
   // volume) A*'s cost and parent (8 bytes), the obstacle and octree charge bytes.
   const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 12 : 24);
-  // 2-D dbm's default capacitance solver adds its Cholesky factor, rows and table.
-  const bool capacitance = method == "dbm" && !depth && body.value("solver", "capacitance") == "capacitance";
+  // dbm's default capacitance solver adds its Cholesky factor, rows and table.
+  const bool capacitance = method == "dbm" && body.value("solver", "capacitance") == "capacitance";
   const int width = body["grid"]["width"].get<int>(), height = body["grid"]["height"].get<int>();
   const bool clamped = size_t(width) * size_t(height) > cells;  // refused by the handler
   const int side = int(std::sqrt(double(cells)));
-  const size_t direct = capacitance ? effects::lightning::capacitanceBytes(clamped ? side : width, clamped ? side : height) : 0;
+  const size_t direct =
+      !capacitance ? 0
+      : depth      ? effects::lightning::capacitanceBytes(width, height, int(depth))
+                   : effects::lightning::capacitanceBytes(clamped ? side : width, clamped ? side : height);
   // The bolt: at most maxSteps cells, and in practice far fewer than the grid.
   const size_t steps =
       std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);

@@ -1,9 +1,11 @@
-// DBM's 2-D potential by the capacitance-matrix method (capacitance.h).
+// DBM's potential by the capacitance-matrix method (capacitance.h), 2-D and 3-D.
 #include "capacitance.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+
+#include "laplace3.h"
 
 namespace effects::lightning::detail {
 
@@ -18,43 +20,102 @@ namespace effects::lightning::detail {
 //   K(ds, dt) = 1 / (n + 1) sum_k cos(theta_k ds) h_k(dt),
 //   h_k(d) = cosh(mu_k (M - d)) / (2 sinh mu_k sinh(mu_k M))
 //          = (e^(-mu_k d) + e^(-mu_k (2M - d))) / (2 sinh mu_k (1 - e^(-2 mu_k M)))  (no overflow).
-BoxGreen::BoxGreen(int width, int height)
-    : transposed_(height < width),
-      n_(std::min(width, height)),
-      m_(std::max(width, height)),
-      stride_(size_t(2 * m_ + 1)) {
-  const int n = n_, m = m_, M = m + 1, period = 2 * (n + 1);
-  std::vector<double> cosine(static_cast<size_t>(period));
-  for (int j = 0; j < period; ++j) cosine[size_t(j)] = std::cos(M_PI * j / (n + 1));
-  std::vector<double> h(stride_);
-  k_.assign(size_t(2 * n + 1) * stride_, 0.0);
-  for (int k = 1; k <= n; ++k) {
-    // cosh mu = 2 - cos theta = 1 + delta, delta = 2 sin^2(theta / 2) (no cancellation).
+BoxGreen::BoxGreen(int width, int height, int depth) : volume_(depth > 0) {
+  if (!volume_) {
+    order_[0] = height < width ? 1 : 0, order_[1] = -1, order_[2] = height < width ? 0 : 1;
+    const int n = std::min(width, height), m = std::max(width, height), M = m + 1, period = 2 * (n + 1);
+    stride2_ = 1, stride_ = size_t(2 * m + 1);
+    std::vector<double> cosine(static_cast<size_t>(period));
+    for (int j = 0; j < period; ++j) cosine[size_t(j)] = std::cos(M_PI * j / (n + 1));
+    std::vector<double> h(stride_);
+    k_.assign(size_t(2 * n + 1) * stride_, 0.0);
+    for (int k = 1; k <= n; ++k) {
+      // cosh mu = 2 - cos theta = 1 + delta, delta = 2 sin^2(theta / 2) (no cancellation).
+      const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
+      const double delta = 2 * half * half;
+      const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
+      const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
+      for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
+      for (int ds = 0; ds <= 2 * n; ++ds) {
+        const double c = cosine[size_t((k * ds) % period)] / (n + 1);
+        double* row = &k_[size_t(ds) * stride_];
+        for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
+      }
+    }
+    return;
+  }
+  // 3-D: the series over the two shorter axes (n1, n2 cells), the closed form along the
+  // longest (m): per mode pair cosh mu = 1 + 2 sin^2(theta_k / 2) + 2 sin^2(phi_l / 2), and
+  //   K(d1, d2, dt) = 1 / ((n1 + 1)(n2 + 1)) sum_k,l cos(theta_k d1) cos(phi_l d2) h_kl(dt),
+  // summed as B_k(d2, dt) = sum_l cos(phi_l d2) h_kl(dt), then K += cos(theta_k d1) B_k.
+  const int len[3] = {width, height, depth};
+  int ax[3] = {0, 1, 2};
+  std::stable_sort(ax, ax + 3, [&](int a, int b) { return len[a] < len[b]; });
+  std::copy(ax, ax + 3, order_);
+  const int n1 = len[ax[0]], n2 = len[ax[1]], m = len[ax[2]], M = m + 1;
+  stride2_ = size_t(2 * n2 + 1), stride_ = size_t(2 * m + 1);
+  auto cosines = [](int n) {
+    std::vector<double> c(size_t(2 * (n + 1)));
+    for (size_t j = 0; j < c.size(); ++j) c[j] = std::cos(M_PI * double(j) / (n + 1));
+    return c;
+  };
+  const std::vector<double> cos1 = cosines(n1), cos2 = cosines(n2);
+  auto halfSquared = [](int k, int n) {
     const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
-    const double delta = 2 * half * half;
-    const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
-    const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
-    for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
-    for (int ds = 0; ds <= 2 * n; ++ds) {
-      const double c = cosine[size_t((k * ds) % period)] / (n + 1);
-      double* row = &k_[size_t(ds) * stride_];
-      for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
+    return 2 * half * half;
+  };
+  const size_t plane = stride2_ * stride_;
+  k_.assign(size_t(2 * n1 + 1) * plane, 0.0);
+  std::vector<double> b(plane), h(stride_);
+  for (int k = 1; k <= n1; ++k) {
+    std::fill(b.begin(), b.end(), 0.0);
+    for (int l = 1; l <= n2; ++l) {
+      const double delta = halfSquared(k, n1) + halfSquared(l, n2);
+      const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
+      const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
+      for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
+      for (int d2 = 0; d2 <= 2 * n2; ++d2) {
+        const double c = cos2[size_t((l * d2) % (2 * (n2 + 1)))];
+        double* row = &b[size_t(d2) * stride_];
+        for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
+      }
+    }
+    for (int d1 = 0; d1 <= 2 * n1; ++d1) {
+      const double c = cos1[size_t((k * d1) % (2 * (n1 + 1)))] / (double(n1 + 1) * double(n2 + 1));
+      double* out = &k_[size_t(d1) * plane];
+      for (size_t i = 0; i < plane; ++i) out[i] += c * b[i];
     }
   }
 }
 
-double BoxGreen::operator()(Cell a, Cell b) const {
-  const int sa = (transposed_ ? a.y : a.x) + 1, sb = (transposed_ ? b.y : b.x) + 1;
-  const int ta = (transposed_ ? a.x : a.y) + 1, tb = (transposed_ ? b.x : b.y) + 1;
-  const size_t ds = size_t(std::abs(sa - sb)) * stride_, ss = size_t(sa + sb) * stride_;
-  const size_t dt = size_t(std::abs(ta - tb)), st = size_t(ta + tb);
-  return (k_[ds + dt] - k_[ss + dt]) - (k_[ds + st] - k_[ss + st]);
+size_t BoxGreen::tableEntries(int width, int height, int depth) {
+  int len[3] = {width, height, depth};
+  std::sort(len, len + (depth > 0 ? 3 : 2));
+  size_t n = 1;
+  for (int i = 0; i < (depth > 0 ? 3 : 2); ++i) n *= size_t(2 * len[i] + 1);
+  return n;
 }
 
-std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height) {
-  // Keyed as a map of depth -1 with no obstacles: a table depends on the grid size only.
+double BoxGreen::operator()(Cell a, Cell b) const {
+  const int ta = axis(a, 2), tb = axis(b, 2);
+  const size_t dt = size_t(std::abs(ta - tb)), st = size_t(ta + tb);
+  const int sa = axis(a, 0), sb = axis(b, 0);
+  if (!volume_) {
+    const size_t ds = size_t(std::abs(sa - sb)) * stride_, ss = size_t(sa + sb) * stride_;
+    return (k_[ds + dt] - k_[ss + dt]) - (k_[ds + st] - k_[ss + st]);
+  }
+  const int ra = axis(a, 1), rb = axis(b, 1);
+  const size_t plane = stride2_ * stride_;
+  const size_t d1 = size_t(std::abs(sa - sb)) * plane, s1 = size_t(sa + sb) * plane;
+  const size_t d2 = size_t(std::abs(ra - rb)) * stride_, s2 = size_t(ra + rb) * stride_;
+  auto axes = [&](size_t t) { return (k_[d1 + d2 + t] - k_[s1 + d2 + t]) - (k_[d1 + s2 + t] - k_[s1 + s2 + t]); };
+  return axes(dt) - axes(st);
+}
+
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth) {
+  // Keyed as a map of depth -1 - depth with no obstacles: a table depends on the grid size only.
   return std::static_pointer_cast<const BoxGreen>(cachedMap(
-      width, height, -1, {}, nullptr, [&] { return std::make_shared<const BoxGreen>(width, height); },
+      width, height, -1 - depth, {}, nullptr, [&] { return std::make_shared<const BoxGreen>(width, height, depth); },
       [](const void* t) { return static_cast<const BoxGreen*>(t)->bytes(); }));
 }
 
@@ -79,23 +140,30 @@ __attribute__((target_clones("avx2", "default"))) double dot(const double* a, co
 size_t rowStart(size_t i) { return i * (i + 1) / 2; }
 }  // namespace
 
-size_t Capacitance::maxFixed(int width, int height) {
+size_t Capacitance::maxFixed(int width, int height, int depth) {
+  if (depth > 0) return 1024;
   return std::clamp<size_t>(size_t(4.5 * std::sqrt(double(width) * double(height))), 64, 1024);
 }
 
-size_t Capacitance::maxBytes(int width, int height) {
+size_t Capacitance::maxBytes(int width, int height, int depth) {
+  if (depth > 0) return size_t(64) << 20;
   const size_t m = maxFixed(width, height);
   return 6 * m * m * sizeof(double);
 }
 
-Capacitance::Capacitance(int width, int height)
+bool Capacitance::fits(int width, int height, int depth) {
+  return depth <= 0 || BoxGreen::tableEntries(width, height, depth) * sizeof(double) <= (size_t(32) << 20);
+}
+
+Capacitance::Capacitance(int width, int height, int depth)
     : w_(width),
       h_(height),
-      maxFixed_(maxFixed(width, height)),
-      maxBytes_(maxBytes(width, height)),
-      green_(cachedBoxGreen(width, height)),
-      fixedIndex_(size_t(width) * size_t(height)),
-      rowOf_(size_t(width) * size_t(height)) {}
+      d_(depth),
+      maxFixed_(maxFixed(width, height, depth)),
+      maxBytes_(maxBytes(width, height, depth)),
+      green_(cachedBoxGreen(width, height, depth)),
+      fixedIndex_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))),
+      rowOf_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))) {}
 
 Capacitance::Row& Capacitance::row(Cell c) const {
   const size_t i = at(c);
@@ -123,7 +191,10 @@ double Capacitance::dotQ(const Row& r, size_t n) const {
 }
 
 void Capacitance::handOver() {
-  fallback_ = std::make_unique<Laplace>(w_, h_);
+  if (d_ > 0)
+    fallback_ = std::make_unique<Laplace3>(w_, h_, d_);
+  else
+    fallback_ = std::make_unique<Laplace>(w_, h_);
   for (size_t j = 0; j < fixed_.size(); ++j) fallback_->fix(fixed_[j], value_[j]);
   // What only the direct solve needed goes.
   for (auto* v : {&lower_, &y_, &q_}) std::vector<double>().swap(*v);
@@ -214,9 +285,10 @@ double Capacitance::residual() const {
 
 namespace effects::lightning {
 
-size_t capacitanceBytes(int width, int height) {
-  const size_t table = size_t(2 * std::min(width, height) + 1) * size_t(2 * std::max(width, height) + 1);
-  return detail::Capacitance::maxBytes(width, height) + table * sizeof(double);
+size_t capacitanceBytes(int width, int height, int depth) {
+  if (!detail::Capacitance::fits(width, height, depth)) return 0;
+  return detail::Capacitance::maxBytes(width, height, depth) +
+         detail::BoxGreen::tableEntries(width, height, depth) * sizeof(double);
 }
 
 }  // namespace effects::lightning

@@ -1,8 +1,9 @@
-// Private to effects/lightning: DBM's 2-D Dirichlet problem (laplace.h) solved directly by
+// Private to effects/lightning: DBM's Dirichlet problem (laplace.h, laplace3.h) solved directly by
 // the capacitance-matrix method (Buzbee, Dorr, George & Golub 1971; Proskurowski & Widlund
 // 1976): the potential is a sum of point sources at the fixed cells,
 //   phi(x) = sum_j q_j G(x, x_j),
-// with G the Green's function of the 5-point Laplacian on the whole box (0 outside), which is
+// with G the Green's function of the 5-point (7-point in 3-D) Laplacian on the whole box (0
+// outside), which is
 // known in closed form. The charges q solve C q = v, C_ij = G(x_i, x_j), v the fixed values,
 // so phi is the exact solution of the same discrete problem Laplace solves iteratively. DBM
 // fixes one cell a step: C grows by a row, its Cholesky factor by a row (O(m^2)), and phi at
@@ -17,25 +18,31 @@
 
 namespace effects::lightning::detail {
 
-// G(a, b) of a width x height grid, A G(., b) = e_b with A the 5-point operator (4 on the
-// diagonal) and 0 outside. A sine series along the shorter axis times the other axis's 1-D
-// Green's functions in closed form; the products of sines and of hyperbolic functions fold
-// into one table K(ds, dt) of (2n + 1) x (2m + 1) entries, so that G is four lookups.
+// G(a, b) of a width x height (x depth) grid, A G(., b) = e_b with A the 5-point operator (4
+// on the diagonal; in 3-D the 7-point one, 6) and 0 outside. A sine series along the shorter
+// axis (the two shorter axes) times the longest axis's 1-D Green's functions in closed form;
+// the products of sines and of hyperbolic functions fold into one table K of
+// (2 n1 + 1) (x (2 n2 + 1)) x (2 m + 1) entries, so that G is four lookups (eight in 3-D).
 class BoxGreen {
  public:
-  BoxGreen(int width, int height);
+  BoxGreen(int width, int height, int depth = 0);  // depth 0: a 2-D grid
   double operator()(Cell a, Cell b) const;
   size_t bytes() const { return k_.size() * sizeof(double); }
+  static size_t tableEntries(int width, int height, int depth = 0);
 
  private:
-  bool transposed_;  // the series runs along y (the shorter axis)
-  int n_, m_;        // series axis length, closed-form axis length
-  size_t stride_;    // 2 m + 1
+  // A cell's coordinates along the series axes and the closed-form axis, from 1 (0 and
+  // length + 1 are the pad).
+  int axis(Cell c, int k) const { return (order_[k] == 0 ? c.x : order_[k] == 1 ? c.y : c.z) + 1; }
+  int order_[3];      // series axis 1, series axis 2 (3-D), closed-form axis: 0 x, 1 y, 2 z
+  bool volume_;       // 3-D
+  size_t stride2_;    // 2 n2 + 1 (3-D)
+  size_t stride_;     // 2 m + 1
   std::vector<double> k_;
 };
 
 // The table of a grid size, kept beside the boundary maps (grid.h: cachedMap).
-std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height);
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth = 0);
 
 class Capacitance final : public Potential {
  public:
@@ -43,13 +50,18 @@ class Capacitance final : public Potential {
   // cells) and O(cells) in MGPCG: past maxFixed() fixed cells the problem goes to Laplace
   // (MGPCG at the request's tolerance). About 4.5 sqrt(cells), where the two measured even
   // (bolts at 64^2-256^2 handed over at several limits), and at most 1024.
-  static size_t maxFixed(int width, int height);
+  // In 3-D: at most 1024, where a step still costs a few milliseconds against MGPCG's tens.
+  static size_t maxFixed(int width, int height, int depth = 0);
   // Working memory at most: the Cholesky factor (maxFixed^2 / 2 entries) and the rows (about
   // 4 maxFixed^2 at the limit: ~3 candidates and the cell itself per fixed cell), 6 maxFixed^2
-  // entries in all; rows beyond that hand over too.
-  static size_t maxBytes(int width, int height);
+  // entries in all; rows beyond that hand over too. In 3-D (~10 candidates per bolt voxel
+  // with 26 neighbours) 64 MB.
+  static size_t maxBytes(int width, int height, int depth = 0);
+  // Whether a grid's table is small enough to build (every 2-D grid up to the solver's cell
+  // limit; 3-D up to about 80^3, 32 MB).
+  static bool fits(int width, int height, int depth);
 
-  Capacitance(int width, int height);
+  Capacitance(int width, int height, int depth = 0);
   void fix(Cell c, double value) override;
   int solve(Solver solver, double tolerance) override;
   double phi(Cell c) const override;
@@ -68,13 +80,13 @@ class Capacitance final : public Potential {
   Row& row(Cell c) const;
   double* block(uint32_t b) const { return pages_[b / kBlocksPerPage].get() + (b % kBlocksPerPage) * kBlock; }
   double entry(const Row& r, size_t j) const { return block(r.blocks[j / kBlock])[j % kBlock]; }
-  size_t at(Cell c) const { return size_t(c.y) * size_t(w_) + size_t(c.x); }
+  size_t at(Cell c) const { return (size_t(c.z) * size_t(h_) + size_t(c.y)) * size_t(w_) + size_t(c.x); }
   // Row . q over the first n fixed cells.
   double dotQ(const Row& r, size_t n) const;
   void handOver();
   static constexpr size_t kBlocksPerPage = 64;
 
-  int w_, h_;
+  int w_, h_, d_;  // d_ 0: 2-D
   size_t maxFixed_, maxBytes_;
   std::shared_ptr<const BoxGreen> green_;
   std::vector<Cell> fixed_;
@@ -87,7 +99,7 @@ class Capacitance final : public Potential {
   mutable std::vector<Row> rows_;
   mutable std::vector<std::unique_ptr<double[]>> pages_;
   mutable uint32_t blocks_ = 0;  // pool blocks handed out
-  std::unique_ptr<Laplace> fallback_;
+  std::unique_ptr<Potential> fallback_;
 };
 
 }  // namespace effects::lightning::detail

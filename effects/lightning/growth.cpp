@@ -505,10 +505,11 @@ std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target, Solver solver
   std::unique_ptr<detail::Potential> lap;
   size_t fixedCells = bolt_.nodes.size() + 1;
   for (uint8_t o : p_.obstacles) fixedCells += o != 0;
-  if (p_.depth)
+  if (solver == Solver::kCapacitance && detail::Capacitance::fits(p_.width, p_.height, p_.depth) &&
+      fixedCells <= detail::Capacitance::maxFixed(p_.width, p_.height, p_.depth) / 2)
+    lap = std::make_unique<detail::Capacitance>(p_.width, p_.height, p_.depth);
+  else if (p_.depth)
     lap = std::make_unique<detail::Laplace3>(p_.width, p_.height, p_.depth);
-  else if (solver == Solver::kCapacitance && fixedCells <= detail::Capacitance::maxFixed(p_.width, p_.height) / 2)
-    lap = std::make_unique<detail::Capacitance>(p_.width, p_.height);
   else
     lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
   for (size_t i = 0; i < g_.cells(); ++i)

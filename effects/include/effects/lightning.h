@@ -16,9 +16,10 @@
 //            Defaults calibrated to DBM (docs/lightning-calibration.md): a = 1.2 per cell,
 //            candidates never expire; the paper's literal a = 2, lifetime 4 are kPaper*.
 //   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
-//            Phi = 1). Solver kCapacitance (the default; 2-D): the exact solution by the
+//            Phi = 1). Solver kCapacitance (the default): the exact solution by the
 //            capacitance-matrix method, one Cholesky row per step, while the fixed cells are
-//            few (about 4.5 sqrt(cells), at most 1024); past that, and in 3-D, MGPCG.
+//            few (2-D: about 4.5 sqrt(cells), at most 1024; 3-D: 1024, on grids up to about
+//            80^3); past that, MGPCG.
 //            kMgpcg: multigrid-preconditioned CG warm-started to `tolerance`; kCg: plain CG
 //            (the baseline of Kim & Lin 2004 and of seed 002's comparison).
 //   kCharges Kim et al. 2007: incremental point-charge potential, no linear solve.
@@ -87,9 +88,10 @@ double calibratedChargesEta(const Params& p);
 
 const char* toString(Method m);
 const char* toString(Solver s);
-// Working memory kDbm's capacitance solver may take on a 2-D grid beyond the iterative
-// solver's (its Cholesky factor, rows of G, the grid's table of G), for admission estimates.
-size_t capacitanceBytes(int width, int height);
+// Working memory kDbm's capacitance solver may take on a grid (depth 0: 2-D) beyond the
+// iterative solver's (its Cholesky factor, rows of G, the grid's table of G), for admission
+// estimates; 0 where the grid is too large for it (3-D past about 80^3: MGPCG alone).
+size_t capacitanceBytes(int width, int height, int depth = 0);
 
 struct Params {
   int width = 128, height = 128;
@@ -153,6 +155,11 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height, i
 // outside; 1 on target) by the given solver (kCapacitance: direct while its limit allows).
 // Returns the full grid, row-major.
 std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
+                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
+                                 int* iterations = nullptr, double* residual = nullptr);
+// The same on a 3-D grid (depth > 0; depth 0: the 2-D one above); cells (z * height + y) *
+// width + x.
+std::vector<double> solveLaplace(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
                                  const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
                                  int* iterations = nullptr, double* residual = nullptr);
 
