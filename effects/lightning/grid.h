@@ -13,28 +13,6 @@
 
 namespace effects::lightning::detail {
 
-// A per-cell array of zeros in calloc'd memory: large blocks come from fresh pages, which
-// the kernel supplies zeroed, so the pages a request never touches are never faulted in (a
-// 3-D grid's bolt touches a sliver of its voxels; filling 128^3 entries cost more than growing
-// the bolt).
-template <class T>
-class Zeroed {
- public:
-  explicit Zeroed(size_t n = 0) { reset(n); }
-  void reset(size_t n) {
-    p_.reset(static_cast<T*>(std::calloc(n ? n : 1, sizeof(T))));
-    if (!p_) throw std::bad_alloc();
-  }
-  T& operator[](size_t i) { return p_[i]; }
-  const T& operator[](size_t i) const { return p_[i]; }
-
- private:
-  struct Free {
-    void operator()(T* p) const { std::free(p); }
-  };
-  std::unique_ptr<T[], Free> p_;
-};
-
 // A value per cell, zero until set, for the bookkeeping of one request (bolt and candidate
 // cells, A*'s search). A bolt touches a sliver of a large grid, and clearing (or faulting in)
 // a flat array of a 4096^2 or 128^3 grid cost more than growing the bolt. So the cells come
@@ -91,7 +69,7 @@ class CellIndex {
 class SharedMemo {
  public:
   static constexpr size_t kPageBits = 10, kPage = size_t(1) << kPageBits;
-  explicit SharedMemo(size_t cells = 0) : pages_((cells + kPage - 1) >> kPageBits), dir_(pages_ ? pages_ : 1) {}
+  explicit SharedMemo(size_t cells = 0) : pages_((cells + kPage - 1) >> kPageBits), dir_(new float*[pages_]()) {}
   ~SharedMemo() {
     for (size_t p = 0; p < pages_; ++p) std::free(std::atomic_ref<float*>(dir_[p]).load(std::memory_order_relaxed));
   }
@@ -118,7 +96,7 @@ class SharedMemo {
 
  private:
   size_t pages_;
-  mutable Zeroed<float*> dir_;
+  std::unique_ptr<float*[]> dir_;  // a page's pointer, null until made
 };
 
 struct Grid {
