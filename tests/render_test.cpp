@@ -71,7 +71,10 @@ TEST(Render, ExampleScenesMatchTheirGoldenImages) {
   TestServer s;
   const bool update = std::getenv("EFFECTD_UPDATE_GOLDEN") != nullptr;
   int scenes = 0;
-  for (const auto& entry : fs::directory_iterator(EFFECTD_EXAMPLES_DIR)) {
+  // The scenes and goldens: EFFECTD_EXAMPLES_DIR in the environment (a build copied to another
+  // machine without the source tree), else the source tree's examples/.
+  const char* examples = std::getenv("EFFECTD_EXAMPLES_DIR");
+  for (const auto& entry : fs::directory_iterator(examples ? examples : EFFECTD_EXAMPLES_DIR)) {
     if (entry.path().extension() != ".json") continue;
     ++scenes;
     SCOPED_TRACE(entry.path().filename().string());
