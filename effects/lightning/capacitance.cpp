@@ -20,27 +20,48 @@ namespace effects::lightning::detail {
 //   K(ds, dt) = 1 / (n + 1) sum_k cos(theta_k ds) h_k(dt),
 //   h_k(d) = cosh(mu_k (M - d)) / (2 sinh mu_k sinh(mu_k M))
 //          = (e^(-mu_k d) + e^(-mu_k (2M - d))) / (2 sinh mu_k (1 - e^(-2 mu_k M)))  (no overflow).
+namespace {
+// cos(pi j / (n + 1)) for j = 0 .. 2n + 1: a sine series' cosines, indexed (k d) mod 2 (n + 1).
+std::vector<double> cosines(int n) {
+  std::vector<double> c(size_t(2 * (n + 1)));
+  for (size_t j = 0; j < c.size(); ++j) c[j] = std::cos(M_PI * double(j) / (n + 1));
+  return c;
+}
+// 2 sin^2(theta_k / 2), theta_k = pi k / (n + 1): mode k's part of cosh mu - 1 (no cancellation).
+double halfSquared(int k, int n) {
+  const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
+  return 2 * half * half;
+}
+// h(d), d = 0 .. 2m, of the closed-form axis (m cells, M = m + 1) for cosh mu = 1 + delta.
+void closedForm(double delta, int m, std::vector<double>& h) {
+  const int M = m + 1;
+  const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
+  const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
+  for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
+}
+// Mode k of a series over n cells: row r of `out` (r = 0 .. 2n, `stride` entries each) gains
+// cos(theta_k r) / divisor times `in`.
+void addMode(const std::vector<double>& cosine, int k, int n, double divisor, const double* in, size_t stride,
+             double* out) {
+  for (int r = 0; r <= 2 * n; ++r) {
+    const double c = cosine[size_t((k * r) % (2 * (n + 1)))] / divisor;
+    double* row = out + size_t(r) * stride;
+    for (size_t i = 0; i < stride; ++i) row[i] += c * in[i];
+  }
+}
+}  // namespace
+
 BoxGreen::BoxGreen(int width, int height, int depth) : volume_(depth > 0) {
   if (!volume_) {
     order_[0] = height < width ? 1 : 0, order_[1] = -1, order_[2] = height < width ? 0 : 1;
-    const int n = std::min(width, height), m = std::max(width, height), M = m + 1, period = 2 * (n + 1);
+    const int n = std::min(width, height), m = std::max(width, height);
     stride2_ = 1, stride_ = size_t(2 * m + 1);
-    std::vector<double> cosine(static_cast<size_t>(period));
-    for (int j = 0; j < period; ++j) cosine[size_t(j)] = std::cos(M_PI * j / (n + 1));
+    const std::vector<double> cosine = cosines(n);
     std::vector<double> h(stride_);
     k_.assign(size_t(2 * n + 1) * stride_, 0.0);
-    for (int k = 1; k <= n; ++k) {
-      // cosh mu = 2 - cos theta = 1 + delta, delta = 2 sin^2(theta / 2) (no cancellation).
-      const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
-      const double delta = 2 * half * half;
-      const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
-      const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
-      for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
-      for (int ds = 0; ds <= 2 * n; ++ds) {
-        const double c = cosine[size_t((k * ds) % period)] / (n + 1);
-        double* row = &k_[size_t(ds) * stride_];
-        for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
-      }
+    for (int k = 1; k <= n; ++k) {  // cosh mu = 2 - cos theta_k
+      closedForm(halfSquared(k, n), m, h);
+      addMode(cosine, k, n, n + 1, h.data(), stride_, k_.data());
     }
     return;
   }
@@ -52,39 +73,19 @@ BoxGreen::BoxGreen(int width, int height, int depth) : volume_(depth > 0) {
   int ax[3] = {0, 1, 2};
   std::stable_sort(ax, ax + 3, [&](int a, int b) { return len[a] < len[b]; });
   std::copy(ax, ax + 3, order_);
-  const int n1 = len[ax[0]], n2 = len[ax[1]], m = len[ax[2]], M = m + 1;
+  const int n1 = len[ax[0]], n2 = len[ax[1]], m = len[ax[2]];
   stride2_ = size_t(2 * n2 + 1), stride_ = size_t(2 * m + 1);
-  auto cosines = [](int n) {
-    std::vector<double> c(size_t(2 * (n + 1)));
-    for (size_t j = 0; j < c.size(); ++j) c[j] = std::cos(M_PI * double(j) / (n + 1));
-    return c;
-  };
   const std::vector<double> cos1 = cosines(n1), cos2 = cosines(n2);
-  auto halfSquared = [](int k, int n) {
-    const double half = std::sin(M_PI * k / (2.0 * (n + 1)));
-    return 2 * half * half;
-  };
   const size_t plane = stride2_ * stride_;
   k_.assign(size_t(2 * n1 + 1) * plane, 0.0);
   std::vector<double> b(plane), h(stride_);
   for (int k = 1; k <= n1; ++k) {
     std::fill(b.begin(), b.end(), 0.0);
     for (int l = 1; l <= n2; ++l) {
-      const double delta = halfSquared(k, n1) + halfSquared(l, n2);
-      const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
-      const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
-      for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
-      for (int d2 = 0; d2 <= 2 * n2; ++d2) {
-        const double c = cos2[size_t((l * d2) % (2 * (n2 + 1)))];
-        double* row = &b[size_t(d2) * stride_];
-        for (size_t d = 0; d < stride_; ++d) row[d] += c * h[d];
-      }
+      closedForm(halfSquared(k, n1) + halfSquared(l, n2), m, h);
+      addMode(cos2, l, n2, 1.0, h.data(), stride_, b.data());
     }
-    for (int d1 = 0; d1 <= 2 * n1; ++d1) {
-      const double c = cos1[size_t((k * d1) % (2 * (n1 + 1)))] / (double(n1 + 1) * double(n2 + 1));
-      double* out = &k_[size_t(d1) * plane];
-      for (size_t i = 0; i < plane; ++i) out[i] += c * b[i];
-    }
+    addMode(cos1, k, n1, double(n1 + 1) * double(n2 + 1), b.data(), plane, k_.data());
   }
 }
 

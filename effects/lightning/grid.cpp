@@ -330,9 +330,7 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
 }
 
 double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c) {
-  const detail::BoundaryMap border(width, height, nullptr);
-  if (detail::obstacleBits(obstacles).empty()) return border.potential(c);
-  return border.potential(c) + detail::BoundaryMap(width, height, &obstacles).potential(c);
+  return detail::cachedBoundary(width, height, obstacles).potential(c);
 }
 
 }  // namespace effects::lightning

@@ -287,7 +287,7 @@ std::vector<double> solveLaplace(int width, int height, int depth, const std::ve
     lap = std::make_unique<detail::Laplace>(width, height);
   const detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
   for (size_t i = 0; i < g.cells(); ++i)
-    if (g.blocked(g.cellAt(i).x, g.cellAt(i).y, g.cellAt(i).z)) lap->fix(g.cellAt(i), 0.0);
+    if (!obstacles.empty() && obstacles[i]) lap->fix(g.cellAt(i), 0.0);
   for (const Cell& c : bolt) lap->fix(c, 0.0);
   lap->fix(target, 1.0);
   int it = lap->solve(solver, tolerance);

@@ -130,9 +130,7 @@ size_t VolumeBoundary::bytes() const {
 }  // namespace detail
 
 double boundaryPotential(int width, int height, int depth, const std::vector<uint8_t>& obstacles, Cell c) {
-  const detail::VolumeBoundary shell(width, height, depth, nullptr);
-  if (detail::obstacleBits(obstacles).empty()) return shell.potential(c);
-  return shell.potential(c) + detail::VolumeBoundary(width, height, depth, &obstacles).potential(c);
+  return detail::cachedBoundary(width, height, depth, obstacles).potential(c);
 }
 
 }  // namespace effects::lightning
