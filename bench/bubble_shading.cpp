@@ -166,15 +166,15 @@ int main(int argc, char** argv) {
     std::vector<double> de, inside;
     for (size_t p = 0; p < reference.bubble.size(); ++p)
       if (reference.bubble[p]) {
-        const float *a = &image.rgba[p * 4], *b = &reference.image.rgba[p * 4];
-        de.push_back(bb::deltaE({a[0], a[1], a[2]}, {b[0], b[1], b[2]}));
+        const float* b = &reference.image.rgba[p * 4];  // the render as its 8-bit PNG holds it
+        de.push_back(bb::deltaE({image.at(p * 4), image.at(p * 4 + 1), image.at(p * 4 + 2)}, {b[0], b[1], b[2]}));
         if (interior[p]) inside.push_back(de.back());
       }
     double mean = 0;
     for (double d : de) mean += d;
     mean /= std::max<size_t>(1, de.size());
     if (argc > 3) {  // the pictures behind the numbers
-      rd::Image map{size, size, std::vector<float>(size_t(size) * size_t(size) * 4, 1.0f)};
+      rd::Image map{size, size, std::vector<float>(size_t(size) * size_t(size) * 4, 1.0f), {}};
       for (size_t p = 0, k = 0; p < reference.bubble.size(); ++p) {
         const double d = reference.bubble[p] ? de[k++] : 0.0;
         for (int c = 0; c < 3; ++c) map.rgba[p * 4 + size_t(c)] = float(std::min(d / 20, 1.0));

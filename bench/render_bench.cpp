@@ -1,12 +1,15 @@
 // 512x512 render latency on whatever EGL offers (llvmpipe without a GPU), p50 and p99, for
 // lightning only, fog only, bubble only and all three, then the bubble's shading variants (the
-// paper's model, + its film table; the film front only, + the far side, + highlights). Two columns: the frame itself (GPU
-// passes + read-back, variants already compiled) and the whole request path (scene building:
-// bolt growth, icosphere, thin-film table; the frame; PNG encoding).
+// paper's model, + its film table; the film front only, + the far side, + highlights). Columns:
+// the frame itself (GPU passes + read-back, variants already compiled), the whole request path
+// (scene building with the server's thread pool: bolt growth, icosphere, thin-film table, film
+// thickness; the frame; PNG encoding), then the p50 of each stage: build, draw (the passes
+// issued and finished), read (read-back into the PNG's format), png (encoding).
 //   build/bench/render_bench [iterations=40]
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
 #include <vector>
 
 #include <render/render.h>
@@ -43,29 +46,39 @@ double percentile(std::vector<double> v, double p) {
 }
 
 // Renders `body` iterations + 1 times as a request would (the first, which compiles the
-// variants, not counted) and prints one row; false when the renderer refuses.
-bool measure(rd::Renderer& renderer, const effectd::Config& config, const char* name, const json& body,
+// variants, not counted) and prints one row: frame and request p50/p99, then the p50 of each
+// stage of the request (scene building, the passes drawn and finished, the read-back, the PNG);
+// false when the renderer refuses.
+bool measure(rd::Renderer& renderer, const effectd::RequestContext& ctx, const char* name, const json& body,
              int iterations) {
-  std::vector<double> frame, request;
+  std::vector<double> frame, request, build, draw, read, png;
   std::string passes;
   for (int i = 0; i <= iterations; ++i) {
     effects::Stopwatch watch;
-    rd::Scene s = effectd::buildScene(body, effectd::RequestContext{"bench", config});
+    rd::Scene s = effectd::buildScene(body, ctx);
+    const double built = watch.ms();
     auto f = renderer.render(s);
     if (!f.ok()) {
       std::fprintf(stderr, "%s: %s\n", name, f.error().message.c_str());
       return false;
     }
-    auto png = rd::encodePng(f.value().image, 8);
+    effects::Stopwatch encode;
+    auto bytes = rd::encodePng(f.value().image, 8, ctx.parallel);
     if (i == 0) {
       passes = f.value().passList();
       continue;
     }
     frame.push_back(f.value().ms);
     request.push_back(watch.ms());
+    build.push_back(built);
+    draw.push_back(f.value().drawMs);
+    read.push_back(f.value().readMs);
+    png.push_back(encode.ms());
   }
-  std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %s\n", name, percentile(frame, 0.5),
-              percentile(frame, 0.99), percentile(request, 0.5), percentile(request, 0.99), passes.c_str());
+  std::printf("%-16s %9.1f ms %9.1f ms %11.1f ms %11.1f ms  %6.1f %6.1f %6.1f %6.1f  %s\n", name,
+              percentile(frame, 0.5), percentile(frame, 0.99), percentile(request, 0.5), percentile(request, 0.99),
+              percentile(build, 0.5), percentile(draw, 0.5), percentile(read, 0.5), percentile(png, 0.5),
+              passes.c_str());
   return true;
 }
 
@@ -74,21 +87,24 @@ bool measure(rd::Renderer& renderer, const effectd::Config& config, const char* 
 int main(int argc, char** argv) {
   const int iterations = argc > 1 ? std::max(2, std::atoi(argv[1])) : 40;
   effectd::Config config;
+  // As the server builds scenes: the request's thread and a pool of the other cores.
+  effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);
+  const effectd::RequestContext ctx{"bench", config, &pool};
   auto renderer = rd::Renderer::create();
   if (!renderer.ok()) {
     std::fprintf(stderr, "render_bench: %s\n", renderer.error().message.c_str());
     return 1;
   }
   std::printf("renderer: %s, 512x512, %d iterations each\n\n", renderer.value()->description().c_str(), iterations);
-  std::printf("%-16s %12s %12s %14s %14s  %s\n", "scene", "frame p50", "frame p99", "request p50", "request p99",
-              "passes");
+  std::printf("%-16s %12s %12s %14s %14s  %6s %6s %6s %6s  %s\n", "scene", "frame p50", "frame p99", "request p50",
+              "request p99", "build", "draw", "read", "png", "passes");
   struct Case {
     const char* name;
     bool lightning, fog, bubble;
   };
   for (const Case& c : {Case{"lightning only", true, false, false}, Case{"fog only", false, true, false},
                         Case{"bubble only", false, false, true}, Case{"all three", true, true, true}}) {
-    if (!measure(*renderer.value(), config, c.name, scene(c.lightning, c.fog, c.bubble), iterations)) return 1;
+    if (!measure(*renderer.value(), ctx, c.name, scene(c.lightning, c.fog, c.bubble), iterations)) return 1;
   }
   // The bubble's shading variants alone, each building its scene as a request does; the film's
   // frames include its thickness texture (128 x 64 by default), recomputed each frame.
@@ -109,7 +125,7 @@ int main(int argc, char** argv) {
         Variant{"film +highlight", film}}) {
     json body = scene(false, false, false);
     body["bubble"] = v.bubble;
-    if (!measure(*renderer.value(), config, v.name, body, iterations)) return 1;
+    if (!measure(*renderer.value(), ctx, v.name, body, iterations)) return 1;
   }
   std::printf("\ntarget: all three, request p50 <= 150 ms on the 2-core CI-class machine\n");
   return 0;

@@ -99,17 +99,27 @@ struct Target {
   GLuint fbo = 0, depth = 0;
   Texture color;
   int width = 0, height = 0;
+  GLenum format = 0;
   Target() = default;
   Target(const Target&) = delete;
   Target& operator=(const Target&) = delete;
-  ~Target() {
+  ~Target() { release(); }
+  void release() {
     if (fbo) glDeleteFramebuffers(1, &fbo);
     if (depth) glDeleteRenderbuffers(1, &depth);
+    fbo = depth = 0, color = Texture(), width = height = 0, format = 0;
   }
-  bool create(int w, int h, GLenum internal, bool withDepth) {
-    width = w, height = h;
-    color = texture2D(w, h, internal, GL_RGBA, internal == GL_RGBA32F ? GL_FLOAT : GL_HALF_FLOAT, nullptr,
-                      GL_CLAMP_TO_EDGE);
+  // Made on first use and again only when the size, format or depth differ (a render thread
+  // keeps its targets from frame to frame); bound for drawing either way.
+  bool ensure(int w, int h, GLenum internal, bool withDepth) {
+    if (fbo && width == w && height == h && format == internal && (depth != 0) == withDepth) {
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+      return true;
+    }
+    release();
+    width = w, height = h, format = internal;
+    const GLenum type = internal == GL_RGBA8 ? GL_UNSIGNED_BYTE : internal == GL_RGBA32F ? GL_FLOAT : GL_HALF_FLOAT;
+    color = texture2D(w, h, internal, GL_RGBA, type, nullptr, GL_CLAMP_TO_EDGE);
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id, 0);
@@ -119,7 +129,9 @@ struct Target {
       glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
     }
-    return glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE) return true;
+    release();
+    return false;
   }
   void use() const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);

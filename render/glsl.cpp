@@ -324,4 +324,17 @@ std::string blendFragment() {
          "void main() { fragColor = vec4(uColor * uAmount, uAmount); }  // eqn 12 via blending\n";
 }
 
+std::string resolveFragment() {
+  return std::string(kFragmentHeader) +
+         "uniform sampler2D uFrame;\nout vec4 fragColor;\n"
+         "void main() {\n"
+         "  ivec2 size = textureSize(uFrame, 0);\n"
+         "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+         "  vec4 c = texelFetch(uFrame, ivec2(p.x, size.y - 1 - p.y), 0);  // flipped: rows top-down\n"
+         "  float a = clamp(c.a, 0.0, 1.0);\n"
+         "  vec3 rgb = a > 0.0 ? clamp(c.rgb / a, 0.0, 1.0) : vec3(0.0);\n"
+         "  fragColor = floor(vec4(rgb, a) * 255.0 + 0.5) / 255.0;\n"
+         "}\n";
+}
+
 }  // namespace effects::render::detail

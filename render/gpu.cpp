@@ -8,6 +8,9 @@ Gpu::~Gpu() {
     for (auto& p : programs) glDeleteProgram(p.second.id);
     if (emptyVao) glDeleteVertexArrays(1, &emptyVao);
     normalA = Texture(), normalB = Texture(), waveAlpha = Texture(), defaultFlow = Texture();
+    for (Target* t : {&main, &resolved, &boltCore, &blurred, &glow}) t->release();
+    environment = Texture();
+    if (environmentFbo) glDeleteFramebuffers(1, &environmentFbo);
     destroyContext(egl);
   }
 }

@@ -36,6 +36,11 @@ struct Gpu {
   Texture normalA, normalB, waveAlpha, defaultFlow;
   std::vector<float> waveVertices;  // the surface-wave quad with its MikkTSpace frames
   std::vector<uint32_t> waveIndices;
+  // Kept from frame to frame (made again only when a frame's size or format differs): the
+  // frame, its 8-bit resolve, the bolt's core and glow buffers, the environment cube.
+  Target main, resolved, boltCore, blurred, glow;
+  Texture environment;
+  GLuint environmentFbo = 0;
 
   ~Gpu();
   // The program for `key` (compiled and linked on first use: the variant cache).
@@ -60,7 +65,7 @@ View viewOf(const Scene& s);
 struct FrameState {
   const Scene& scene;
   View view;
-  Target main;                    // premultiplied RGBA float with depth
+  Target& main;                   // premultiplied RGBA float with depth (Gpu::main)
   std::optional<FogVariant> fog;  // the fog shader variant when the scene has fog
   std::string fogKey;             // ":" + its key, part of the program keys that include fog
   Texture backgroundImage;        // the backdrop image, when it is one

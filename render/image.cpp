@@ -1,4 +1,4 @@
-// PNG out and PNG/JPEG in, in memory, through OpenImageIO.
+// GIFs out and PNG/JPEG in, in memory, through OpenImageIO (PNGs out: png.cpp).
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
@@ -9,22 +9,6 @@
 #include "render/render.h"
 
 namespace effects::render {
-
-Result<std::string> encodePng(const Image& image, int bitDepth) {
-  if (bitDepth != 8 && bitDepth != 16) return invalid("/bitDepth", "must be 8 or 16");
-  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * image.height * 4)
-    return invalid("/image", "has no pixels");
-  std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy(bytes);
-  auto out = OIIO::ImageOutput::create("frame.png", &proxy);
-  if (!out) return unsatisfiable("/image", "OpenImageIO has no PNG writer");
-  OIIO::ImageSpec spec(image.width, image.height, 4, bitDepth == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
-  spec.attribute("oiio:UnassociatedAlpha", 1);  // the pixels are straight alpha already
-  spec.attribute("png:compressionLevel", 3);    // fast; previews are not archived
-  if (!out->open("frame.png", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !out->close())
-    return unsatisfiable("/image", "PNG encoding failed: " + out->geterror());
-  return std::string(bytes.begin(), bytes.end());
-}
 
 int gifDelay(double fps) { return std::max(2, int(std::lround(100.0 / fps))); }
 
@@ -61,11 +45,15 @@ std::optional<Error> GifEncoder::add(const Image& frame) {
   if (g.added >= int(g.specs.size())) return invalid("/frames", "more frames than announced");
   if (g.added > 0 && !g.out->open("frames.gif", g.specs[size_t(g.added)], OIIO::ImageOutput::AppendSubimage))
     return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
-  // OpenImageIO's GIF writer takes 8-bit pixels; round as encodePng does.
-  g.pixels.resize(frame.rgba.size());
-  for (size_t i = 0; i < frame.rgba.size(); ++i)
-    g.pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(frame.rgba[i], 0.0f, 1.0f) * 255.0f));
-  if (!g.out->write_image(OIIO::TypeDesc::UINT8, g.pixels.data()))
+  // OpenImageIO's GIF writer takes 8-bit pixels; rounded as encodePng rounds them.
+  const unsigned char* pixels = frame.rgba8.data();
+  if (frame.rgba8.empty()) {
+    g.pixels.resize(frame.rgba.size());
+    for (size_t i = 0; i < frame.rgba.size(); ++i)
+      g.pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(frame.rgba[i], 0.0f, 1.0f) * 255.0f));
+    pixels = g.pixels.data();
+  }
+  if (!g.out->write_image(OIIO::TypeDesc::UINT8, pixels))
     return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
   ++g.added;
   return std::nullopt;
@@ -92,12 +80,20 @@ Flipbook::Flipbook(int width, int height, int count) : frameWidth(width), frameH
 }
 
 void Flipbook::put(const Image& frame, int index) {
-  // Allocated with the first frame, on the render thread: a queued request holds no sheet.
-  if (sheet.rgba.empty()) sheet.rgba.assign(size_t(sheet.width) * size_t(sheet.height) * 4, 0.0f);
+  // Allocated with the first frame, on the render thread: a queued request holds no sheet. The
+  // sheet holds the frames' kind of values (bytes from an 8-bit render, else floats).
+  const size_t values = size_t(sheet.width) * size_t(sheet.height) * 4;
+  const bool bytes8 = !frame.rgba8.empty();
+  if (sheet.values() == 0) (bytes8 ? sheet.rgba8.assign(values, 0) : sheet.rgba.assign(values, 0.0f));
   const int cx = index % columns, cy = index / columns;
-  for (int y = 0; y < std::min(frame.height, frameHeight); ++y)
-    std::copy_n(&frame.rgba[size_t(y) * size_t(frame.width) * 4], size_t(std::min(frame.width, frameWidth)) * 4,
-                &sheet.rgba[((size_t(cy) * frameHeight + size_t(y)) * size_t(sheet.width) + size_t(cx) * frameWidth) * 4]);
+  for (int y = 0; y < std::min(frame.height, frameHeight); ++y) {
+    const size_t from = size_t(y) * size_t(frame.width) * 4, n = size_t(std::min(frame.width, frameWidth)) * 4;
+    const size_t to = ((size_t(cy) * frameHeight + size_t(y)) * size_t(sheet.width) + size_t(cx) * frameWidth) * 4;
+    if (bytes8)
+      std::copy_n(&frame.rgba8[from], n, &sheet.rgba8[to]);
+    else
+      std::copy_n(&frame.rgba[from], n, &sheet.rgba[to]);
+  }
 }
 
 Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
@@ -111,9 +107,12 @@ Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
     return invalid("", "is neither a PNG nor a JPEG image");
   try {
     OIIO::Filesystem::IOMemReader proxy(data, bytes.size());
-    auto in = OIIO::ImageInput::create(name, false, nullptr, &proxy);
+    // Straight alpha, as a PNG stores it (OpenImageIO would otherwise multiply it in).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::create(name, false, &config, &proxy);
     OIIO::ImageSpec spec;
-    if (!in || !in->set_ioproxy(&proxy) || !in->open(name, spec))
+    if (!in || !in->set_ioproxy(&proxy) || !in->open(name, spec, config))
       return invalid("", "cannot be decoded: " + (in ? in->geterror() : std::string("no reader")));
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
       return invalid("", "has no usable pixels");
@@ -125,7 +124,7 @@ Result<Image> decodeImage(const std::string& bytes, size_t maxPixels) {
     std::vector<float> raw(pixels * size_t(n));
     if (!in->read_image(0, 0, 0, n, OIIO::TypeDesc::FLOAT, raw.data()))
       return invalid("", "cannot be decoded: " + in->geterror());
-    Image out{spec.width, spec.height, std::vector<float>(pixels * 4)};
+    Image out{spec.width, spec.height, std::vector<float>(pixels * 4), {}};
     for (size_t i = 0; i < pixels; ++i) {
       const float* s = &raw[i * size_t(n)];
       float* d = &out.rgba[i * 4];

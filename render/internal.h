@@ -50,5 +50,8 @@ std::string boltFragment();
 std::string blurFragment();
 std::string compositeFragment(bool glow);
 std::string blendFragment();
+// The frame (premultiplied, rows bottom-up) as an 8-bit PNG's rows: straight alpha, top-down,
+// each value floor(255 v + 0.5) / 255 so that the RGBA8 target stores round(255 v) exactly.
+std::string resolveFragment();
 
 }  // namespace effects::render::detail

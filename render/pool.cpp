@@ -44,7 +44,7 @@ std::optional<std::future<Result<Frame>>> RenderPool::submit(Scene scene, Sequen
   // Jobs beyond the idle workers wait; at most `queue` of them.
   const int idle = options_.threads - busy_.load();
   if (int(jobs_.size()) >= options_.queue + std::max(0, idle)) return std::nullopt;
-  jobs_.push_back(Job{std::move(scene), std::nullopt, {}});
+  jobs_.push_back(Job{std::move(scene), std::nullopt, {}, {}});
   if (sequence.count > 0) jobs_.back().sequence = std::move(sequence);
   auto future = jobs_.back().done.get_future();
   wake_.notify_one();
@@ -74,12 +74,12 @@ void RenderPool::worker(int) {
       }
     }
     try {
-      if (!renderer.ok())
-        job.done.set_value(unsatisfiable("/renderer", renderer.error().message));
-      else if (job.sequence)
-        job.done.set_value(renderer.value()->render(job.scene, *job.sequence));
-      else
-        job.done.set_value(renderer.value()->render(job.scene));
+      const double queueMs = job.queued.ms();
+      Result<Frame> frame = !renderer.ok()   ? Result<Frame>(unsatisfiable("/renderer", renderer.error().message))
+                            : job.sequence ? renderer.value()->render(job.scene, *job.sequence)
+                                           : renderer.value()->render(job.scene);
+      if (frame.ok()) frame.value().queueMs = queueMs;
+      job.done.set_value(std::move(frame));
     } catch (const std::exception& e) {
       job.done.set_value(unsatisfiable("/renderer", std::string("render failed: ") + e.what()));
     }

@@ -144,7 +144,7 @@ Result<Reference> referenceRender(const Scene& scene, Parallel* parallel) {
   const dvec3 eye = scene.camera.position;
   const size_t w = size_t(scene.width), h = size_t(scene.height);
   Reference out;
-  out.image = Image{scene.width, scene.height, std::vector<float>(w * h * 4, 1.0f)};
+  out.image = Image{scene.width, scene.height, std::vector<float>(w * h * 4, 1.0f), {}};
   out.bubble.assign(w * h, 0);
   forRange(parallel, h, 4, [&](size_t begin, size_t end) {
     std::vector<double> spectra(3 * toRgb.wavelengthsNm().size());

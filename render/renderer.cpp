@@ -36,14 +36,14 @@ namespace {
 
 using namespace detail;
 
-// Reads the main target back (rows bottom-up in GL), flipped and un-premultiplied.
-Result<Image> readBack(const Scene& scene) {
+// Reads the main target back (rows bottom-up in GL) as floats, flipped and un-premultiplied.
+Result<Image> readBackFloat(const Scene& scene) {
   const size_t w = size_t(scene.width), h = size_t(scene.height);
   std::vector<float> pixels(w * h * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadPixels(0, 0, scene.width, scene.height, GL_RGBA, GL_FLOAT, pixels.data());
   if (GLenum e = glGetError(); e != GL_NO_ERROR) return unsatisfiable("/renderer", "OpenGL error " + std::to_string(e));
-  Image image{scene.width, scene.height, std::vector<float>(w * h * 4)};
+  Image image{scene.width, scene.height, std::vector<float>(w * h * 4), {}};
   for (size_t y = 0; y < h; ++y) {
     const float* src = &pixels[(h - 1 - y) * w * 4];
     float* dst = &image.rgba[y * w * 4];
@@ -53,6 +53,25 @@ Result<Image> readBack(const Scene& scene) {
       dst[3] = a;
     }
   }
+  return image;
+}
+
+// For an 8-bit PNG: the GPU un-premultiplies, flips and rounds the frame into an RGBA8 target
+// (resolveFragment), and the read-back is the PNG's bytes, a quarter of the floats' size.
+Result<Image> readBack8(Gpu& gpu, const Scene& scene) {
+  auto program = gpu.program("resolve8", screenVertex(), resolveFragment());
+  if (!program.ok()) return program.error();
+  if (!gpu.resolved.ensure(scene.width, scene.height, GL_RGBA8, false))
+    return unsatisfiable("/renderer", "the 8-bit frame buffer cannot be created");
+  gpu.resolved.use();
+  Program& p = *program.value();
+  glUseProgram(p.id);
+  gpu.main.color.bind(0), p.set("uFrame", 0);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  Image image{scene.width, scene.height, {}, std::vector<uint8_t>(size_t(scene.width) * size_t(scene.height) * 4)};
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, scene.width, scene.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba8.data());
+  if (GLenum e = glGetError(); e != GL_NO_ERROR) return unsatisfiable("/renderer", "OpenGL error " + std::to_string(e));
   return image;
 }
 
@@ -67,9 +86,9 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
     return invalid("/lightning/grid", "must have at least one cell");
 
   // The frame: its main target cleared, the fog variant, the backdrop image uploaded.
-  FrameState f{scene, viewOf(scene), {}, {}, {}, {}, {}};
+  FrameState f{scene, viewOf(scene), gpu.main, {}, {}, {}, {}};
   const GLenum mainFormat = scene.bitDepth == 16 && gpu.floatBlend ? GL_RGBA32F : GL_RGBA16F;
-  if (!f.main.create(scene.width, scene.height, mainFormat, true))
+  if (!f.main.ensure(scene.width, scene.height, mainFormat, true))
     return unsatisfiable("/renderer", "the frame buffer cannot be created");
   f.main.use();
   glClearColor(0, 0, 0, 0);
@@ -100,10 +119,14 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   if (scene.blend && scene.blend->amount > 0) passes.push_back(cameraBlendPass);
   for (Pass pass : passes)
     if (auto e = pass(gpu, f)) return *e;
+  glFinish();
+  f.frame.drawMs = watch.ms();
 
-  auto image = readBack(scene);
+  Stopwatch read;
+  auto image = scene.bitDepth == 8 ? readBack8(gpu, scene) : readBackFloat(scene);
   if (!image.ok()) return image.error();
   f.frame.image = std::move(image.value());
+  f.frame.readMs = read.ms();
   f.frame.variantsCompiled = gpu.compiled;
   f.frame.variantsCached = int(gpu.programs.size());
   f.frame.ms = watch.ms();
@@ -151,6 +174,8 @@ Result<Frame> Renderer::render(Scene& scene, const Sequence& sequence) {
     auto frame = impl_->render(scene);
     if (!frame.ok()) return frame.error();
     total.ms += frame.value().ms;
+    total.drawMs += frame.value().drawMs;
+    total.readMs += frame.value().readMs;
     total.variantsCompiled += frame.value().variantsCompiled;
     total.variantsCached = frame.value().variantsCached;
     total.passes = frame.value().passes;

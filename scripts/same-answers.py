@@ -3,14 +3,47 @@
 the response cache off and sends both the same requests: every proto/examples request to its
 endpoint, every examples/*.json scene to /v1/render, a large tangents mesh in each mode and a
 level-6 bubble mesh. JSON answers are compared with their run-time fields removed (elapsedMs,
-computeMs and the like differ from run to run); PNG and glTF answers byte for byte.
+computeMs and the like differ from run to run); PNGs by their header and pixels (decoded here,
+every chunk's CRC and the zlib stream checked: two encoders may write the same pixels in
+different bytes); glTF and other answers byte for byte.
 
   scripts/same-answers.py OLD_EFFECTD NEW_EFFECTD     exit 0 when every answer is the same
 """
-import base64, glob, http.client, json, math, os, sys
+import base64, glob, http.client, json, math, os, struct, sys, zlib
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 from answers import scrub  # noqa: E402
 import effectd_process  # noqa: E402
+
+
+def png_pixels(data):
+    """(IHDR fields, unfiltered rows) of a non-interlaced PNG; raises on a bad CRC or stream."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    at, ihdr, idat = 8, None, b""
+    while at < len(data):
+        n, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + n]
+        assert struct.unpack(">I", data[at + 8 + n:at + 12 + n])[0] == zlib.crc32(kind + body), "bad CRC"
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        at += 12 + n
+    w, h, depth, ctype, _, _, interlace = ihdr
+    assert interlace == 0, "interlaced"
+    bpp = {0: 1, 2: 3, 4: 2, 6: 4}[ctype] * depth // 8
+    raw, stride, rows, prev = zlib.decompress(idat), w * bpp, [], bytearray(w * bpp)
+    for y in range(h):
+        f, row = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = row[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            p = a + b - c
+            pred = [0, a, b, (a + b) // 2,
+                    a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c][f]
+            row[i] = (row[i] + pred) & 0xFF
+        rows.append(bytes(row))
+        prev = row
+    return ihdr, b"".join(rows)
 
 
 def start(binary):
@@ -74,6 +107,8 @@ def main():
             same = a[0] == b[0] and a[1] == b[1]
             if same and "json" in a[1]:
                 same = scrub(json.loads(a[2])) == scrub(json.loads(b[2]))
+            elif same and a[1] == "image/png":
+                same = png_pixels(a[2]) == png_pixels(b[2])
             elif same:
                 same = a[2] == b[2]
             differ += not same

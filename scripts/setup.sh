@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config git ca-certificates curl
   libcpp-httplib-dev nlohmann-json3-dev libglm-dev
   libopenimageio-dev libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+  zlib1g-dev         # PNGs written in strips on several threads (render/png.cpp)
   libgtest-dev libgmock-dev libbenchmark-dev
   glslang-tools spirv-tools  # every shader variant compiled and validated by each language's own tools
   glslang-dev libspirv-cross-c-shared-dev  # GLSL -> SPIR-V -> HLSL / MSL (server/shader_targets.cpp)

@@ -290,8 +290,10 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
     shader["resources"] = resourcesJson(t->resources);
     if (target == ShaderTarget::kSpirv) shader["encoding"] = "base64: SPIR-V 1.0 words, little-endian (Vulkan 1.0)";
     reply.runHeaders["X-Shader-Cache"] = cached ? "hit" : "miss";
-    if (!cached)  // already inside the caller's compute time
+    if (!cached) {  // already inside the caller's compute time
       reply.runHeaders["X-Shader-Compile-Ms"] = std::to_string(t->compileMs);
+      reply.stages.emplace_back("shader", t->compileMs);
+    }
   }
   out["shader"] = std::move(shader);
 }

@@ -209,6 +209,7 @@ rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at,
   if (style.contains("baseColor")) b.baseColor = rgba(style["baseColor"]);
   if (style.contains("flowTexture")) b.flowTexture = image(style["flowTexture"], styleAt + "/flowTexture", config);
   b.time = t;
+  if (auto e = rd::prepareThickness(b, ctx.parallel)) throwError(*e, at);
   return b;
 }
 
@@ -338,7 +339,7 @@ JsonReply referenceReply(const json& body, const RequestContext& ctx) {
     if (!body.contains("bubble") && e.field.rfind("/bubble/", 0) == 0) e.field = "/bubbles/0" + e.field;
     throwError(e);
   }
-  auto png = rd::encodePng(r.value().image, scene.bitDepth);
+  auto png = rd::encodePng(r.value().image, scene.bitDepth, ctx.parallel);
   if (!png.ok()) throwError(png.error());
   reply.binary = std::move(png.value());
   reply.contentType = "image/png";
@@ -368,7 +369,7 @@ void addRenderEndpoints(Service& service) {
         rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
         const int bitDepth = scene.bitDepth;
         std::optional<MovieWriter> movie;
-        if (animation.frames.count > 0) movie.emplace(animation, scene.width, scene.height, bitDepth);
+        if (animation.frames.count > 0) movie.emplace(animation, scene.width, scene.height, bitDepth, ctx.parallel);
         auto job = movie ? pool->submit(std::move(scene), movie->sequence()) : pool->submit(std::move(scene));
         if (!job)
           throw ApiError{503,
@@ -389,14 +390,17 @@ void addRenderEndpoints(Service& service) {
           reply.contentType = m.value().contentType;
           for (auto& [name, value] : m.value().headers) reply.headers[name] = std::move(value);
         } else {
-          auto png = rd::encodePng(f.image, bitDepth);
+          auto png = rd::encodePng(f.image, bitDepth, ctx.parallel);
           if (!png.ok()) throwError(png.error());
           reply.binary = std::move(png.value());
           reply.contentType = "image/png";
         }
         for (const auto& p : f.passes) metrics->count("render_passes", p);
         metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
-        reply.computeMs += f.ms + encode.ms();
+        const double encodeMs = movie ? movie->encodeMs() : encode.ms();
+        reply.stages = {{"scene", reply.computeMs}, {"queue", f.queueMs}, {"draw", f.drawMs},
+                        {"read", f.readMs},         {"encode", encodeMs}};
+        reply.computeMs += f.ms + encodeMs;
         reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
                             {"X-Render-Ms", std::to_string(f.ms)}};
         return reply;

@@ -57,14 +57,15 @@ bool readScene(const std::string& scenePath, nlohmann::json& body) {
 int renderScene(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
   try {
     effectd::Animation animation;
+    effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);  // as the server's
     effects::render::Scene scene =
-        effectd::buildScene(body, effectd::RequestContext{"render", config}, nullptr, &animation);
+        effectd::buildScene(body, effectd::RequestContext{"render", config, &pool}, nullptr, &animation);
     auto renderer = effects::render::Renderer::create(config.eglPlatform);
     if (!renderer.ok()) throw effectd::toApiError(renderer.error());
     nlohmann::json said = {{"renderer", renderer.value()->description()}};
     std::string bytes;
     if (animation.frames.count > 0) {
-      effectd::MovieWriter writer(animation, scene.width, scene.height, scene.bitDepth);
+      effectd::MovieWriter writer(animation, scene.width, scene.height, scene.bitDepth, &pool);
       auto frames = renderer.value()->render(scene, writer.sequence());
       if (!frames.ok()) throw effectd::toApiError(frames.error());
       auto movie = writer.finish();
@@ -77,7 +78,7 @@ int renderScene(const nlohmann::json& body, const effectd::Config& config, const
     } else {
       auto frame = renderer.value()->render(scene);
       if (!frame.ok()) throw effectd::toApiError(frame.error());
-      auto png = effects::render::encodePng(frame.value().image, scene.bitDepth);
+      auto png = effects::render::encodePng(frame.value().image, scene.bitDepth, &pool);
       if (!png.ok()) throw effectd::toApiError(png.error());
       bytes = std::move(png.value());
       said["passes"] = frame.value().passList();

@@ -5,8 +5,9 @@ namespace effectd {
 
 namespace rd = effects::render;
 
-MovieWriter::MovieWriter(const Animation& animation, int width, int height, int bitDepth)
-    : animation_(animation), bitDepth_(bitDepth) {
+MovieWriter::MovieWriter(const Animation& animation, int width, int height, int bitDepth,
+                         effects::Parallel* parallel)
+    : animation_(animation), bitDepth_(bitDepth), parallel_(parallel) {
   if (animation.frames.flipbook)
     book_.emplace(width, height, animation.frames.count);
   else
@@ -29,23 +30,33 @@ rd::Sequence MovieWriter::sequence() {
     }
   };
   s.consume = [this](const rd::Frame& frame, int i) -> std::optional<effects::Error> {
-    if (book_) {
+    effects::Stopwatch watch;
+    std::optional<effects::Error> e;
+    if (book_)
       book_->put(frame.image, i);
-      return std::nullopt;
-    }
-    return gif_->add(frame.image);
+    else
+      e = gif_->add(frame.image);
+    encodeMs_ += watch.ms();
+    return e;
   };
   return s;
 }
 
 effects::Result<Movie> MovieWriter::finish() {
+  effects::Stopwatch watch;
+  auto movie = write();
+  encodeMs_ += watch.ms();
+  return movie;
+}
+
+effects::Result<Movie> MovieWriter::write() {
   Movie m;
   const Frames& f = animation_.frames;
   // A GIF plays at 100 / delay frames per second (whole hundredths); a flipbook at the rate asked.
   const double rate = book_ ? f.fps : 100.0 / rd::gifDelay(f.fps);
   m.headers = {{"X-Frame-Count", std::to_string(f.count)}, {"X-Frame-Rate", nlohmann::json(rate).dump()}};
   if (book_) {
-    auto png = rd::encodePng(book_->sheet, bitDepth_);
+    auto png = rd::encodePng(book_->sheet, bitDepth_, parallel_);
     if (!png.ok()) return png.error();
     m.bytes = std::move(png.value());
     m.contentType = "image/png";

@@ -43,13 +43,19 @@ struct Movie {
 // Renders `animation`'s frames into a Movie: hand sequence() to a renderer, then finish().
 class MovieWriter {
  public:
-  MovieWriter(const Animation& animation, int width, int height, int bitDepth);
+  // `parallel` writes a flipbook's PNG (null: the calling thread only).
+  MovieWriter(const Animation& animation, int width, int height, int bitDepth, effects::Parallel* parallel);
   effects::render::Sequence sequence();
   effects::Result<Movie> finish();
+  // Time spent encoding: each frame into the GIF or the sheet (on the render thread), and finish.
+  double encodeMs() const { return encodeMs_; }
 
  private:
   const Animation& animation_;
   int bitDepth_;
+  effects::Parallel* parallel_;
+  double encodeMs_ = 0;
+  effects::Result<Movie> write();  // finish() without the stopwatch
   std::optional<effects::render::GifEncoder> gif_;
   std::optional<effects::render::Flipbook> book_;
 };

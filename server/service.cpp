@@ -99,8 +99,16 @@ double answerBinary(const BinaryHandler& handler, const std::string& body, const
 
 // Runs a JSON body's handler into `answer` (JSON, or the bytes it answers with instead) and
 // frees the request document; the run's own headers go to `res` only. Returns its compute time.
-double answerJson(const JsonHandler& handler, json& body, const RequestContext& ctx, CachedAnswer& answer,
-                  httplib::Response& res) {
+// Server-Timing's value: compute first, then its stages.
+std::string serverTiming(double computeMs, const std::vector<std::pair<std::string, double>>& stages) {
+  std::string timing = "compute;dur=" + std::to_string(computeMs);
+  for (const auto& [name, ms] : stages) timing += ", " + name + ";dur=" + std::to_string(ms);
+  return timing;
+}
+
+// Answers a JSON request into `answer`; its run's headers (Server-Timing included) go to `res`.
+void answerJson(const JsonHandler& handler, json& body, const RequestContext& ctx, CachedAnswer& answer,
+                httplib::Response& res) {
   JsonReply reply = handler(body, ctx);
   body = json();  // the request document is no longer needed
   if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
@@ -113,7 +121,7 @@ double answerJson(const JsonHandler& handler, json& body, const RequestContext& 
     answer.body = writeJson(reply.body);
     answer.contentType = "application/json";
   }
-  return reply.computeMs;
+  res.set_header("Server-Timing", serverTiming(reply.computeMs, reply.stages));
 }
 
 // Encodes an answer worth compressing in the negotiated coding.
@@ -339,13 +347,11 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
 
     auto answer = std::make_shared<CachedAnswer>();
     answer->etag = tag;
-    const double computeMs = binary != route.binary.end() ? answerBinary(binary->second.handler, req.body, ctx, *answer)
-                                                          : answerJson(route.json, body, ctx, *answer, res);
+    if (binary != route.binary.end())
+      res.set_header("Server-Timing", serverTiming(answerBinary(binary->second.handler, req.body, ctx, *answer), {}));
+    else
+      answerJson(route.json, body, ctx, *answer, res);
     encodeAnswer(coding, *answer);
-    std::string timing = "compute;dur=" + std::to_string(computeMs);
-    if (res.has_header("X-Shader-Compile-Ms"))  // a shader translated for this answer (its part of compute)
-      timing += ", shader;dur=" + res.get_header_value("X-Shader-Compile-Ms");
-    res.set_header("Server-Timing", timing);
     sendAnswer(*answer, inm, res);
     if (!tag.empty()) cache_.put(std::move(answer), requestKey);
   } catch (const ApiError& e) {

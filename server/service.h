@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -43,6 +44,8 @@ struct JsonReply {
   std::string binary, contentType;
   std::map<std::string, std::string> headers;     // part of the answer (cached with it)
   std::map<std::string, std::string> runHeaders;  // facts of this run (timings): not cached
+  // Server-Timing entries after compute (name;dur=ms), in order: its parts, and waits.
+  std::vector<std::pair<std::string, double>> stages;
 };
 
 // What a request will cost, estimated from its body before any work starts: the bytes it

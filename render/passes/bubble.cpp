@@ -12,12 +12,17 @@ namespace effects::render::detail {
 namespace {
 
 // The backdrop as a cube map, so that eqn 8's final vector can look it up.
-std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environment) {
+// The cube (Gpu::environment) is made once per render thread and drawn again every frame.
+std::optional<Error> environmentCube(Gpu& gpu, FrameState& f) {
   const Background& bg = f.scene.background;
-  environment.make(GL_TEXTURE_CUBE_MAP);
-  for (int face = 0; face < 6; ++face)
-    glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, kEnvironmentSize, kEnvironmentSize, 0, GL_RGBA,
-                 GL_HALF_FLOAT, nullptr);
+  Texture& environment = gpu.environment;
+  if (!environment.id) {
+    environment.make(GL_TEXTURE_CUBE_MAP);
+    for (int face = 0; face < 6; ++face)
+      glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, GL_RGBA16F, kEnvironmentSize, kEnvironmentSize, 0,
+                   GL_RGBA, GL_HALF_FLOAT, nullptr);
+    glGenFramebuffers(1, &gpu.environmentFbo);
+  }
   const std::optional<Environment>& sky = f.scene.environment;
   auto program = gpu.program("environment:" + (sky ? std::string("sky") : std::to_string(int(bg.kind))),
                              screenVertex(), environmentFragment(bg.kind, sky.has_value()));
@@ -33,9 +38,7 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
   }
   p.set("uView", glm::mat3(f.view.view));
   p.set("uTanHalfFov", f.view.tanHalfFov);
-  GLuint fbo = 0;
-  glGenFramebuffers(1, &fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, gpu.environmentFbo);
   glViewport(0, 0, kEnvironmentSize, kEnvironmentSize);
   for (int face = 0; face < 6; ++face) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, environment.id,
@@ -43,7 +46,6 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f, Texture& environme
     p.set("uFace", face);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
-  glDeleteFramebuffers(1, &fbo);
   f.main.use();
   f.frame.passes.push_back("environment");
   return std::nullopt;
@@ -154,11 +156,14 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
     thinFilm =
         texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB16F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
   if (film && features.thickness) {  // 16F filters everywhere (32F needs an extension)
-    bubble::ThicknessOptions o = b.film;
-    o.measureError = false;  // the request's answer measures it; a frame only draws
-    auto field = bubble::thicknessField(b.params, o, b.time);
-    if (!field.ok()) return field.error();
-    const bubble::ThicknessField& t = field.value();
+    const bool prepared = b.thickness && b.thicknessTime == b.time;
+    std::optional<bubble::ThicknessField> own;  // computed here when the scene came without it
+    if (!prepared) {
+      auto field = thicknessOf(b, nullptr);
+      if (!field.ok()) return field.error();
+      own = std::move(field.value());
+    }
+    const bubble::ThicknessField& t = prepared ? *b.thickness : *own;
     thickness = texture2D(t.width, t.height, GL_R16F, GL_RED, GL_FLOAT, t.nm.data());
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   }
@@ -180,9 +185,8 @@ std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
   bool needsEnvironment = false;
   for (const Bubble& b : f.scene.bubbles)
     needsEnvironment |= b.features.shading == bubble::Shading::kFilm || b.features.reflection || b.features.refraction;
-  Texture environment;  // one cube for every bubble
-  if (needsEnvironment)
-    if (auto e = environmentCube(gpu, f, environment)) return e;
+  if (needsEnvironment)  // one cube for every bubble
+    if (auto e = environmentCube(gpu, f)) return e;
   // Far to near, so each is blended over those behind it.
   std::vector<const Bubble*> order;
   for (const Bubble& b : f.scene.bubbles) order.push_back(&b);
@@ -191,10 +195,30 @@ std::optional<Error> bubblePass(Gpu& gpu, FrameState& f) {
     return glm::length(a->center - eye) > glm::length(b->center - eye);
   });
   for (const Bubble* b : order) {
-    if (environment.id) environment.bind(0);
+    if (needsEnvironment) gpu.environment.bind(0);
     if (auto e = drawBubble(gpu, f, *b)) return e;
   }
   return std::nullopt;
 }
 
 }  // namespace effects::render::detail
+
+namespace effects::render {
+
+Result<bubble::ThicknessField> thicknessOf(const Bubble& b, Parallel* parallel) {
+  bubble::ThicknessOptions o = b.film;
+  o.measureError = false;  // the request's answer measures it; a frame only draws
+  return bubble::thicknessField(b.params, o, b.time, parallel);
+}
+
+std::optional<Error> prepareThickness(Bubble& b, Parallel* parallel) {
+  b.thickness.reset();
+  if (b.features.shading != bubble::Shading::kFilm || !b.features.thickness) return std::nullopt;
+  auto field = thicknessOf(b, parallel);
+  if (!field.ok()) return field.error();
+  b.thickness = std::move(field.value());
+  b.thicknessTime = b.time;
+  return std::nullopt;
+}
+
+}  // namespace effects::render

@@ -84,8 +84,8 @@ std::vector<float> boltGeometry3d(const Lightning& l, const View& view, int widt
 
 // Separable Gaussian of the core at half resolution (sigma in half-resolution pixels) into
 // `glow`, through `blurred`.
-std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l, const Target& core, Target& blurred,
-                              Target& glow) {
+std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l) {
+  Target &core = gpu.boltCore, &blurred = gpu.blurred, &glow = gpu.glow;
   auto program = gpu.program("blur", screenVertex(), blurFragment());
   if (!program.ok()) return program.error();
   Program& p = *program.value();
@@ -100,7 +100,7 @@ std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l, const
   p.set("uRadius", radius);
   p.set("uSource", 0);
   const int hw = (f.scene.width + 1) / 2, hh = (f.scene.height + 1) / 2;
-  if (!blurred.create(hw, hh, GL_RGBA16F, false) || !glow.create(hw, hh, GL_RGBA16F, false))
+  if (!blurred.ensure(hw, hh, GL_RGBA16F, false) || !glow.ensure(hw, hh, GL_RGBA16F, false))
     return unsatisfiable("/renderer", "the glow buffers cannot be created");
   p.set("uTargetSize", glm::vec2(hw, hh));
   blurred.use();
@@ -121,14 +121,13 @@ std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l, const
 std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   const Scene& scene = f.scene;
   const Lightning& l = *scene.lightning;
-  Target core;
-  if (!core.create(scene.width, scene.height, GL_RGBA16F, false))
+  Target& core = gpu.boltCore;
+  if (!core.ensure(scene.width, scene.height, GL_RGBA16F, false))
     return unsatisfiable("/renderer", "the lightning buffer cannot be created");
-  if (l.world) {  // the scene's depth, to be tested against (not written)
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f.main.depth);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      return unsatisfiable("/renderer", "the lightning buffer cannot share the scene's depth");
-  }
+  // A 3-D bolt is tested against the scene's depth (not written); a 2-D one has none.
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, l.world ? f.main.depth : 0);
+  if (l.world && glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    return unsatisfiable("/renderer", "the lightning buffer cannot share the scene's depth");
   core.use();
   glClear(GL_COLOR_BUFFER_BIT);
   {
@@ -152,16 +151,15 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
     f.frame.passes.push_back("lightning");
   }
   const bool glow = l.glowSigma > 0 && l.glowStrength > 0;
-  Target blurred, glowTarget;
   if (glow)
-    if (auto e = glowBlur(gpu, f, l, core, blurred, glowTarget)) return e;
+    if (auto e = glowBlur(gpu, f, l)) return e;
   f.main.use();
   auto program = gpu.program(glow ? "composite:glow" : "composite", screenVertex(), compositeFragment(glow));
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
   core.color.bind(0), p.set("uCore", 0);
-  if (glow) glowTarget.color.bind(1), p.set("uGlow", 1), p.set("uGlowStrength", float(l.glowStrength));
+  if (glow) gpu.glow.color.bind(1), p.set("uGlow", 1), p.set("uGlowStrength", float(l.glowStrength));
   p.set("uColor", glm::vec3(l.color));
   glEnable(GL_BLEND);
   glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);

@@ -37,13 +37,18 @@
 #include <effects/common.h>
 #include <effects/fog.h>
 #include <effects/lightning.h>
+#include <effects/parallel.h>
 
 namespace effects::render {
 
-// Straight-alpha RGBA, rows top to bottom, float in [0, 1].
+// Straight-alpha RGBA, rows top to bottom: floats in [0, 1], or (a frame read back for an
+// 8-bit PNG) bytes, value round(255 x) — one of the two is filled.
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgba;
+  std::vector<uint8_t> rgba8;
+  size_t values() const { return rgba8.empty() ? rgba.size() : rgba8.size(); }
+  float at(size_t i) const { return rgba8.empty() ? rgba[i] : float(rgba8[i]) / 255.0f; }
 };
 
 struct Camera {
@@ -149,6 +154,10 @@ struct Bubble {
   int thinFilmWidth = 0, thinFilmHeight = 0;
   glm::dvec2 thinFilmRangeNm{0, 1000};  // thickness at the table's first and last column
   bubble::ThicknessOptions film;        // film model: the thickness field, computed per frame at `time`
+  // The field, when the scene's builder computed it off the render thread (prepareThickness),
+  // at thicknessTime; a frame at another time (an animation's) has the render thread compute it.
+  std::optional<bubble::ThicknessField> thickness;
+  double thicknessTime = 0;
   std::vector<bubble::Light> lights;    // film model with features.highlight, at most kMaxLights
   Image flowTexture;  // eqn 9's texture; empty = a generated soft swirl
 };
@@ -174,6 +183,9 @@ struct Frame {
   int variantsCompiled = 0;         // shader programs compiled for this frame (0 when all cached)
   int variantsCached = 0;           // programs in this context's cache afterwards
   double ms = 0;                    // GPU work including read-back
+  double drawMs = 0;                // the passes issued and finished (glFinish)
+  double readMs = 0;                // the pixels read back and converted
+  double queueMs = 0;               // waiting for a render thread, before ms
   std::string passList() const;     // "background,quads,...": the passes, comma-separated
 };
 
@@ -221,8 +233,14 @@ struct Reference {
 inline constexpr int kReferenceWavelengths = 400;
 Result<Reference> referenceRender(const Scene& scene, Parallel* parallel = nullptr);
 
-// PNG bytes of `frame` (8 or 16 bits per channel, straight alpha) via OpenImageIO.
-Result<std::string> encodePng(const Image& image, int bitDepth);
+// The film's thickness field at b.time as a frame draws it; prepareThickness stores it in b
+// (film model with the thickness feature; nothing otherwise).
+Result<bubble::ThicknessField> thicknessOf(const Bubble& b, Parallel* parallel);
+std::optional<Error> prepareThickness(Bubble& b, Parallel* parallel);
+
+// PNG bytes of `image` (8 or 16 bits per channel, RGBA, straight alpha); its strips are
+// filtered and deflated on `parallel` (null: this thread only), the same bytes either way.
+Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parallel = nullptr);
 
 // An animated GIF written frame by frame through OpenImageIO's GIF writer (256 colours per
 // frame, looping forever), so a sequence never holds more than one frame. GIF delays are whole
@@ -291,6 +309,7 @@ class RenderPool {
     Scene scene;
     std::optional<Sequence> sequence;
     std::promise<Result<Frame>> done;
+    Stopwatch queued;  // since submit
   };
   PoolOptions options_;
   std::mutex mu_;
