@@ -139,15 +139,19 @@ struct Target {
   }
 };
 
-// Interleaved float vertices with the given attribute sizes at locations 0, 1, ...
+// Interleaved float vertices with the given attribute sizes at locations 0, 1, ...; `usage`
+// GL_STATIC_DRAW for vertices kept and drawn again (Gpu::spheres).
 struct Vertices {
   GLuint vao = 0, vbo = 0, ibo = 0;
-  Vertices(const std::vector<float>& data, std::vector<int> sizes, const std::vector<uint32_t>* indices = nullptr) {
+  Vertices(const Vertices&) = delete;
+  Vertices& operator=(const Vertices&) = delete;
+  Vertices(const std::vector<float>& data, std::vector<int> sizes, const std::vector<uint32_t>* indices = nullptr,
+           GLenum usage = GL_STREAM_DRAW) {
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
     glGenBuffers(1, &vbo);
     glBindBuffer(GL_ARRAY_BUFFER, vbo);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), usage);
     const int stride = std::accumulate(sizes.begin(), sizes.end(), 0);
     for (size_t i = 0, offset = 0; i < sizes.size(); offset += size_t(sizes[i]), ++i) {
       glEnableVertexAttribArray(GLuint(i));
@@ -156,7 +160,7 @@ struct Vertices {
     if (indices) {
       glGenBuffers(1, &ibo);
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
-      glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices->size() * 4), indices->data(), GL_STREAM_DRAW);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices->size() * 4), indices->data(), usage);
     }
   }
   ~Vertices() {

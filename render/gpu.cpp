@@ -10,6 +10,7 @@ Gpu::~Gpu() {
     normalA = Texture(), normalB = Texture(), waveAlpha = Texture(), defaultFlow = Texture();
     for (Target* t : {&main, &resolved, &boltCore, &blurred, &glow}) t->release();
     environment = Texture();
+    thinFilms.entries.clear(), spheres.entries.clear();
     if (environmentFbo) glDeleteFramebuffers(1, &environmentFbo);
     destroyContext(egl);
   }

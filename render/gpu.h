@@ -4,6 +4,8 @@
 // returns an Error when the GPU refuses; renderer.cpp decides which passes a scene needs.
 #pragma once
 
+#include <deque>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +27,23 @@ std::vector<uint8_t> softPattern(int size, int channels, uint64_t seed, double l
 std::vector<float> premultiplied(const Image& image);
 inline glm::vec4 premultiplied(const glm::dvec4& c) { return glm::vec4(glm::dvec3(c) * c.a, c.a); }
 
+// GPU copies of objects that scenes share (a thin-film table, a sphere mesh), found by the
+// shared object they were made from, which they keep alive: a render thread keeps its last few.
+template <class Source, class Object>
+struct Uploads {
+  static constexpr size_t kKept = 4;
+  std::deque<std::pair<std::shared_ptr<const Source>, std::unique_ptr<Object>>> entries;
+  // The object made from `source` (by make() the first time); the oldest goes past kKept.
+  template <class Make>
+  Object& get(const std::shared_ptr<const Source>& source, Make make) {
+    for (auto& e : entries)
+      if (e.first == source) return *e.second;
+    if (entries.size() == kKept) entries.pop_front();
+    entries.emplace_back(source, make());
+    return *entries.back().second;
+  }
+};
+
 struct Gpu {
   EglContext egl;
   std::string description;
@@ -41,6 +60,8 @@ struct Gpu {
   Target main, resolved, boltCore, blurred, glow;
   Texture environment;
   GLuint environmentFbo = 0;
+  Uploads<bubble::ThinFilmTable, Texture> thinFilms;
+  Uploads<bubble::Mesh, Vertices> spheres;  // position, normal, uv
 
   ~Gpu();
   // The program for `key` (compiled and linked on first use: the variant cache).

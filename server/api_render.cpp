@@ -39,23 +39,51 @@ rd::Image image(const json& base64, const std::string& pointer, const Config& co
   return std::move(decoded.value());
 }
 
-// Thin-film tables are deterministic in their options and cost tens of milliseconds: renders
-// share them through a small process-wide cache.
-std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOptions& o, const std::string& pointer) {
-  static std::mutex mu;
-  static std::map<std::string, std::shared_ptr<const bb::ThinFilmTable>> cache;
-  const std::string key = json{o.ior, o.thicknessMinNm, o.thicknessMaxNm, o.width, o.height, o.wavelengths}.dump();
-  {
-    std::lock_guard<std::mutex> lock(mu);
-    if (auto it = cache.find(key); it != cache.end()) return it->second;
+// What renders share, deterministic in a key and costly to make (thin-film tables: tens of
+// milliseconds; the sphere a bubble is drawn on: milliseconds, its normals through MikkTSpace's
+// welding): kept process-wide, at most 16 of each (all dropped when full). make() runs outside
+// the lock; two requests may both make a missing entry, and the first stored wins.
+template <class T>
+class SharedCache {
+ public:
+  template <class Make>
+  std::shared_ptr<const T> get(const std::string& key, Make make) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (auto it = entries_.find(key); it != entries_.end()) return it->second;
+    }
+    std::shared_ptr<const T> made = make();
+    std::lock_guard<std::mutex> lock(mu_);
+    if (entries_.size() >= 16) entries_.clear();
+    return entries_.emplace(key, std::move(made)).first->second;
   }
-  auto table = bb::thinFilmTable(o);
-  if (!table.ok()) throwError(table.error(), pointer + "/thinFilm");
-  auto shared = std::make_shared<const bb::ThinFilmTable>(std::move(table.value()));
-  std::lock_guard<std::mutex> lock(mu);
-  if (cache.size() >= 16) cache.clear();
-  cache.emplace(key, shared);
-  return shared;
+
+ private:
+  std::mutex mu_;
+  std::map<std::string, std::shared_ptr<const T>> entries_;
+};
+
+std::shared_ptr<const bb::ThinFilmTable> cachedThinFilm(const bb::ThinFilmOptions& o, const std::string& pointer) {
+  static SharedCache<bb::ThinFilmTable> cache;
+  const std::string key = json{o.ior, o.thicknessMinNm, o.thicknessMaxNm, o.width, o.height, o.wavelengths}.dump();
+  return cache.get(key, [&] {
+    auto table = bb::thinFilmTable(o);
+    if (!table.ok()) throwError(table.error(), pointer + "/thinFilm");
+    return std::make_shared<const bb::ThinFilmTable>(std::move(table.value()));
+  });
+}
+
+// The still sphere the vertex shader wobbles: it depends on the level and radius alone.
+std::shared_ptr<const bb::Mesh> cachedSphere(const bb::Params& p, const bb::MeshOptions& o, const std::string& at) {
+  static SharedCache<bb::Mesh> cache;
+  return cache.get(json{o.level, o.radius}.dump(), [&] {
+    auto mesh = bb::icosphere(p, o);
+    if (!mesh.ok()) {
+      effects::Error e = mesh.error();
+      throwError(e, e.field == "/level" || e.field == "/radius" ? at + "/mesh" : at);
+    }
+    return std::make_shared<const bb::Mesh>(std::move(mesh.value()));
+  });
 }
 
 void parseCamera(const json& body, rd::Scene& s) {
@@ -178,14 +206,10 @@ rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at,
   o.radius = m.value("radius", 1.0);
   o.wobble = false;  // the vertex shader wobbles (eqn 11)
   o.parallel = ctx.parallel;
-  auto mesh = bb::icosphere(b.params, o);
-  if (!mesh.ok()) {
-    effects::Error e = mesh.error();
-    throwError(e, e.field == "/level" || e.field == "/radius" ? at + "/mesh" : at);
-  }
+  if (auto e = bb::validate(b.params)) throwError(*e, at);  // the cached sphere's were other params
+  b.mesh = cachedSphere(b.params, o, at);
   if (b.features.wobble)  // the shader wobbles what icosphere() left still
     if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, at + "/mesh");
-  b.mesh = std::move(mesh.value());
   b.radius = o.radius;
   if (film) {
     b.film = parseFilm(bj, config, at);
@@ -195,10 +219,7 @@ rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at,
   if (film || b.features.iridescence) {
     bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, thicknessRange(bj, b.features, b.film), config, at);
     tf.measureError = false;
-    auto table = cachedThinFilm(tf, at);
-    b.thinFilm = table->rgb;
-    b.thinFilmWidth = table->width;
-    b.thinFilmHeight = table->height;
+    b.thinFilm = cachedThinFilm(tf, at);
     b.thinFilmRangeNm = {tf.thicknessMinNm, tf.thicknessMaxNm};
   }
   if (bj.contains("motion")) {

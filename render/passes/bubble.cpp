@@ -151,10 +151,14 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   setUniforms(p, b, f);
   if (f.scene.fog) setFog(p, *f.scene.fog, f.view.eye);
   // Made first, bound after: making a texture binds it to the active unit.
-  Texture flowOwned, thinFilm, thickness;
-  if (film || features.iridescence)
-    thinFilm =
-        texture2D(b.thinFilmWidth, b.thinFilmHeight, GL_RGB16F, GL_RGB, GL_FLOAT, b.thinFilm.data(), GL_CLAMP_TO_EDGE);
+  Texture flowOwned, thickness;
+  const Texture* thinFilm = nullptr;
+  if ((film || features.iridescence) && b.thinFilm)
+    thinFilm = &gpu.thinFilms.get(b.thinFilm, [&] {
+      const bubble::ThinFilmTable& t = *b.thinFilm;
+      return std::make_unique<Texture>(
+          texture2D(t.width, t.height, GL_RGB16F, GL_RGB, GL_FLOAT, t.rgb.data(), GL_CLAMP_TO_EDGE));
+    });
   if (film && features.thickness) {  // 16F filters everywhere (32F needs an extension)
     const bool prepared = b.thickness && b.thicknessTime == b.time;
     std::optional<bubble::ThicknessField> own;  // computed here when the scene came without it
@@ -170,10 +174,14 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   const Texture* flow = !film && features.textureFlow ? &gpu.flowTexture(b, flowOwned) : nullptr;
   p.set("uEnvironment", 0);
   if (flow) flow->bind(1), p.set("uFlowTexture", 1);
-  if (thinFilm.id) thinFilm.bind(2), p.set("uThinFilm", 2);
+  if (thinFilm) thinFilm->bind(2), p.set("uThinFilm", 2);
   if (thickness.id) thickness.bind(3), p.set("uThicknessField", 3);
-  Vertices mesh(interleaved(b.mesh), {3, 3, 2}, &b.mesh.indices);
-  drawMesh(p, features, GLsizei(b.mesh.indices.size()));
+  const Vertices& mesh = gpu.spheres.get(b.mesh, [&] {
+    return std::make_unique<Vertices>(interleaved(*b.mesh), std::vector<int>{3, 3, 2}, &b.mesh->indices,
+                                      GL_STATIC_DRAW);
+  });
+  glBindVertexArray(mesh.vao);
+  drawMesh(p, features, GLsizei(b.mesh->indices.size()));
   glBindVertexArray(gpu.emptyVao);
   f.frame.passes.push_back(std::string(film ? "bubble-film" : "bubble") + (f.scene.fog ? "+fog" : ""));
   return std::nullopt;

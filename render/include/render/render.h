@@ -145,13 +145,12 @@ FogShader fogShader(const Fog& fog, const glm::dvec3& eye);
 struct Bubble {
   bubble::Params params;
   bubble::Features features;
-  bubble::Mesh mesh;
+  std::shared_ptr<const bubble::Mesh> mesh;  // shared by the scenes that use the same sphere
   glm::dvec3 center{0, 0, 0};
   double time = 0;  // seconds (eqns 3, 9, 11)
   glm::dvec4 baseColor{1, 1, 1, 1};
   double radius = 1;  // of the mesh, object units (the wobble's unit)
-  std::vector<float> thinFilm;  // film model, or iridescence: RGB table (bubble::ThinFilmTable::rgb)
-  int thinFilmWidth = 0, thinFilmHeight = 0;
+  std::shared_ptr<const bubble::ThinFilmTable> thinFilm;  // film model, or iridescence (shared)
   glm::dvec2 thinFilmRangeNm{0, 1000};  // thickness at the table's first and last column
   bubble::ThicknessOptions film;        // film model: the thickness field, computed per frame at `time`
   // The field, when the scene's builder computed it off the render thread (prepareThickness),
