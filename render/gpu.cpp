@@ -16,8 +16,7 @@ Gpu::~Gpu() {
   }
 }
 
-Result<Program*> Gpu::program(const std::string& key, const std::string& vs, const std::string& fs) {
-  if (auto it = programs.find(key); it != programs.end()) return &it->second;
+Result<Program*> Gpu::compileProgram(const std::string& key, const std::string& vs, const std::string& fs) {
   auto v = compile(GL_VERTEX_SHADER, vs);
   if (!v.ok()) return v.error();
   auto f = compile(GL_FRAGMENT_SHADER, fs);

@@ -64,8 +64,15 @@ struct Gpu {
   Uploads<bubble::Mesh, Vertices> spheres;  // position, normal, uv
 
   ~Gpu();
-  // The program for `key` (compiled and linked on first use: the variant cache).
-  Result<Program*> program(const std::string& key, const std::string& vs, const std::string& fs);
+  // The program for `key` (compiled and linked on first use: the variant cache); source()
+  // gives its (vertex, fragment) GLSL and is called only then.
+  template <class Source>
+  Result<Program*> program(const std::string& key, Source source) {
+    if (auto it = programs.find(key); it != programs.end()) return &it->second;
+    const auto [vs, fs] = source();
+    return compileProgram(key, vs, fs);
+  }
+  Result<Program*> compileProgram(const std::string& key, const std::string& vs, const std::string& fs);
   // The bubble's flow texture: its own image (uploaded into `owned`) or the default pattern.
   const Texture& flowTexture(const Bubble& b, Texture& owned);
   // Generated once per context: the two normal maps, the alpha texture, and the quad with

@@ -59,7 +59,7 @@ Result<Image> readBackFloat(const Scene& scene) {
 // For an 8-bit PNG: the GPU un-premultiplies, flips and rounds the frame into an RGBA8 target
 // (resolveFragment), and the read-back is the PNG's bytes, a quarter of the floats' size.
 Result<Image> readBack8(Gpu& gpu, const Scene& scene) {
-  auto program = gpu.program("resolve8", screenVertex(), resolveFragment());
+  auto program = gpu.program("resolve8", [] { return std::pair{screenVertex(), resolveFragment()}; });
   if (!program.ok()) return program.error();
   if (!gpu.resolved.ensure(scene.width, scene.height, GL_RGBA8, false))
     return unsatisfiable("/renderer", "the 8-bit frame buffer cannot be created");

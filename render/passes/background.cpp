@@ -19,7 +19,8 @@ void setBackground(Program& p, const Background& b, const Texture* image) {
 
 std::optional<Error> backgroundPass(Gpu& gpu, FrameState& f) {
   const Background& bg = f.scene.background;
-  auto program = gpu.program("background:" + std::to_string(int(bg.kind)), screenVertex(), backgroundFragment(bg.kind));
+  auto program = gpu.program("background:" + std::to_string(int(bg.kind)),
+                             [&] { return std::pair{screenVertex(), backgroundFragment(bg.kind)}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

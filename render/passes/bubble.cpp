@@ -24,8 +24,9 @@ std::optional<Error> environmentCube(Gpu& gpu, FrameState& f) {
     glGenFramebuffers(1, &gpu.environmentFbo);
   }
   const std::optional<Environment>& sky = f.scene.environment;
-  auto program = gpu.program("environment:" + (sky ? std::string("sky") : std::to_string(int(bg.kind))),
-                             screenVertex(), environmentFragment(bg.kind, sky.has_value()));
+  auto program = gpu.program("environment:" + (sky ? std::string("sky") : std::to_string(int(bg.kind))), [&] {
+    return std::pair{screenVertex(), environmentFragment(bg.kind, sky.has_value())};
+  });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
@@ -142,9 +143,11 @@ std::string fogFinish(const bubble::Features& f) {
 std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   const bubble::Features& features = b.features;
   const bool film = features.shading == bubble::Shading::kFilm;
-  bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
-                                            f.fog ? fogFinish(features) : "");
-  auto program = gpu.program("bubble:" + bubble::variantKey(features) + f.fogKey, src.vertex, src.fragment);
+  auto program = gpu.program("bubble:" + bubble::variantKey(features) + f.fogKey, [&] {
+    bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
+                                              f.fog ? fogFinish(features) : "");
+    return std::pair{src.vertex, src.fragment};
+  });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

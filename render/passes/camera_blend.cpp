@@ -4,7 +4,7 @@
 namespace effects::render::detail {
 
 std::optional<Error> cameraBlendPass(Gpu& gpu, FrameState& f) {
-  auto program = gpu.program("cameraBlend", screenVertex(), blendFragment());
+  auto program = gpu.program("cameraBlend", [] { return std::pair{screenVertex(), blendFragment()}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

@@ -86,7 +86,7 @@ std::vector<float> boltGeometry3d(const Lightning& l, const View& view, int widt
 // `glow`, through `blurred`.
 std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l) {
   Target &core = gpu.boltCore, &blurred = gpu.blurred, &glow = gpu.glow;
-  auto program = gpu.program("blur", screenVertex(), blurFragment());
+  auto program = gpu.program("blur", [] { return std::pair{screenVertex(), blurFragment()}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
@@ -131,7 +131,7 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   core.use();
   glClear(GL_COLOR_BUFFER_BIT);
   {
-    auto program = gpu.program(l.world ? "bolt:world" : "bolt", boltVertex(l.world), boltFragment());
+    auto program = gpu.program(l.world ? "bolt:world" : "bolt", [&] { return std::pair{boltVertex(l.world), boltFragment()}; });
     if (!program.ok()) return program.error();
     Program& p = *program.value();
     glUseProgram(p.id);
@@ -154,7 +154,8 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   if (glow)
     if (auto e = glowBlur(gpu, f, l)) return e;
   f.main.use();
-  auto program = gpu.program(glow ? "composite:glow" : "composite", screenVertex(), compositeFragment(glow));
+  auto program = gpu.program(glow ? "composite:glow" : "composite",
+                             [&] { return std::pair{screenVertex(), compositeFragment(glow)}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

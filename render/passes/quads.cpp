@@ -123,7 +123,8 @@ std::optional<Error> quadsPass(Gpu& gpu, FrameState& f) {
       data.insert(data.end(),
                   {float(c.x), float(c.y), float(c.z), float(q.color.r), float(q.color.g), float(q.color.b)});
   }
-  auto program = gpu.program("quad" + f.fogKey, quadVertex(), quadFragment(f.fog ? &*f.fog : nullptr));
+  auto program = gpu.program("quad" + f.fogKey,
+                             [&] { return std::pair{quadVertex(), quadFragment(f.fog ? &*f.fog : nullptr)}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);

@@ -9,7 +9,7 @@ namespace effects::render::detail {
 std::optional<Error> surfaceWavePass(Gpu& gpu, FrameState& f) {
   const SurfaceWave& w = *f.scene.wave;
   if (auto e = gpu.ensureWave()) return *e;
-  auto program = gpu.program("wave", waveVertex(), waveFragment());
+  auto program = gpu.program("wave", [] { return std::pair{waveVertex(), waveFragment()}; });
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
