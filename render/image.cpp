@@ -1,4 +1,5 @@
-// GIFs out and PNG/JPEG in, in memory, through OpenImageIO (PNGs out: png.cpp).
+// Flipbook sheets, and PNG/JPEG in, in memory, through OpenImageIO (PNGs out: png.cpp; GIFs
+// out: gif.cpp).
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
@@ -9,63 +10,6 @@
 #include "render/render.h"
 
 namespace effects::render {
-
-int gifDelay(double fps) { return std::max(2, int(std::lround(100.0 / fps))); }
-
-struct GifEncoder::Impl {
-  std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy{bytes};
-  std::unique_ptr<OIIO::ImageOutput> out;
-  std::vector<OIIO::ImageSpec> specs;
-  std::vector<unsigned char> pixels;
-  int added = 0;
-  std::string error;
-};
-
-GifEncoder::GifEncoder(int width, int height, int count, double fps) : impl_(std::make_unique<Impl>()) {
-  OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
-  // GIF delays are whole hundredths of a second: the rate is 100 / delay (gifDelay()).
-  const int rate[2] = {100, gifDelay(fps)};
-  spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
-  spec.attribute("gif:LoopCount", 0);  // forever
-  spec.attribute("oiio:UnassociatedAlpha", 1);
-  impl_->specs.assign(size_t(std::max(1, count)), spec);
-  impl_->out = OIIO::ImageOutput::create("frames.gif", &impl_->proxy);
-  if (!impl_->out)
-    impl_->error = "OpenImageIO has no GIF writer";
-  else if (!impl_->out->open("frames.gif", int(impl_->specs.size()), impl_->specs.data()))
-    impl_->error = impl_->out->geterror();
-}
-
-GifEncoder::~GifEncoder() = default;
-
-std::optional<Error> GifEncoder::add(const Image& frame) {
-  Impl& g = *impl_;
-  if (!g.error.empty()) return unsatisfiable("/frames", "GIF encoding failed: " + g.error);
-  if (g.added >= int(g.specs.size())) return invalid("/frames", "more frames than announced");
-  if (g.added > 0 && !g.out->open("frames.gif", g.specs[size_t(g.added)], OIIO::ImageOutput::AppendSubimage))
-    return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
-  // OpenImageIO's GIF writer takes 8-bit pixels; rounded as encodePng rounds them.
-  const unsigned char* pixels = frame.rgba8.data();
-  if (frame.rgba8.empty()) {
-    g.pixels.resize(frame.rgba.size());
-    for (size_t i = 0; i < frame.rgba.size(); ++i)
-      g.pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(frame.rgba[i], 0.0f, 1.0f) * 255.0f));
-    pixels = g.pixels.data();
-  }
-  if (!g.out->write_image(OIIO::TypeDesc::UINT8, pixels))
-    return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
-  ++g.added;
-  return std::nullopt;
-}
-
-Result<std::string> GifEncoder::finish() {
-  Impl& g = *impl_;
-  if (!g.error.empty()) return unsatisfiable("/frames", "GIF encoding failed: " + g.error);
-  if (g.added != int(g.specs.size())) return invalid("/frames", "fewer frames than announced");
-  if (!g.out->close()) return unsatisfiable("/frames", "GIF encoding failed: " + g.out->geterror());
-  return std::string(g.bytes.begin(), g.bytes.end());
-}
 
 int Flipbook::cells(int count) {
   const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));

@@ -144,7 +144,8 @@ Cost renderCost(const json& body, const Config& config) {
   // decoded background image.
   c.bytes += pixels * 96;
   // Frames: a flipbook sheet (RGBA float, then 8/16-bit and PNG) of count x pixels; a GIF
-  // holds one frame at a time plus its output (under a byte per pixel per frame).
+  // holds at most 9 RGBA8 frames (a batch being encoded and the one before) plus its output
+  // (under a byte per pixel per frame).
   if (body.contains("frames")) {
     const size_t count = std::max<size_t>(1, body["frames"].value("count", 1));
     c.bytes += std::min(count * pixels, config.limits.maxRenderPixels) * 28;

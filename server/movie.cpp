@@ -11,7 +11,7 @@ MovieWriter::MovieWriter(const Animation& animation, int width, int height, int 
   if (animation.frames.flipbook)
     book_.emplace(width, height, animation.frames.count);
   else
-    gif_.emplace(width, height, animation.frames.count, animation.frames.fps);
+    gif_.emplace(width, height, animation.frames.count, animation.frames.fps, parallel);
 }
 
 rd::Sequence MovieWriter::sequence() {
@@ -21,8 +21,12 @@ rd::Sequence MovieWriter::sequence() {
     const Animation& a = animation_;
     const double dt = 1.0 / a.frames.fps, offset = i * dt;
     scene.time = a.time + offset;
-    for (size_t k = 0; k < scene.bubbles.size() && k < a.bubbleTimes.size(); ++k)
+    for (size_t k = 0; k < scene.bubbles.size() && k < a.bubbleTimes.size(); ++k) {
       scene.bubbles[k].time = a.bubbleTimes[k] + offset;
+      // The film at this frame's time, on the thread pool (the first frame's was checked when
+      // the scene was built; should this one fail, the frame computes it and says why).
+      (void)rd::prepareThickness(scene.bubbles[k], parallel_);
+    }
     if (scene.lightning && a.strike) {
       // The strike as an eye sees it: each vertex at its brightest moment in the frame.
       const double t = scene.time - a.strikeTime;

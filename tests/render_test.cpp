@@ -706,6 +706,75 @@ httplib::Result renderFrames(const TestServer& s, const json& scene, const std::
   return r;
 }
 
+// render/gif.cpp against giflib (OpenImageIO's GIF reader): every frame comes back at its size;
+// a frame of at most 255 colours exactly; a frame of many colours within a few levels; pixels
+// of alpha < 1/2 transparent; delta frames (pixels unchanged from the frame before left
+// transparent) show the whole frame; one thread or several, the same bytes.
+TEST(Render, GifEncoderRoundTripsThroughGiflib) {
+  const int w = 37, h = 23, count = 11;
+  std::vector<rd::Image> frames;
+  uint64_t state = 3;
+  auto next = [&state] { return (state = state * 6364136223846793005ULL + 1442695040888963407ULL) >> 33; };
+  for (int f = 0; f < count; ++f) {
+    rd::Image img{w, h, {}, std::vector<uint8_t>(size_t(w) * h * 4)};
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        uint8_t* p = &img.rgba8[(size_t(y) * w + x) * 4];
+        if (f % 3 == 0) {  // a few colours, moving
+          const int k = (x / 5 + y / 4 + f) % 40;
+          p[0] = uint8_t(k * 6), p[1] = uint8_t(255 - k * 5), p[2] = uint8_t(k * 3 + 7), p[3] = 255;
+        } else if (f % 3 == 1) {  // thousands of colours
+          p[0] = uint8_t(next()), p[1] = uint8_t(x * 7), p[2] = uint8_t(y * 11), p[3] = 255;
+        } else {  // the frame before, one corner changed, and a transparent hole
+          std::copy_n(&frames.back().rgba8[(size_t(y) * w + x) * 4], 4, p);
+          if (x < 6 && y < 6) p[0] = uint8_t(255 - p[0]);
+          if (x > 30 && y > 15) p[3] = 0;
+        }
+      }
+    frames.push_back(std::move(img));
+  }
+  effects::ThreadPool pool(3);
+  std::string bytes[2];
+  for (int run = 0; run < 2; ++run) {
+    rd::GifEncoder gif(w, h, count, 10, run ? &pool : nullptr);
+    for (const rd::Image& f : frames) ASSERT_FALSE(gif.add(f).has_value());
+    auto out = gif.finish();
+    ASSERT_TRUE(out.ok()) << out.error().message;
+    bytes[run] = out.value();
+  }
+  EXPECT_EQ(bytes[0], bytes[1]) << "the same bytes on one thread and on several";
+  const std::vector<rd::Image> back = decodeGif(bytes[0]);
+  ASSERT_EQ(back.size(), size_t(count));
+  for (int f = 0; f < count; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    ASSERT_EQ(back[size_t(f)].width, w);
+    ASSERT_EQ(back[size_t(f)].height, h);
+    double sum = 0, worst = 0;
+    size_t holes = 0;
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+      const uint8_t* want = &frames[size_t(f)].rgba8[i * 4];
+      const float* got = &back[size_t(f)].rgba[i * 4];
+      if (want[3] < 128) {
+        holes += got[3] < 0.5f;
+        continue;
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double d = std::abs(double(got[c]) * 255 - want[c]);
+        sum += d, worst = std::max(worst, d);
+      }
+    }
+    if (f % 3 == 0) EXPECT_LT(worst, 0.51) << "at most 255 colours come back exactly";
+    // Random reds over gradients: 255 cells of a 256-level cube are ~40 levels a side.
+    if (f % 3 == 1) EXPECT_LT(sum / (w * h * 3), 12.0) << "mean error in levels of 255";
+    if (f % 3 == 2) EXPECT_EQ(holes, size_t(6 * 7)) << "the transparent hole";
+  }
+  rd::GifEncoder short_(w, h, 2, 10);
+  ASSERT_FALSE(short_.add(frames[0]).has_value());
+  EXPECT_FALSE(short_.finish().ok()) << "fewer frames than announced";
+  EXPECT_TRUE(short_.add(rd::Image{w + 1, h, {}, std::vector<uint8_t>(size_t(w + 1) * h * 4)}).has_value())
+      << "a frame of another size";
+}
+
 TEST(Render, StrikeAsAnimatedGif) {
   TestServer s;
   auto r = renderFrames(s, strikeScene(30, "gif"), "image/gif");

@@ -241,14 +241,15 @@ std::optional<Error> prepareThickness(Bubble& b, Parallel* parallel);
 // filtered and deflated on `parallel` (null: this thread only), the same bytes either way.
 Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parallel = nullptr);
 
-// An animated GIF written frame by frame through OpenImageIO's GIF writer (256 colours per
-// frame, looping forever), so a sequence never holds more than one frame. GIF delays are whole
-// hundredths of a second, at least 2 (browsers play shorter ones at 10 fps): a frame lasts
-// gifDelay(fps) hundredths, so the rate played is 100 / gifDelay(fps) (fps <= 50).
+// An animated GIF (gif.cpp; 255 colours and a transparent index per frame, looping forever),
+// frames encoded in batches of 8 on `parallel` (null: the calling thread only), so a sequence
+// holds at most 9 frames. GIF delays are whole hundredths of a second, at least 2 (browsers
+// play shorter ones at 10 fps): a frame lasts gifDelay(fps) hundredths, so the rate played is
+// 100 / gifDelay(fps) (fps <= 50).
 int gifDelay(double fps);
 class GifEncoder {
  public:
-  GifEncoder(int width, int height, int count, double fps);
+  GifEncoder(int width, int height, int count, double fps, Parallel* parallel = nullptr);
   ~GifEncoder();
   GifEncoder(const GifEncoder&) = delete;
   GifEncoder& operator=(const GifEncoder&) = delete;
