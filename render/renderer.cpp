@@ -170,11 +170,13 @@ Result<Frame> Renderer::render(const Scene& scene) { return impl_->render(scene)
 Result<Frame> Renderer::render(Scene& scene, const Sequence& sequence) {
   Frame total;
   for (int i = 0; i < sequence.count; ++i) {
+    Stopwatch prepare;  // moving the scene on is part of drawing its frame
     if (sequence.prepare) sequence.prepare(scene, i);
+    const double prepareMs = prepare.ms();
     auto frame = impl_->render(scene);
     if (!frame.ok()) return frame.error();
-    total.ms += frame.value().ms;
-    total.drawMs += frame.value().drawMs;
+    total.ms += prepareMs + frame.value().ms;
+    total.drawMs += prepareMs + frame.value().drawMs;
     total.readMs += frame.value().readMs;
     total.variantsCompiled += frame.value().variantsCompiled;
     total.variantsCached = frame.value().variantsCached;

@@ -181,8 +181,9 @@ struct Frame {
   std::vector<std::string> passes;  // in the order they ran
   int variantsCompiled = 0;         // shader programs compiled for this frame (0 when all cached)
   int variantsCached = 0;           // programs in this context's cache afterwards
-  double ms = 0;                    // GPU work including read-back
-  double drawMs = 0;                // the passes issued and finished (glFinish)
+  double ms = 0;                    // GPU work including read-back (a sequence: each frame's
+                                    // preparation too)
+  double drawMs = 0;                // the passes issued and finished (glFinish), + preparation
   double readMs = 0;                // the pixels read back and converted
   double queueMs = 0;               // waiting for a render thread, before ms
   std::string passList() const;     // "background,quads,...": the passes, comma-separated
