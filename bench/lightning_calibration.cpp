@@ -178,7 +178,8 @@ int main(int argc, char** argv) {
       if (dbmSeeds > 0) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;
-        const double dbmCells = row(grid, eta, "dbm", "mgpcg", p, dbmSeeds);
+        // The default solver: exact (capacitance) while its fixed cells allow, then MGPCG.
+        const double dbmCells = row(grid, eta, "dbm", std::string(lt::toString(p.solver)) + " (default)", p, dbmSeeds);
         if (fit) {
           for (double sc : screenings) {
             lt::Params f = base;
