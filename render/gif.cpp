@@ -1,7 +1,7 @@
 // Animated GIFs, written here rather than through OpenImageIO's writer (one thread, ~20 ms a
 // 256² frame: most of an animated preview once the GPU drew the frames). Frames are encoded
 // in batches on several threads: each gets its own 255-colour palette (median cut over a
-// 5-bit-per-channel histogram of its exact colours, each colour mapped to its nearest entry),
+// 6-bit-per-channel histogram of its exact colours, each colour mapped to its nearest entry),
 // pixels unchanged from the frame before left transparent (delta frames), then LZW. Index 0
 // is transparent. A frame with pixels of alpha < 1/2 is written whole and the frame before it
 // is cleared after showing (disposal 2), so that what is transparent shows the page.
@@ -145,6 +145,8 @@ std::string lzw(const std::vector<uint8_t>& symbols) {
     prefix = symbols[i];
   }
   emit(prefix);
+  // A decoder adds its entry for that code too: past a power of two, the end code is wider.
+  if (next == (1u << width) && width < 12) ++width;
   emit(kEnd);
   if (held) out.push_back(char(bits & 0xFF));
   return out;
@@ -241,7 +243,8 @@ Result<std::string> GifEncoder::finish() {
   out.push_back(0);
   for (size_t i = 0; i < g.encoded.size(); ++i) {
     const Impl::Encoded& e = g.encoded[i];
-    const bool nextClears = i + 1 < g.encoded.size() && g.encoded[i + 1].transparent;
+    // The last frame's successor is the first, when the animation loops.
+    const bool nextClears = g.encoded[i + 1 < g.encoded.size() ? i + 1 : 0].transparent;
     out += "\x21\xF9\x04";
     out.push_back(char((nextClears ? 2 : 1) << 2 | 1));  // disposal; transparent index given
     put16(g.delay);

@@ -94,7 +94,7 @@ Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parall
   std::vector<uint8_t> filtered(line * height);
   std::vector<std::string> deflated(strips);
   std::vector<uLong> adler(strips);
-  std::string failure;
+  std::vector<uint8_t> failed(strips);  // per strip: strips fail (or not) on their own threads
   auto filterStrip = [&](size_t s) {
     std::array<std::vector<uint8_t>, 5> trial;
     for (auto& t : trial) t.resize(rowBytes);
@@ -116,7 +116,7 @@ Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parall
       const bool last = s + 1 == strips;
       z_stream z{};
       if (deflateInit2(&z, kLevel, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
-        failure = "zlib cannot start";
+        failed[s] = 1;
         continue;
       }
       const size_t dictionary = std::min(kWindow, from);  // the rows before this strip
@@ -128,13 +128,15 @@ Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parall
       z.next_out = reinterpret_cast<Bytef*>(out.data());
       z.avail_out = uInt(out.size());
       const int r = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
-      if ((last ? r != Z_STREAM_END : r != Z_OK) || z.avail_in != 0) failure = "zlib did not take every row";
+      // Every row taken, and (a sync flush) room left: a full buffer may hold an unfinished flush.
+      failed[s] = (last ? r != Z_STREAM_END : r != Z_OK || z.avail_out == 0) || z.avail_in != 0;
       out.resize(out.size() - z.avail_out);
       deflateEnd(&z);
       adler[s] = adler32(adler32(0, nullptr, 0), &filtered[from], uInt(to - from));
     }
   });
-  if (!failure.empty()) return unsatisfiable("/image", "PNG encoding failed: " + failure);
+  if (std::find(failed.begin(), failed.end(), 1) != failed.end())
+    return unsatisfiable("/image", "PNG encoding failed: zlib did not take every row");
 
   // One zlib stream: header, the strips' blocks, the Adler-32 of every filtered row.
   std::string idat = {char(0x78), char(0x5E)};  // deflate, 32 KiB window, "fast" level; FCHECK holds

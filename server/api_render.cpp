@@ -54,6 +54,7 @@ class SharedCache {
     }
     std::shared_ptr<const T> made = make();
     std::lock_guard<std::mutex> lock(mu_);
+    if (auto it = entries_.find(key); it != entries_.end()) return it->second;  // stored meanwhile
     if (entries_.size() >= 16) entries_.clear();
     return entries_.emplace(key, std::move(made)).first->second;
   }

@@ -25,7 +25,8 @@ rd::Sequence MovieWriter::sequence() {
       scene.bubbles[k].time = a.bubbleTimes[k] + offset;
       // The film at this frame's time, on the thread pool (the first frame's was checked when
       // the scene was built; should this one fail, the frame computes it and says why).
-      (void)rd::prepareThickness(scene.bubbles[k], parallel_);
+      rd::Bubble& b = scene.bubbles[k];
+      if (!b.thickness || b.thicknessTime != b.time) (void)rd::prepareThickness(b, parallel_);
     }
     if (scene.lightning && a.strike) {
       // The strike as an eye sees it: each vertex at its brightest moment in the frame.

@@ -124,10 +124,11 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   Target& core = gpu.boltCore;
   if (!core.ensure(scene.width, scene.height, GL_RGBA16F, false))
     return unsatisfiable("/renderer", "the lightning buffer cannot be created");
-  // A 3-D bolt is tested against the scene's depth (not written); a 2-D one has none.
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, l.world ? f.main.depth : 0);
-  if (l.world && glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    return unsatisfiable("/renderer", "the lightning buffer cannot share the scene's depth");
+  if (l.world) {  // the scene's depth, to be tested against (not written); detached at the end
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f.main.depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      return unsatisfiable("/renderer", "the lightning buffer cannot share the scene's depth");
+  }
   core.use();
   glClear(GL_COLOR_BUFFER_BIT);
   {
@@ -166,6 +167,11 @@ std::optional<Error> lightningPass(Gpu& gpu, FrameState& f) {
   glBlendFuncSeparate(GL_ONE, GL_ONE, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisable(GL_BLEND);
+  if (l.world) {  // the scene's depth is not kept attached to the bolt's buffer between frames
+    core.use();
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, 0);
+    f.main.use();
+  }
   f.frame.passes.push_back("lightningComposite");
   return std::nullopt;
 }
