@@ -4,7 +4,6 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <thread>
 
 #include <effects/bubble.h>
 
@@ -17,7 +16,7 @@ void BM_Icosphere(benchmark::State& state) {
   o.level = int(state.range(0));
   o.t = 12.5;
   o.camera = glm::dvec3(0, 0, 4);
-  static effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);  // as effectd runs it
+  static effects::ThreadPool pool(effects::ThreadPool::besideCaller());  // as effectd runs it
   o.parallel = &pool;
   size_t vertices = 0;
   for (auto _ : state) {

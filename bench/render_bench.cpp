@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <thread>
 #include <vector>
 
 #include <render/render.h>
@@ -88,7 +87,7 @@ int main(int argc, char** argv) {
   const int iterations = argc > 1 ? std::max(2, std::atoi(argv[1])) : 40;
   effectd::Config config;
   // As the server builds scenes: the request's thread and a pool of the other cores.
-  effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);
+  effects::ThreadPool pool(effects::ThreadPool::besideCaller());
   const effectd::RequestContext ctx{"bench", config, &pool};
   auto renderer = rd::Renderer::create();
   if (!renderer.ok()) {

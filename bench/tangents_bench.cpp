@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
 #include <effects/tangents.h>
 
@@ -25,7 +24,7 @@ const Mesh& mesh100k() {
 
 // As effectd runs it: the steps split over a pool of cores - 1 workers beside the caller.
 effects::ThreadPool& pool() {
-  static effects::ThreadPool p(std::max(1u, std::thread::hardware_concurrency()) - 1);
+  static effects::ThreadPool p(effects::ThreadPool::besideCaller());
   return p;
 }
 

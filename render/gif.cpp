@@ -219,12 +219,7 @@ std::optional<Error> GifEncoder::add(const Image& frame) {
   if (g.added >= g.count) return invalid("/frames", "more frames than announced");
   if (frame.width != g.width || frame.height != g.height || frame.values() != size_t(g.width) * g.height * 4)
     return invalid("/frames", "a frame of another size");
-  std::vector<uint8_t> rgba = frame.rgba8;
-  if (rgba.empty()) {  // rounded as encodePng rounds
-    rgba.resize(frame.rgba.size());
-    for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = uint8_t(std::lround(std::clamp(frame.rgba[i], 0.0f, 1.0f) * 255.0f));
-  }
-  g.pending.push_back(std::move(rgba));
+  g.pending.push_back(bytes8(frame));
   ++g.added;
   if (g.pending.size() == kBatch) g.flush();
   return std::nullopt;

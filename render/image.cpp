@@ -11,6 +11,13 @@
 
 namespace effects::render {
 
+std::vector<uint8_t> bytes8(const Image& image) {
+  if (!image.rgba8.empty()) return image.rgba8;
+  std::vector<uint8_t> out(image.rgba.size());
+  for (size_t i = 0; i < out.size(); ++i) out[i] = uint8_t(std::lround(std::clamp(image.rgba[i], 0.0f, 1.0f) * 255.0f));
+  return out;
+}
+
 int Flipbook::cells(int count) {
   const int columns = std::max(1, int(std::ceil(std::sqrt(double(count)))));
   return columns * ((count + columns - 1) / columns);

@@ -62,16 +62,12 @@ void filterRow(const uint8_t* __restrict row, const uint8_t* __restrict above, c
 
 // A float image's samples as PNG rows (RGBA, big-endian for 16 bits), without filter bytes.
 std::vector<uint8_t> samples(const Image& image, int bitDepth) {
+  if (bitDepth == 8) return bytes8(image);
   const size_t n = image.rgba.size();
-  std::vector<uint8_t> out(n * size_t(bitDepth / 8));
+  std::vector<uint8_t> out(n * 2);
   for (size_t i = 0; i < n; ++i) {
-    const float v = std::clamp(image.rgba[i], 0.0f, 1.0f);
-    if (bitDepth == 8) {
-      out[i] = uint8_t(std::lround(v * 255.0f));
-    } else {
-      const auto s = uint16_t(std::lround(v * 65535.0f));
-      out[2 * i] = uint8_t(s >> 8), out[2 * i + 1] = uint8_t(s & 0xFF);
-    }
+    const auto s = uint16_t(std::lround(std::clamp(image.rgba[i], 0.0f, 1.0f) * 65535.0f));
+    out[2 * i] = uint8_t(s >> 8), out[2 * i + 1] = uint8_t(s & 0xFF);
   }
   return out;
 }

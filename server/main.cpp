@@ -57,7 +57,7 @@ bool readScene(const std::string& scenePath, nlohmann::json& body) {
 int renderScene(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
   try {
     effectd::Animation animation;
-    effects::ThreadPool pool(std::max(1u, std::thread::hardware_concurrency()) - 1);  // as the server's
+    effects::ThreadPool pool(effects::ThreadPool::besideCaller());  // as the server's
     effects::render::Scene scene =
         effectd::buildScene(body, effectd::RequestContext{"render", config, &pool}, nullptr, &animation);
     auto renderer = effects::render::Renderer::create(config.eglPlatform);

@@ -179,7 +179,7 @@ Service::Service(Config config)
       admission_(std::make_unique<Admission>(admissionOptions(config_))),
       cache_(config_.responseCacheMb << 20),
       http_(std::make_unique<httplib::Server>()),
-      compute_(std::make_unique<effects::ThreadPool>(std::max(1u, std::thread::hardware_concurrency()) - 1)),
+      compute_(std::make_unique<effects::ThreadPool>(effects::ThreadPool::besideCaller())),
       idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())

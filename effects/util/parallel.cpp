@@ -19,6 +19,8 @@ struct ThreadPool::Call {
   size_t helpers = 0;  // workers inside runChunks for this call (guarded by mu_)
 };
 
+size_t ThreadPool::besideCaller() { return std::max(1u, std::thread::hardware_concurrency()) - 1; }
+
 ThreadPool::ThreadPool(size_t threads) {
   for (size_t i = 0; i < threads; ++i) workers_.emplace_back([this] { work(); });
 }

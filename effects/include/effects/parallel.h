@@ -38,6 +38,8 @@ class ThreadPool final : public Parallel {
   ThreadPool& operator=(const ThreadPool&) = delete;
   void forRange(size_t n, size_t grain, const std::function<void(size_t, size_t)>& fn) override;
   size_t threads() const { return workers_.size(); }
+  // Workers for the rest of the machine: its cores less the calling thread (at least 0).
+  static size_t besideCaller();
 
  private:
   struct Call;

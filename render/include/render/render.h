@@ -50,6 +50,9 @@ struct Image {
   size_t values() const { return rgba8.empty() ? rgba.size() : rgba8.size(); }
   float at(size_t i) const { return rgba8.empty() ? rgba[i] : float(rgba8[i]) / 255.0f; }
 };
+// The image's 8-bit values: its bytes, or its floats rounded to round(255 x) (an 8-bit PNG's
+// and a GIF's samples).
+std::vector<uint8_t> bytes8(const Image& image);
 
 struct Camera {
   glm::dvec3 position{0, 1, 6}, target{0, 0.5, 0}, up{0, 1, 0};
