@@ -20,14 +20,17 @@ namespace {
 constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not zero" bound on UV area
 
 // Plain data, filled in whole by initTriInfo (in parallel, so that the threads first touch the
-// pages of their own range).
-struct TriInfo {
-  dvec3 os, ot;      // unit first-order derivatives, sign-adjusted by orientation (or zero)
-  int neighbor[3];   // across edge (i, i+1); -1: none
+// pages of their own range). The edge pairing and the groups walk only the links, 16 bytes a
+// triangle, which stay in cache where the derivatives would not.
+struct TriLinks {
+  int neighbor[3];    // across edge (i, i+1); -1: none
   bool orientPreserving;
   bool groupWithAny;  // UV area or a derivative is zero: joins any group, adds nothing
   bool zeroUvArea;
   uint8_t grouped;  // bit i: corner i has its group
+};
+struct TriDerivatives {
+  dvec3 os, ot;  // unit first-order derivatives, sign-adjusted by orientation (or zero)
 };
 
 struct Group {
@@ -73,7 +76,8 @@ class Mikk {
         tri_.push_back(v);
       }
     }
-    info_.resize(good_.size());
+    links_.resize(good_.size());
+    derivatives_.resize(good_.size());
     initTriInfo();
     buildNeighbors();
     buildGroups();
@@ -82,7 +86,7 @@ class Mikk {
     fallbacks();
     MikkStats stats;
     stats.degenerateTriangles = degenerate.size();
-    for (const TriInfo& ti : info_) stats.zeroUvArea += ti.zeroUvArea;
+    for (const TriLinks& ti : links_) stats.zeroUvArea += ti.zeroUvArea;
     stats.groups = groups_.size();
     return stats;
   }
@@ -97,8 +101,10 @@ class Mikk {
   }
   void initTriInfo(size_t begin, size_t end) {
     for (size_t g = begin; g < end; ++g) {
-      TriInfo& ti = info_[g];
-      ti = {dvec3(0), dvec3(0), {-1, -1, -1}, false, true, false, 0};
+      TriLinks& ti = links_[g];
+      TriDerivatives& d = derivatives_[g];
+      ti = {{-1, -1, -1}, false, true, false, 0};
+      d = {dvec3(0), dvec3(0)};
       dvec3 v1 = pos(corner(g, 0)), v2 = pos(corner(g, 1)), v3 = pos(corner(g, 2));
       dvec2 t1 = uv(corner(g, 0)), t2 = uv(corner(g, 1)), t3 = uv(corner(g, 2));
       double t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
@@ -109,8 +115,8 @@ class Mikk {
       ti.orientPreserving = area > 0;
       if (std::abs(area) > kFloatMin) {
         double lenOs = glm::length(os), lenOt = glm::length(ot), s = ti.orientPreserving ? 1.0 : -1.0;
-        if (lenOs > 0) ti.os = (s / lenOs) * os;
-        if (lenOt > 0) ti.ot = (s / lenOt) * ot;
+        if (lenOs > 0) d.os = (s / lenOs) * os;
+        if (lenOt > 0) d.ot = (s / lenOt) * ot;
         if (lenOs > 0 && lenOt > 0) ti.groupWithAny = false;
       } else {
         ti.zeroUvArea = true;
@@ -150,12 +156,12 @@ class Mikk {
     for (Edge* k = first + 1; k < last; ++k)  // buckets are small: stable insertion sort by i1
       for (Edge* j = k; j > first && (j - 1)->i1 > j->i1; --j) std::swap(*(j - 1), *j);
     for (Edge* a = first; a < last; ++a) {
-      if (info_[a->face].neighbor[a->num] != -1) continue;
+      if (links_[a->face].neighbor[a->num] != -1) continue;
       uint32_t fromA = corner(a->face, a->num);
       for (Edge* b = a + 1; b < last && b->i1 == a->i1; ++b)
-        if (corner(b->face, b->num) != fromA && info_[b->face].neighbor[b->num] == -1) {
-          info_[a->face].neighbor[a->num] = int(b->face);
-          info_[b->face].neighbor[b->num] = int(a->face);
+        if (corner(b->face, b->num) != fromA && links_[b->face].neighbor[b->num] == -1) {
+          links_[a->face].neighbor[a->num] = int(b->face);
+          links_[b->face].neighbor[b->num] = int(a->face);
           break;
         }
     }
@@ -173,11 +179,11 @@ class Mikk {
     members_.reserve(good_.size() * 3);
     for (size_t g = 0; g < good_.size(); ++g) {
       for (uint32_t i = 0; i < 3; ++i) {
-        if (info_[g].groupWithAny || (info_[g].grouped >> i & 1)) continue;
+        if (links_[g].groupWithAny || (links_[g].grouped >> i & 1)) continue;
         const uint32_t vertex = corner(g, i);
-        const bool orient = info_[g].orientPreserving;
+        const bool orient = links_[g].orientPreserving;
         const size_t first = members_.size();
-        info_[g].grouped |= uint8_t(1u << i);
+        links_[g].grouped |= uint8_t(1u << i);
         members_.push_back({uint32_t(g), i & 3u});
         stack.clear();
         pushNeighbors(g, i, stack);
@@ -185,7 +191,7 @@ class Mikk {
           uint32_t f = stack.back();
           stack.pop_back();
           int k = cornerOf(f, vertex);
-          TriInfo& ti = info_[f];
+          TriLinks& ti = links_[f];
           if (k < 0 || (ti.grouped >> k & 1)) continue;
           if (ti.groupWithAny && ti.grouped == 0)
             ti.orientPreserving = orient;  // the reference's one order dependency
@@ -199,7 +205,7 @@ class Mikk {
     }
   }
   void pushNeighbors(size_t f, uint32_t i, std::vector<uint32_t>& stack) const {
-    int left = info_[f].neighbor[i], right = info_[f].neighbor[(i + 2) % 3];
+    int left = links_[f].neighbor[i], right = links_[f].neighbor[(i + 2) % 3];
     if (right >= 0) stack.push_back(uint32_t(right));  // popped after the left subtree
     if (left >= 0) stack.push_back(uint32_t(left));
   }
@@ -228,11 +234,11 @@ class Mikk {
       os.resize(k);
       ot.resize(k);
       for (size_t a = 0; a < k; ++a) {
-        os[a] = projected(info_[faces[a].face].os, n);
-        ot[a] = projectToPlane(info_[faces[a].face].ot, n);  // normalised below only if needed
+        os[a] = projected(derivatives_[faces[a].face].os, n);
+        ot[a] = projectToPlane(derivatives_[faces[a].face].ot, n);  // normalised below only if needed
       }
       auto agree = [&](size_t a, size_t b, bool otUnit) {
-        if (a == b || info_[faces[a].face].groupWithAny || info_[faces[b].face].groupWithAny) return true;
+        if (a == b || links_[faces[a].face].groupWithAny || links_[faces[b].face].groupWithAny) return true;
         return glm::dot(os[a], os[b]) > -1.0 && (otUnit ? glm::dot(ot[a], ot[b]) > -1.0 : glm::dot(ot[a], ot[b]) >= 0.0);
       };
       bool whole = true;
@@ -262,7 +268,7 @@ class Mikk {
           auto it = std::find_if(subgroups.begin(), subgroups.end(), same);
           if (it == subgroups.end()) {
             std::vector<dvec3> subsetOs(subset.size());
-            for (size_t i = 0; i < subset.size(); ++i) subsetOs[i] = projected(info_[subset[i].face].os, n);
+            for (size_t i = 0; i < subset.size(); ++i) subsetOs[i] = projected(derivatives_[subset[i].face].os, n);
             subgroups.emplace_back(subset, evalTSpace(subset.data(), subset.size(), subsetOs.data(), n));
             it = subgroups.end() - 1;
           }
@@ -300,7 +306,7 @@ class Mikk {
         cosine[a - first] = std::clamp(glm::dot(v1, v2), -1.0, 1.0);
       }
       for (size_t a = first; a < last; ++a)
-        if (!info_[faces[a].face].groupWithAny) sum += std::acos(cosine[a - first]) * os[a];
+        if (!links_[faces[a].face].groupWithAny) sum += std::acos(cosine[a - first]) * os[a];
     }
     return normalizeOrZero(sum);
   }
@@ -334,7 +340,8 @@ class Mikk {
   CornerTangents& out_;
   std::vector<uint32_t> good_;                // triangles that take part, in input order
   std::vector<std::array<uint32_t, 3>> tri_;  // their welded corners
-  Buffer<TriInfo> info_;                      // per good triangle
+  Buffer<TriLinks> links_;                    // per good triangle
+  Buffer<TriDerivatives> derivatives_;        // per good triangle
   std::vector<Group> groups_;
   std::vector<Member> members_;  // group member lists, contiguous
 };
