@@ -241,9 +241,12 @@ class Mikk {
         if (a == b || links_[faces[a].face].groupWithAny || links_[faces[b].face].groupWithAny) return true;
         return glm::dot(os[a], os[b]) > -1.0 && (otUnit ? glm::dot(ot[a], ot[b]) > -1.0 : glm::dot(ot[a], ot[b]) >= 0.0);
       };
-      bool whole = true;
-      for (size_t a = 0; a < k && whole; ++a)
-        for (size_t b = a + 1; b < k && whole; ++b) whole = agree(a, b, false);
+      bool whole = nearTogether(faces, k, os.data(), ot.data());
+      if (!whole) {
+        whole = true;
+        for (size_t a = 0; a < k && whole; ++a)
+          for (size_t b = a + 1; b < k && whole; ++b) whole = agree(a, b, false);
+      }
       if (whole) {
         store(grp, faces, k, evalTSpace(faces, k, os.data(), n));
         continue;
@@ -277,6 +280,28 @@ class Mikk {
         store(grp, faces + a, 1, tangent);
       }
     }
+  }
+
+  // Whether the pairwise test of generateTSpaces finds every pair of the group in agreement,
+  // shown in one pass where the frames lie close together: every unit os within 89.9 degrees
+  // of the first's puts every pair less than 180 degrees apart (dot > -1), and every ot within
+  // 42 degrees of the first's puts every pair less than 84 degrees apart (dot >= 0), both with
+  // margins far beyond rounding (ot also no shorter than 1e-50, so no square underflows). False
+  // means only that the pairs must be tested one by one.
+  bool nearTogether(const Member* faces, size_t k, const dvec3* os, const dvec3* ot) const {
+    size_t first = 0;
+    while (first < k && links_[faces[first].face].groupWithAny) ++first;
+    if (first == k) return true;
+    const dvec3 s0 = os[first], t0 = ot[first];
+    const double t0Squared = glm::dot(t0, t0);
+    if (t0Squared < 1e-100) return false;
+    for (size_t a = first + 1; a < k; ++a) {
+      if (links_[faces[a].face].groupWithAny) continue;
+      const double ts = glm::dot(ot[a], t0), tSquared = glm::dot(ot[a], ot[a]);
+      if (!(glm::dot(os[a], s0) >= 1e-3) || tSquared < 1e-100 || !(ts > 0) || ts * ts < 0.55 * tSquared * t0Squared)
+        return false;
+    }
+    return true;
   }
 
   // The corners `faces` of a group get `tangent` (unit, in the normal's plane) unless it is zero.
