@@ -6,14 +6,16 @@
 namespace effects::tangents {
 
 // A vertex with no usable triangle gets +z.
-std::vector<dvec3> vertexNormals(const Mesh& mesh) {
+std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel) {
   const size_t n = mesh.positions.size();
   std::vector<dvec3> out(n, dvec3(0));
   if (!mesh.normals.empty()) {
-    for (size_t i = 0; i < n; ++i) {
-      dvec3 v = normalizeOrZero(dvec3(mesh.normals[i]));
-      out[i] = notZero(v) ? v : dvec3(0, 0, 1);
-    }
+    forRange(parallel, n, kParallelGrain, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        dvec3 v = normalizeOrZero(dvec3(mesh.normals[i]));
+        out[i] = notZero(v) ? v : dvec3(0, 0, 1);
+      }
+    });
     return out;
   }
   std::vector<uint32_t> at = weld<3>(n, [&](size_t i, float* k) {

@@ -56,7 +56,7 @@ inline constexpr size_t kGroupGrain = 1000;
 
 // A unit normal per vertex: given ones normalised; missing ones angle-weighted over every
 // corner at the same position (welded, weld.h); +z where no triangle has area.
-std::vector<dvec3> vertexNormals(const Mesh& mesh);
+std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel);
 // Every corner its own vertex with the face normal (glTF's rule for meshes without normals);
 // cornerToInput[c] = the input vertex of corner c.
 Mesh flatExpanded(const Mesh& mesh, std::vector<uint32_t>& cornerToInput);

@@ -84,7 +84,7 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   const Mesh& mesh = flat ? expanded : meshIn;
   const size_t triCount = mesh.indices.size() / 3;
   // 2. A unit normal per vertex.
-  const std::vector<dvec3> normals = vertexNormals(mesh);
+  const std::vector<dvec3> normals = vertexNormals(mesh, options.parallel);
   // 3. A tangent per corner by the requested method; MikkTSpace also when it is the reference.
   const bool needMikk = options.mode == Mode::kMikkTSpace || options.measureError;
   MikkStats mikkStats;
