@@ -283,10 +283,12 @@ class Mikk {
   }
 
   // Whether the pairwise test of generateTSpaces finds every pair of the group in agreement,
-  // shown in one pass where the frames lie close together: every unit os within 89.9 degrees
-  // of the first's puts every pair less than 180 degrees apart (dot > -1), and every ot within
-  // 42 degrees of the first's puts every pair less than 84 degrees apart (dot >= 0), both with
-  // margins far beyond rounding (ot also no shorter than 1e-50, so no square underflows). False
+  // shown in one pass where the frames lie close together: every os within 89.9 degrees of the
+  // first's puts every pair less than 180 degrees apart (dot > -1), and every ot within 42
+  // degrees of the first's puts every pair less than 84 degrees apart (dot >= 0), both with
+  // margins far beyond rounding. The os must be no longer than 1 + 1e-9 (a "unit" vector
+  // normalised from a subnormal squared length can come out several per cent longer, and two
+  // such can have dot < -1), the ot no shorter than 1e-50 (so that no square underflows). False
   // means only that the pairs must be tested one by one.
   bool nearTogether(const Member* faces, size_t k, const dvec3* os, const dvec3* ot) const {
     size_t first = 0;
@@ -294,11 +296,13 @@ class Mikk {
     if (first == k) return true;
     const dvec3 s0 = os[first], t0 = ot[first];
     const double t0Squared = glm::dot(t0, t0);
-    if (t0Squared < 1e-100) return false;
+    constexpr double kLongest = 1 + 1e-9;
+    if (t0Squared < 1e-100 || !(glm::dot(s0, s0) <= kLongest)) return false;
     for (size_t a = first + 1; a < k; ++a) {
       if (links_[faces[a].face].groupWithAny) continue;
       const double ts = glm::dot(ot[a], t0), tSquared = glm::dot(ot[a], ot[a]);
-      if (!(glm::dot(os[a], s0) >= 1e-3) || tSquared < 1e-100 || !(ts > 0) || ts * ts < 0.55 * tSquared * t0Squared)
+      if (!(glm::dot(os[a], s0) >= 1e-3) || !(glm::dot(os[a], os[a]) <= kLongest) || tSquared < 1e-100 || !(ts > 0) ||
+          ts * ts < 0.55 * tSquared * t0Squared)
         return false;
     }
     return true;
