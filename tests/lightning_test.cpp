@@ -84,6 +84,36 @@ TEST(Fast, LargeGridsCountScreeningWithinRadius3) {
   EXPECT_EQ(validate(fast)->field, "/screeningRadius");
 }
 
+// From 256^2 up the base comes from the table of docs/lightning-calibration.md section 12: the
+// measured values at its grids and etas, continuous between (no jump as a client varies the
+// grid or eta), held beyond, never rising with the grid.
+TEST(Fast, LargeGridBaseFollowsTheCalibrationTable) {
+  auto base = [](int side, double eta, int neighbourhood = 8) {
+    Params p = basic(side);
+    p.eta = eta;
+    p.neighbourhood = neighbourhood;
+    return calibratedAxisGrowth(p);
+  };
+  EXPECT_DOUBLE_EQ(base(256, 0.5), 1.13);
+  EXPECT_DOUBLE_EQ(base(512, 0.5), 1.085);
+  EXPECT_DOUBLE_EQ(base(512, 2), 1.095);
+  EXPECT_DOUBLE_EQ(base(1024, 2), 1.08);
+  EXPECT_DOUBLE_EQ(base(1024, 4), 1.09);
+  EXPECT_DOUBLE_EQ(base(512, 3, 4), 1.125);
+  EXPECT_DOUBLE_EQ(base(1024, 3, 4), 1.125);
+  EXPECT_DOUBLE_EQ(base(512, 2.5, 4), 0.5 * (1.095 + 1.125));
+  EXPECT_DOUBLE_EQ(base(4096, 0.1), base(1024, 0.5));
+  EXPECT_DOUBLE_EQ(base(700, 9), base(700, 4));
+  for (int neighbourhood : {8, 4})
+    for (int side = 512; side <= 1100; side += 1)
+      for (double eta = 0.3; eta <= 4.5; eta += 0.01) {
+        const double b = base(side, eta, neighbourhood);
+        ASSERT_LT(std::abs(base(side, eta + 0.01, neighbourhood) - b), 0.0006) << side << " " << eta;
+        ASSERT_LT(std::abs(base(side + 1, eta, neighbourhood) - b), 0.0002) << side << " " << eta;
+        ASSERT_LE(base(side + 1, eta, neighbourhood), b + 1e-12) << side << " " << eta;
+      }
+}
+
 // Kim et al.'s point-charge potential raised to eta is space-filling at DBM's eta (their
 // dimension parameter wants 4-16); the calibrated power meets DBM's D (docs/lightning-
 // calibration.md section 6: within 0.05 over 10 seeds; looser here with 4 DBM seeds).

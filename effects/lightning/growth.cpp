@@ -57,6 +57,33 @@ namespace {
 // The grid side from which N is counted within radius 3 (section 11): 256 in the
 // 8-neighbourhood, 512 in the 4-neighbourhood (whose adjacent-cell law still meets DBM at 256^2).
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
+
+// Section 12: with N counted within radius 3, the base per cell that meets DBM, per grid side
+// (a row: 256, 512, 1024) and eta (a column: kTableEtas), measured against DBM's bolts.
+constexpr double kTableEtas[] = {0.5, 1, 2, 3, 4};
+constexpr int kTableColumns = 5;
+constexpr double kRadiusBase8[][kTableColumns] = {
+    {1.13, 1.13, 1.13, 1.13, 1.13},         // 256^2
+    {1.085, 1.095, 1.095, 1.095, 1.095},   // 512^2
+    {1.08, 1.08, 1.08, 1.09, 1.09},        // 1024^2 (eta < 2: held, no DBM reference)
+};
+constexpr double kRadiusBase4[][kTableColumns] = {
+    {1.095, 1.095, 1.095, 1.125, 1.125},  // 512^2 (eta 0.5 and 4: held), held beyond: no DBM reference
+};
+
+// table[row][column]: rows at sides firstSide, 2 firstSide, ...; linear in log2 of the side and
+// in eta between rows and columns, held beyond the first and last of each.
+template <size_t Rows>
+double tableBase(const double (&table)[Rows][kTableColumns], double firstSide, double side, double eta) {
+  const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));
+  const size_t r0 = std::min(size_t(r), Rows - 1), r1 = std::min(r0 + 1, Rows - 1);
+  const double e = std::clamp(eta, kTableEtas[0], kTableEtas[kTableColumns - 1]);
+  size_t c0 = 0;
+  while (c0 + 2 < kTableColumns && e > kTableEtas[c0 + 1]) ++c0;
+  const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]);
+  auto at = [&](size_t row) { return table[row][c0] + (table[row][c0 + 1] - table[row][c0]) * ce; };
+  return at(r0) + (at(r1) - at(r0)) * (r - double(r0));
+}
 }  // namespace
 
 double calibratedAxisGrowth(const Params& p) {
@@ -66,12 +93,8 @@ double calibratedAxisGrowth(const Params& p) {
                                 : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
   }
   const double longer = std::max(3, std::max(p.width, p.height));
-  if (longer >= radiusFrom(p)) {
-    // Section 11: the base that meets DBM with N counted within radius 3, at 256^2, 512^2 and
-    // 1024^2; linear in log L between, held beyond (extrapolated: DBM is minutes a bolt there).
-    const double t = std::log2(longer / 256.0);
-    return t <= 1 ? 1.13 + (1.095 - 1.13) * t : t <= 2 ? 1.095 + (1.09 - 1.095) * (t - 1) : 1.09;
-  }
+  if (longer >= radiusFrom(p))
+    return p.neighbourhood == 4 ? tableBase(kRadiusBase4, 512, longer, p.eta) : tableBase(kRadiusBase8, 256, longer, p.eta);
   if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
   return std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35));
 }
