@@ -10,7 +10,7 @@ void splitVertices(const Mesh& mesh, const Buffer<glm::vec4>& corner, const std:
                    Output& out) {
   const size_t vertCount = mesh.positions.size();
   std::vector<int64_t> nextSplit(vertCount, -1);  // chain of the splits of each input vertex
-  std::vector<bool> assigned(vertCount, false);
+  std::vector<uint8_t> assigned(vertCount, 0);
   out.tangents.resize(vertCount);
   out.remap.resize(vertCount);
   out.indices.resize(corner.size());
@@ -18,7 +18,7 @@ void splitVertices(const Mesh& mesh, const Buffer<glm::vec4>& corner, const std:
   for (size_t c = 0; c < corner.size(); ++c) {
     uint32_t v = mesh.indices[c];
     if (!assigned[v]) {
-      assigned[v] = true;
+      assigned[v] = 1;
       out.tangents[v] = corner[c];
       out.indices[c] = v;
       continue;
