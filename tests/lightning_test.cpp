@@ -97,6 +97,7 @@ TEST(Fast, LargeGridBaseFollowsTheCalibrationTable) {
   EXPECT_DOUBLE_EQ(base(256, 0.5), 1.13);
   EXPECT_DOUBLE_EQ(base(512, 0.5), 1.085);
   EXPECT_DOUBLE_EQ(base(512, 2), 1.095);
+  EXPECT_DOUBLE_EQ(base(512, 3), 1.11);
   EXPECT_DOUBLE_EQ(base(1024, 2), 1.08);
   EXPECT_DOUBLE_EQ(base(1024, 4), 1.09);
   EXPECT_DOUBLE_EQ(base(512, 3, 4), 1.125);

@@ -64,7 +64,7 @@ constexpr double kTableEtas[] = {0.5, 1, 2, 3, 4};
 constexpr int kTableColumns = 5;
 constexpr double kRadiusBase8[][kTableColumns] = {
     {1.13, 1.13, 1.13, 1.13, 1.13},         // 256^2
-    {1.085, 1.095, 1.095, 1.095, 1.095},   // 512^2
+    {1.085, 1.095, 1.095, 1.11, 1.11},      // 512^2
     {1.08, 1.08, 1.08, 1.09, 1.09},        // 1024^2 (eta < 2: held, no DBM reference)
 };
 constexpr double kRadiusBase4[][kTableColumns] = {

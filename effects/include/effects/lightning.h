@@ -71,10 +71,11 @@ struct Params;
 double calibratedAxisGrowth(const Params& p);
 // eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
 // the paper). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) the calibrated
-// default counts them within radius 3, with a base per cell of 1.13 at 256^2, 1.095 at 512^2
-// and 1.09 from 1024^2 up (interpolated in log L between): with adjacent cells only, no base
-// meets DBM's dimension and its mass together there (docs/lightning-calibration.md sections 7
-// and 11).
+// default counts them within radius 3, with a base per cell from a table per grid and eta
+// (1.13 at 256^2; 1.085-1.11 at 512^2 and 1.08-1.09 from 1024^2 in the 8-neighbourhood,
+// 1.095-1.125 from 512^2 in the 4-neighbourhood, rising with eta), linear in log L and eta
+// between: with adjacent cells only, no base meets DBM's dimension and its mass together there
+// (docs/lightning-calibration.md sections 7, 11 and 12).
 int calibratedScreeningRadius(const Params& p);
 // The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
 // one; 1 for every method but 2-D fast.
