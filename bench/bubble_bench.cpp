@@ -3,7 +3,6 @@
 // with its Delta E against the 1 nm reference (counters meanDeltaE, maxDeltaE).
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
 
 #include <effects/bubble.h>
 

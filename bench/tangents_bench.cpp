@@ -6,7 +6,6 @@
 // runs both).
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
 #include <cmath>
 
 #include <effects/tangents.h>
