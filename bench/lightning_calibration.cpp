@@ -5,8 +5,10 @@
 // `--lifetime` is a row, so a scan shows which setting meets DBM at each grid and eta.
 //
 //   lightning_calibration [--grid N]... [--eta E]... [--axis A]... [--lifetime L]...
-//                         [--seeds S] [--dbm-seeds S] [--neighbourhood 4|8] [--fit]
-//                         [--charges-eta E]... [--screening S]... [--volume]
+//                         [--seeds S] [--dbm-seeds S] [--dbm-first-seed F] [--neighbourhood 4|8]
+//                         [--fit] [--charges-eta E]... [--screening S]... [--volume]
+// --dbm-first-seed: DBM's bolts are seeds F ... F+S-1 (default 1), so slow references can be
+// grown a few seeds a run and pooled by hand.
 // --volume: N x N x N grids (neighbourhood 26 unless given; 6 is the other 3-D one).
 // --screening: the exponent of eqn 6's N (1 in the paper), one row (or fit) per value.
 // --charges-eta: rows for the charges method (Kim et al. 2007) with their potential raised to
@@ -60,11 +62,13 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-// Prints one table row over `seeds` bolts; returns their median cells.
-double row(const std::string& grid, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds) {
+// Prints one table row over `seeds` bolts (seeds firstSeed, firstSeed + 1, ...); returns their
+// median cells.
+double row(const std::string& grid, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds,
+           int firstSeed = 1) {
   std::vector<double> d, cells, tips;
   double ms = 0;
-  for (int s = 1; s <= seeds; ++s) {
+  for (int s = firstSeed; s < firstSeed + seeds; ++s) {
     lt::Params p = base;
     p.seed = uint64_t(s);
     const Sample x = measure(p);
@@ -118,7 +122,7 @@ int main(int argc, char** argv) {
   std::vector<int> grids;
   std::vector<double> etas, axes, chargesEtas, screenings;
   std::vector<int> lifetimes, radii;
-  int seeds = 20, dbmSeeds = 10, neighbourhood = 0;  // 0: 8 in 2-D, 26 in 3-D
+  int seeds = 20, dbmSeeds = 10, dbmFirstSeed = 1, neighbourhood = 0;  // 0: 8 in 2-D, 26 in 3-D
   bool fit = false, volume = false;
   for (int i = 1; i < argc; i += 2) {
     const std::string flag = argv[i];
@@ -145,6 +149,8 @@ int main(int argc, char** argv) {
       seeds = std::atoi(v);
     else if (flag == "--dbm-seeds")
       dbmSeeds = std::atoi(v);
+    else if (flag == "--dbm-first-seed")
+      dbmFirstSeed = std::max(1, std::atoi(v));
     else if (flag == "--charges-eta")
       chargesEtas.push_back(std::atof(v));
     else if (flag == "--neighbourhood")
@@ -179,7 +185,7 @@ int main(int argc, char** argv) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;
         // The default solver: exact (capacitance) while its fixed cells allow, then MGPCG.
-        const double dbmCells = row(grid, eta, "dbm", std::string(lt::toString(p.solver)) + " (default)", p, dbmSeeds);
+        const double dbmCells = row(grid, eta, "dbm", std::string(lt::toString(p.solver)) + " (default)", p, dbmSeeds, dbmFirstSeed);
         if (fit) {
           for (double sc : screenings) {
             lt::Params f = base;

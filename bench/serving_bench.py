@@ -6,11 +6,14 @@ cheap requests while heavy ones run.
 
 1. One kept-alive connection (python http.client), 200 sequential requests per route:
    p50 / p99 in ms (the Nagle stall made every request after the first take ~44 ms).
-2. Small uncached fog requests on one connection while 8 dbm 256^2 bolts run, with the
+2. A 19 800-triangle mesh to /v1/tangents on one connection (--response-cache-mb 0), as JSON
+   (1.8 MB) and, as the peer in the same run, as the same mesh in a GLB (0.5 MB):
+   client p50 and the p50 of each Server-Timing stage, so the cost of taking JSON is plain.
+3. Small uncached fog requests on one connection while 8 dbm 256^2 bolts run, with the
    default heavy-work slots (cores - 1) and, as the baseline in the same run, with
    --heavy-threads 8 (every bolt runs at once, as before the heavy slots existed).
 """
-import http.client, json, os, statistics, sys, threading, time
+import http.client, json, math, os, statistics, struct, sys, threading, time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 import effectd_process  # noqa: E402
@@ -55,6 +58,80 @@ def keep_alive(port):
         print(f"  {name:34} {statistics.median(ms):8.3f} {pct(ms, 0.99):8.3f}")
 
 
+def sphere(rings=100, segments=100):
+    """A UV sphere: (positions, normals, uvs, indices) as flat lists; 19 800 triangles."""
+    pos, nrm, uv, idx = [], [], [], []
+    for r in range(rings + 1):
+        for s in range(segments + 1):
+            th, ph = math.pi * r / rings, 2 * math.pi * s / segments
+            st = 0 if r in (0, rings) else math.sin(th)
+            p = [st * math.cos(ph), math.cos(th), st * math.sin(ph)]
+            pos += p
+            nrm += p
+            uv += [s / segments, 1 - r / rings]
+    row = segments + 1
+    for r in range(rings):
+        for s in range(segments):
+            a = r * row + s
+            if r > 0:
+                idx += [a, a + 1, a + row]
+            if r + 1 < rings:
+                idx += [a + 1, a + row + 1, a + row]
+    return pos, nrm, uv, idx
+
+
+def glb(pos, nrm, uv, idx):
+    """The mesh as a glTF binary: one primitive, float32 attributes, uint32 indices."""
+    parts = [struct.pack(f"<{len(pos)}f", *pos), struct.pack(f"<{len(nrm)}f", *nrm), struct.pack(f"<{len(uv)}f", *uv),
+             struct.pack(f"<{len(idx)}I", *idx)]
+    views, offset = [], 0
+    for part in parts:
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(part)})
+        offset += len(part)
+    n = len(pos) // 3
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": n, "type": "VEC3",
+                  "min": [min(pos[i::3]) for i in range(3)], "max": [max(pos[i::3]) for i in range(3)]},
+                 {"bufferView": 1, "componentType": 5126, "count": n, "type": "VEC3"},
+                 {"bufferView": 2, "componentType": 5126, "count": n, "type": "VEC2"},
+                 {"bufferView": 3, "componentType": 5125, "count": len(idx), "type": "SCALAR"}]
+    doc = {"asset": {"version": "2.0"}, "buffers": [{"byteLength": offset}], "bufferViews": views,
+           "accessors": accessors, "scenes": [{"nodes": [0]}], "scene": 0, "nodes": [{"mesh": 0}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3}]}]}
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    binary = b"".join(parts)
+    chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    return struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks
+
+
+def mesh_upload(port, rounds=30):
+    pos, nrm, uv, idx = sphere()
+    as_json = json.dumps({"mesh": {"positions": pos, "normals": nrm, "uvs": uv, "indices": idx}})
+    as_glb = glb(pos, nrm, uv, idx)
+    print(f"\n/v1/tangents, a {len(idx) // 3}-triangle sphere, one connection, {rounds} requests each, no cache:")
+    print(f"  {'body':24} {'bytes':>9} {'client p50':>11}  Server-Timing p50 (ms)")
+    p50s = {}
+    for name, body, ctype in [("JSON", as_json, "application/json"), ("GLB (peer)", as_glb, "model/gltf-binary")]:
+        c = http.client.HTTPConnection("127.0.0.1", port)
+        ms, stages = [], {}
+        for i in range(rounds + 1):
+            t = time.perf_counter()
+            c.request("POST", "/v1/tangents", body=body, headers={"Content-Type": ctype})
+            r = c.getresponse()
+            r.read()
+            assert r.status == 200, (name, r.status)
+            if i:  # the first warms the heap
+                ms.append((time.perf_counter() - t) * 1e3)
+                for part in (r.getheader("Server-Timing") or "").split(","):
+                    key, _, dur = part.strip().partition(";dur=")
+                    if dur:
+                        stages.setdefault(key, []).append(float(dur))
+        p50s[name] = statistics.median(ms)
+        timing = ", ".join(f"{k} {statistics.median(v):.2f}" for k, v in stages.items())
+        print(f"  {name:24} {len(body):9d} {p50s[name]:11.2f}  {timing}")
+    print(f"  JSON / GLB client p50: {p50s['JSON'] / p50s['GLB (peer)']:.2f}")
+
+
 def cheap_under_heavy(flags, label):
     p, port = start("--response-cache-mb", "0", *flags)
     stop = time.time() + SECONDS
@@ -94,6 +171,12 @@ def main():
     p, port = start()
     try:
         keep_alive(port)
+    finally:
+        p.terminate()
+        p.wait()
+    p, port = start("--response-cache-mb", "0")
+    try:
+        mesh_upload(port)
     finally:
         p.terminate()
         p.wait()

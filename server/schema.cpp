@@ -47,17 +47,43 @@ std::string typeOf(const json& v) {
   }
 }
 
-bool hasType(const json& v, const std::string& t) {
-  if (t == "number") return v.is_number();
-  if (t == "integer") {
-    if (v.is_number_integer()) return true;
-    if (v.is_number_float()) {
-      double d = v.get<double>();
-      return std::isfinite(d) && std::floor(d) == d && std::fabs(d) < 9.007199254740992e15;
+// JSON Schema's types as bits, so that "type" is one AND per value.
+enum TypeBit : unsigned {
+  kNull = 1,
+  kBoolean = 2,
+  kInteger = 4,  // an integer, or a float with an integral value
+  kFloat = 8,    // a float with a fractional part (or out of the exact-integer range)
+  kString = 16,
+  kArray = 32,
+  kObject = 64,
+};
+
+unsigned typeBitsOf(const std::string& t) {
+  if (t == "null") return kNull;
+  if (t == "boolean") return kBoolean;
+  if (t == "integer") return kInteger;
+  if (t == "number") return kInteger | kFloat;
+  if (t == "string") return kString;
+  if (t == "array") return kArray;
+  if (t == "object") return kObject;
+  return 0;  // an unknown type name matches nothing
+}
+
+unsigned typeBitOf(const json& v) {
+  switch (v.type()) {
+    case json::value_t::null: return kNull;
+    case json::value_t::boolean: return kBoolean;
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned: return kInteger;
+    case json::value_t::number_float: {
+      const double d = v.get<double>();
+      return std::isfinite(d) && std::floor(d) == d && std::fabs(d) < 9.007199254740992e15 ? kInteger : kFloat;
     }
-    return false;
+    case json::value_t::string: return kString;
+    case json::value_t::array: return kArray;
+    case json::value_t::object: return kObject;
+    default: return 0;
   }
-  return typeOf(v) == t;
 }
 
 std::string fmtNumber(const json& n) {
@@ -73,112 +99,26 @@ size_t codePoints(const std::string& s) {
   return n;
 }
 
-// The violations found so far, capped: once `maxErrors` are in, the rest are dropped.
-struct Errors {
-  std::vector<FieldError> errors;
-  size_t maxErrors;
-  bool full() const { return errors.size() >= maxErrors; }
-  void add(const std::string& pointer, std::string message) {
-    if (!full()) errors.push_back({pointer, std::move(message)});
-  }
+// A bound on a number ("minimum", ...) or a size ("minItems", ...), with its message.
+struct Bound {
+  bool set = false;
+  double value = 0;
+  std::string message;
 };
 
-// The keyword families of SchemaRegistry::check, in the order it applies them. Those that
-// descend into members take `walk(schema, value, pointer)`, which checks one member against
-// its subschema with the same errors and depth.
-
-// "type"; false when `v` has the wrong type: the remaining keywords would only repeat the
-// same complaint.
-bool checkType(const json& s, const json& v, const std::string& ptr, Errors& out) {
-  auto it = s.find("type");
-  if (it == s.end()) return true;
-  bool ok = false;
-  std::string expected;
-  if (it->is_string()) {
-    ok = hasType(v, it->get<std::string>());
-    expected = it->get<std::string>();
-  } else {
-    for (const auto& t : *it) {
-      ok = ok || hasType(v, t.get<std::string>());
-      expected += (expected.empty() ? "" : " or ") + t.get<std::string>();
-    }
-  }
-  if (!ok) out.add(ptr, "must be " + expected + ", got " + typeOf(v));
-  return ok;
+Bound numberBound(const json& s, const char* keyword, const char* prefix) {
+  auto it = s.find(keyword);
+  if (it == s.end()) return {};
+  if (!it->is_number()) throw std::runtime_error(std::string(keyword) + " must be a number");
+  return {true, it->get<double>(), prefix + fmtNumber(*it)};
 }
 
-// "const" and "enum".
-void checkValue(const json& s, const json& v, const std::string& ptr, Errors& out) {
-  if (auto it = s.find("const"); it != s.end() && v != *it) out.add(ptr, "must be " + it->dump());
-  if (auto it = s.find("enum"); it != s.end()) {
-    bool found = false;
-    for (const auto& e : *it) found = found || e == v;
-    if (!found) out.add(ptr, "must be one of " + it->dump());
-  }
-}
-
-// "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum".
-void checkNumber(const json& s, const json& v, const std::string& ptr, Errors& out) {
-  if (!v.is_number()) return;
-  double d = v.get<double>();
-  if (auto it = s.find("minimum"); it != s.end() && d < it->get<double>()) out.add(ptr, "must be >= " + fmtNumber(*it));
-  if (auto it = s.find("maximum"); it != s.end() && d > it->get<double>()) out.add(ptr, "must be <= " + fmtNumber(*it));
-  if (auto it = s.find("exclusiveMinimum"); it != s.end() && d <= it->get<double>())
-    out.add(ptr, "must be > " + fmtNumber(*it));
-  if (auto it = s.find("exclusiveMaximum"); it != s.end() && d >= it->get<double>())
-    out.add(ptr, "must be < " + fmtNumber(*it));
-}
-
-// "minLength", "maxLength", in code points.
-void checkString(const json& s, const json& v, const std::string& ptr, Errors& out) {
-  if (!v.is_string()) return;
-  size_t n = codePoints(v.get_ref<const std::string&>());
-  if (auto it = s.find("minLength"); it != s.end() && n < it->get<size_t>())
-    out.add(ptr, "must have at least " + it->dump() + " characters");
-  if (auto it = s.find("maxLength"); it != s.end() && n > it->get<size_t>())
-    out.add(ptr, "must have at most " + it->dump() + " characters");
-}
-
-// "minItems", "maxItems", "items"; false for an array over maxItems, which is not walked and
-// ends the check.
-template <typename Walk>
-bool checkArray(const json& s, const json& v, const std::string& ptr, Errors& out, const Walk& walk) {
-  if (!v.is_array()) return true;
-  if (auto it = s.find("minItems"); it != s.end() && v.size() < it->get<size_t>())
-    out.add(ptr, "must have at least " + it->dump() + " items");
-  if (auto it = s.find("maxItems"); it != s.end() && v.size() > it->get<size_t>()) {
-    out.add(ptr, "must have at most " + it->dump() + " items");
-    return false;
-  }
-  if (auto it = s.find("items"); it != s.end()) {
-    for (size_t i = 0; i < v.size() && !out.full(); ++i) walk(*it, v[i], ptr + "/" + std::to_string(i));
-  }
-  return true;
-}
-
-// "required", "properties", "additionalProperties".
-template <typename Walk>
-void checkObject(const json& s, const json& v, const std::string& ptr, Errors& out, const Walk& walk) {
-  if (!v.is_object()) return;
-  const json* props = nullptr;
-  if (auto it = s.find("properties"); it != s.end()) props = &*it;
-  if (auto it = s.find("required"); it != s.end()) {
-    for (const auto& r : *it) {
-      if (!v.contains(r.get<std::string>())) out.add(ptr + "/" + pointerEscape(r.get<std::string>()), "is required");
-    }
-  }
-  auto additional = s.find("additionalProperties");
-  for (const auto& [key, val] : v.items()) {
-    std::string child = ptr + "/" + pointerEscape(key);
-    if (props && props->contains(key)) {
-      walk((*props)[key], val, child);
-    } else if (additional != s.end()) {
-      if (additional->is_boolean() && !additional->get<bool>())
-        out.add(child, "is not a known field");
-      else
-        walk(*additional, val, child);
-    }
-  }
+Bound sizeBound(const json& s, const char* keyword, const char* prefix, const char* suffix) {
+  auto it = s.find(keyword);
+  if (it == s.end()) return {};
+  if (typeBitOf(*it) != kInteger || it->get<double>() < 0)
+    throw std::runtime_error(std::string(keyword) + " must be a non-negative integer");
+  return {true, it->get<double>(), prefix + it->dump() + suffix};
 }
 
 // For alternatives that each only require one member ({"required": ["box"]}, ...): the members
@@ -195,49 +135,59 @@ std::string exclusiveMembers(const json& alternatives) {
   return out;
 }
 
-// "oneOf" and "anyOf". `tryBranch(schema)` checks the value at `ptr` against one alternative
-// on its own (a few errors at most) and returns what it found; the report names the
-// alternative the client most likely meant.
-template <typename TryBranch>
-void checkAlternatives(const json& s, const std::string& ptr, Errors& out, const TryBranch& tryBranch) {
-  for (const char* kw : {"oneOf", "anyOf"}) {
-    auto it = s.find(kw);
-    if (it == s.end()) continue;
-    size_t matches = 0;
-    std::vector<FieldError> firstErrors;
-    std::vector<std::string> missing;  // branches that fail only for a missing member
-    for (const auto& branch : *it) {
-      std::vector<FieldError> errors = tryBranch(branch);
-      if (errors.empty())
-        ++matches;
-      else if (firstErrors.empty() || errors.front().pointer.size() > firstErrors.front().pointer.size())
-        firstErrors = errors;  // the branch that got deepest is the one the client meant
-      if (errors.size() == 1 && errors.front().message == "is required" &&
-          errors.front().pointer.rfind(ptr + "/", 0) == 0)
-        missing.push_back(errors.front().pointer.substr(ptr.size() + 1));
-    }
-    bool ok = std::string(kw) == "oneOf" ? matches == 1 : matches >= 1;
-    if (!ok) {
-      if (matches > 1) {
-        const std::string members = exclusiveMembers(*it);
-        out.add(ptr, members.empty() ? "matches more than one alternative" : "give exactly one of " + members);
-      } else if (missing.size() == it->size()) {  // none of the alternatives' members given
-        std::string names;
-        for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;
-        out.add(ptr, "needs one of: " + names);
-      } else {
-        for (auto& e : firstErrors) out.add(e.pointer, e.message);
-      }
-    }
-  }
-}
-
 }  // namespace
 
-struct SchemaRegistry::Ctx : Errors {
-  explicit Ctx(size_t maxErrors) : Errors{{}, maxErrors} {}
-  int depth = 0;  // $ref nesting, to stop a cyclic reference
+// One schema object (or boolean schema) with its keywords looked up once, at load.
+struct SchemaRegistry::Node {
+  int boolean = -1;  // a boolean schema: 0 (false) or 1 (true); -1 for an object
+  const Node* ref = nullptr;
+  bool typed = false;  // has "type"
+  unsigned types = 0;  // "type" as TypeBits
+  std::string typeMessage;  // "must be integer or null" (", got <type>" follows)
+  const json* constValue = nullptr;
+  std::string constMessage;
+  const json* enumValues = nullptr;
+  std::string enumMessage;
+  Bound minimum, maximum, exclusiveMinimum, exclusiveMaximum;
+  Bound minLength, maxLength, minItems, maxItems;
+  const Node* items = nullptr;
+  std::vector<std::string> required;
+  std::map<std::string, const Node*, std::less<>> properties;
+  enum class Additional { kAny, kForbidden, kSchema } additional = Additional::kAny;
+  const Node* additionalSchema = nullptr;
+  struct Alternatives {
+    bool oneOf = false;
+    std::vector<const Node*> branches;
+    std::string exclusiveMembers;  // exclusiveMembers() of the branches
+  };
+  std::vector<Alternatives> alternatives;  // oneOf, then anyOf
+  std::vector<const Node*> allOf;
 };
+
+// Where a value sits in the instance, spelled out as a JSON pointer only when reported.
+struct SchemaRegistry::Path {
+  const Path* parent = nullptr;
+  const std::string* key = nullptr;  // an object member; else an array index
+  size_t index = 0;
+  std::string str() const {
+    if (!parent) return "";
+    return parent->str() + "/" + (key ? pointerEscape(*key) : std::to_string(index));
+  }
+};
+
+// The violations found so far, capped: once `maxErrors` are in, the rest are dropped.
+struct SchemaRegistry::Ctx {
+  std::vector<FieldError> errors;
+  size_t maxErrors;
+  int depth = 0;  // schema nesting through $ref and alternatives, to stop a cyclic reference
+  bool full() const { return errors.size() >= maxErrors; }
+  void add(const Path& at, std::string message) {
+    if (!full()) errors.push_back({at.str(), std::move(message)});
+  }
+};
+
+SchemaRegistry::~SchemaRegistry() = default;
+SchemaRegistry::SchemaRegistry(SchemaRegistry&&) noexcept = default;
 
 SchemaRegistry::SchemaRegistry(const std::map<std::string, std::string>& documents) {
   for (const auto& [name, text] : documents) {
@@ -249,6 +199,75 @@ SchemaRegistry::SchemaRegistry(const std::map<std::string, std::string>& documen
     }
   }
   for (const auto& [name, doc] : docs_) lint(doc, name, "");
+  for (const auto& [name, doc] : docs_) roots_[name] = &compile(doc, name);
+}
+
+const SchemaRegistry::Node& SchemaRegistry::compile(const json& s, const std::string& doc) {
+  if (auto it = nodes_.find(&s); it != nodes_.end()) return *it->second;
+  Node& n = *nodes_.emplace(&s, std::make_unique<Node>()).first->second;  // before the members: $ref cycles
+  if (s.is_boolean()) {
+    n.boolean = s.get<bool>();
+    return n;
+  }
+  try {
+    if (auto it = s.find("$ref"); it != s.end()) {
+      std::string target;
+      const json& sub = resolve(it->get<std::string>(), doc, target);
+      n.ref = &compile(sub, target);
+    }
+    if (auto it = s.find("type"); it != s.end()) {
+      n.typed = true;
+      std::string names;
+      for (const auto& t : it->is_string() ? json::array({*it}) : *it) {
+        n.types |= typeBitsOf(t.get<std::string>());
+        names += (names.empty() ? "" : " or ") + t.get<std::string>();
+      }
+      n.typeMessage = "must be " + names;
+    }
+    if (auto it = s.find("const"); it != s.end()) {
+      n.constValue = &*it;
+      n.constMessage = "must be " + it->dump();
+    }
+    if (auto it = s.find("enum"); it != s.end()) {
+      n.enumValues = &*it;
+      n.enumMessage = "must be one of " + it->dump();
+    }
+    n.minimum = numberBound(s, "minimum", "must be >= ");
+    n.maximum = numberBound(s, "maximum", "must be <= ");
+    n.exclusiveMinimum = numberBound(s, "exclusiveMinimum", "must be > ");
+    n.exclusiveMaximum = numberBound(s, "exclusiveMaximum", "must be < ");
+    n.minLength = sizeBound(s, "minLength", "must have at least ", " characters");
+    n.maxLength = sizeBound(s, "maxLength", "must have at most ", " characters");
+    n.minItems = sizeBound(s, "minItems", "must have at least ", " items");
+    n.maxItems = sizeBound(s, "maxItems", "must have at most ", " items");
+    if (auto it = s.find("items"); it != s.end()) n.items = &compile(*it, doc);
+    if (auto it = s.find("required"); it != s.end())
+      for (const auto& r : *it) n.required.push_back(r.get<std::string>());
+    if (auto it = s.find("properties"); it != s.end())
+      for (const auto& [key, sub] : it->items()) n.properties[key] = &compile(sub, doc);
+    if (auto it = s.find("additionalProperties"); it != s.end()) {
+      if (it->is_boolean() && !it->get<bool>()) {
+        n.additional = Node::Additional::kForbidden;
+      } else {
+        n.additional = Node::Additional::kSchema;
+        n.additionalSchema = &compile(*it, doc);
+      }
+    }
+    for (const char* kw : {"oneOf", "anyOf"}) {
+      auto it = s.find(kw);
+      if (it == s.end()) continue;
+      Node::Alternatives a{std::string(kw) == "oneOf", {}, exclusiveMembers(*it)};
+      for (const auto& branch : *it) a.branches.push_back(&compile(branch, doc));
+      n.alternatives.push_back(std::move(a));
+    }
+    if (auto it = s.find("allOf"); it != s.end())
+      for (const auto& branch : *it) n.allOf.push_back(&compile(branch, doc));
+  } catch (const json::exception& e) {
+    throw std::runtime_error("schema " + doc + ": malformed keyword value: " + e.what());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("schema " + doc + ": " + e.what());
+  }
+  return n;
 }
 
 void SchemaRegistry::lint(const json& schema, const std::string& doc, const std::string& where) const {
@@ -290,20 +309,25 @@ const json& SchemaRegistry::resolve(const std::string& ref, const std::string& d
 
 std::vector<FieldError> SchemaRegistry::validate(const std::string& name, const json& instance,
                                                  size_t maxErrors) const {
-  Ctx ctx{maxErrors};
-  check(document(name), name, instance, "", ctx);
-  return ctx.errors;
+  auto root = roots_.find(name);
+  if (root == roots_.end()) document(name);  // throws: no such document
+  Ctx ctx{{}, maxErrors};
+  check(*root->second, instance, Path{}, ctx);
+  return std::move(ctx.errors);
 }
 
-void SchemaRegistry::check(const json& s, const std::string& doc, const json& v, const std::string& ptr,
-                           Ctx& ctx) const {
+// The keyword families in a fixed order: $ref; type (a wrong type ends the check: the rest would
+// only repeat it); const and enum; number bounds; string lengths; array sizes and items (an
+// array over maxItems is not walked, and ends the check); required, properties and
+// additionalProperties; oneOf and anyOf; allOf.
+void SchemaRegistry::check(const Node& s, const json& v, const Path& path, Ctx& ctx) const {
   if (ctx.full()) return;
-  if (s.is_boolean()) {
-    if (!s.get<bool>()) ctx.add(ptr, "is not allowed here");
+  if (s.boolean >= 0) {
+    if (!s.boolean) ctx.add(path, "is not allowed here");
     return;
   }
   if (++ctx.depth > 64) {  // the contract is far shallower; deeper means a cyclic $ref
-    ctx.add(ptr, "nesting too deep");
+    ctx.add(path, "nesting too deep");
     --ctx.depth;
     return;
   }
@@ -311,30 +335,89 @@ void SchemaRegistry::check(const json& s, const std::string& doc, const json& v,
     int& d;
     ~DepthGuard() { --d; }
   } guard{ctx.depth};
-  auto walk = [&](const json& sub, const json& member, const std::string& memberPtr) {
-    check(sub, doc, member, memberPtr, ctx);
-  };
-  auto tryBranch = [&](const json& branch) {
-    Ctx sub{4};
-    check(branch, doc, v, ptr, sub);
-    return std::move(sub.errors);
-  };
 
-  if (auto it = s.find("$ref"); it != s.end()) {
-    std::string target;
-    const json& sub = resolve(it->get<std::string>(), doc, target);
-    check(sub, target, v, ptr, ctx);
+  if (s.ref) check(*s.ref, v, path, ctx);
+  const unsigned type = typeBitOf(v);
+  if (s.typed && !(s.types & type)) {
+    ctx.add(path, s.typeMessage + ", got " + typeOf(v));
+    return;
   }
-  if (!checkType(s, v, ptr, ctx)) return;
-  checkValue(s, v, ptr, ctx);
-  checkNumber(s, v, ptr, ctx);
-  checkString(s, v, ptr, ctx);
-  if (!checkArray(s, v, ptr, ctx, walk)) return;
-  checkObject(s, v, ptr, ctx, walk);
-  checkAlternatives(s, ptr, ctx, tryBranch);
-  if (auto it = s.find("allOf"); it != s.end()) {
-    for (const auto& branch : *it) check(branch, doc, v, ptr, ctx);
+  if (s.constValue && v != *s.constValue) ctx.add(path, s.constMessage);
+  if (s.enumValues) {
+    bool found = false;
+    for (const auto& e : *s.enumValues) found = found || e == v;
+    if (!found) ctx.add(path, s.enumMessage);
   }
+  if (type & (kInteger | kFloat)) {
+    const double d = v.get<double>();
+    if (s.minimum.set && d < s.minimum.value) ctx.add(path, s.minimum.message);
+    if (s.maximum.set && d > s.maximum.value) ctx.add(path, s.maximum.message);
+    if (s.exclusiveMinimum.set && d <= s.exclusiveMinimum.value) ctx.add(path, s.exclusiveMinimum.message);
+    if (s.exclusiveMaximum.set && d >= s.exclusiveMaximum.value) ctx.add(path, s.exclusiveMaximum.message);
+  } else if (type == kString && (s.minLength.set || s.maxLength.set)) {
+    const double n = double(codePoints(v.get_ref<const std::string&>()));
+    if (s.minLength.set && n < s.minLength.value) ctx.add(path, s.minLength.message);
+    if (s.maxLength.set && n > s.maxLength.value) ctx.add(path, s.maxLength.message);
+  } else if (type == kArray) {
+    const double n = double(v.size());
+    if (s.minItems.set && n < s.minItems.value) ctx.add(path, s.minItems.message);
+    if (s.maxItems.set && n > s.maxItems.value) {
+      ctx.add(path, s.maxItems.message);
+      return;
+    }
+    if (s.items) {
+      Path item{&path, nullptr, 0};
+      for (; item.index < v.size() && !ctx.full(); ++item.index) check(*s.items, v[item.index], item, ctx);
+    }
+  } else if (type == kObject) {
+    for (const auto& r : s.required)
+      if (!v.contains(r)) {
+        const Path member{&path, &r, 0};
+        ctx.add(member, "is required");
+      }
+    for (const auto& [key, value] : v.items()) {
+      const Path member{&path, &key, 0};
+      if (auto p = s.properties.find(key); p != s.properties.end())
+        check(*p->second, value, member, ctx);
+      else if (s.additional == Node::Additional::kForbidden)
+        ctx.add(member, "is not a known field");
+      else if (s.additional == Node::Additional::kSchema)
+        check(*s.additionalSchema, value, member, ctx);
+    }
+  }
+  // Each alternative is tried on its own (a few errors at most); the report names the one the
+  // client most likely meant.
+  for (const auto& alt : s.alternatives) {
+    const std::string ptr = path.str();
+    size_t matches = 0;
+    std::vector<FieldError> firstErrors;
+    std::vector<std::string> missing;  // branches that fail only for a missing member
+    for (const Node* branch : alt.branches) {
+      Ctx sub{{}, 4, ctx.depth};
+      check(*branch, v, path, sub);
+      const std::vector<FieldError>& errors = sub.errors;
+      if (errors.empty())
+        ++matches;
+      else if (firstErrors.empty() || errors.front().pointer.size() > firstErrors.front().pointer.size())
+        firstErrors = errors;  // the branch that got deepest is the one the client meant
+      if (errors.size() == 1 && errors.front().message == "is required" &&
+          errors.front().pointer.rfind(ptr + "/", 0) == 0)
+        missing.push_back(errors.front().pointer.substr(ptr.size() + 1));
+    }
+    if (alt.oneOf ? matches == 1 : matches >= 1) continue;
+    if (matches > 1) {
+      ctx.add(path, alt.exclusiveMembers.empty() ? "matches more than one alternative"
+                                                 : "give exactly one of " + alt.exclusiveMembers);
+    } else if (missing.size() == alt.branches.size()) {  // none of the alternatives' members given
+      std::string names;
+      for (const auto& m : missing) names += (names.empty() ? "" : ", ") + m;
+      ctx.add(path, "needs one of: " + names);
+    } else {
+      for (auto& e : firstErrors)
+        if (!ctx.full()) ctx.errors.push_back(std::move(e));
+    }
+  }
+  for (const Node* branch : s.allOf) check(*branch, v, path, ctx);
 }
 
 }  // namespace effectd

@@ -8,10 +8,16 @@
 // A keyword outside this subset is a programming error: the registry refuses to load it, so
 // the contract cannot silently say more than the server checks. tests/schema_suite_test.cpp
 // runs the official JSON-Schema-Test-Suite on this subset.
+//
+// Each schema object is compiled once, at load, into a Node holding its keywords already looked
+// up and their messages already written, and a member's JSON pointer is only spelled out when
+// it is reported: a 250 000-number mesh is checked in a few milliseconds, not tens.
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -25,6 +31,8 @@ class SchemaRegistry {
   // Loads every document whose key ends in ".json"; keys are file names ("fog.json").
   // Throws std::runtime_error on a malformed schema (startup only).
   explicit SchemaRegistry(const std::map<std::string, std::string>& documents);
+  ~SchemaRegistry();
+  SchemaRegistry(SchemaRegistry&&) noexcept;
 
   // Validates `instance` against document `name`; returns at most `maxErrors` violations.
   std::vector<FieldError> validate(const std::string& name, const nlohmann::json& instance,
@@ -33,13 +41,18 @@ class SchemaRegistry {
   const nlohmann::json& document(const std::string& name) const;
 
  private:
+  struct Node;
+  struct Path;
   struct Ctx;
-  void check(const nlohmann::json& schema, const std::string& doc, const nlohmann::json& value,
-             const std::string& pointer, Ctx& ctx) const;
+  void check(const Node& schema, const nlohmann::json& value, const Path& path, Ctx& ctx) const;
+  const Node& compile(const nlohmann::json& schema, const std::string& doc);
   const nlohmann::json& resolve(const std::string& ref, const std::string& doc, std::string& outDoc) const;
   void lint(const nlohmann::json& schema, const std::string& doc, const std::string& where) const;
 
   std::map<std::string, nlohmann::json> docs_;
+  // Every schema object of docs_ reachable from a document's root, by its address in docs_.
+  std::unordered_map<const nlohmann::json*, std::unique_ptr<Node>> nodes_;
+  std::map<std::string, const Node*> roots_;
 };
 
 // Escapes a key for use in a JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1").

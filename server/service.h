@@ -35,6 +35,9 @@ struct Response;
 
 namespace effectd {
 
+// Server-Timing entries (name;dur=ms), in order.
+using Stages = std::vector<std::pair<std::string, double>>;
+
 // What a JSON endpoint returns: the body, plus the stats whose timing goes to Server-Timing.
 struct JsonReply {
   nlohmann::json body;
@@ -44,8 +47,8 @@ struct JsonReply {
   std::string binary, contentType;
   std::map<std::string, std::string> headers;     // part of the answer (cached with it)
   std::map<std::string, std::string> runHeaders;  // facts of this run (timings): not cached
-  // Server-Timing entries after compute (name;dur=ms), in order: its parts, and waits.
-  std::vector<std::pair<std::string, double>> stages;
+  // Server-Timing entries after compute, in order: its parts, and waits.
+  Stages stages;
 };
 
 // What a request will cost, estimated from its body before any work starts: the bytes it
