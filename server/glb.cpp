@@ -4,6 +4,8 @@
 #include <cstring>
 #include <set>
 
+#include "json_reader.h"
+
 namespace effectd::glb {
 namespace {
 
@@ -168,9 +170,12 @@ std::optional<FieldError> parse(const std::string& b, Asset& out) {
     std::string data = b.substr(at + 8, len);
     if (!haveJson) {
       if (type != kJson) return FieldError{"", "the first chunk must be JSON"};
-      out.gltf = json::parse(data, nullptr, false);
-      if (out.gltf.is_discarded() || !out.gltf.is_object())
-        return FieldError{"", "the JSON chunk is not a JSON object"};
+      try {
+        out.gltf = readJson(data);
+      } catch (const JsonSyntaxError& e) {
+        return FieldError{"", std::string("the JSON chunk is not JSON: ") + e.what()};
+      }
+      if (!out.gltf.is_object()) return FieldError{"", "the JSON chunk is not a JSON object"};
       haveJson = true;
     } else if (type == kBin) {
       out.bin = std::move(data);

@@ -15,6 +15,7 @@
 #include "config.h"
 #include "endpoints.h"
 #include "idle_trim.h"
+#include "json_reader.h"
 #include "playground.h"
 #include "scene.h"
 #include "service.h"
@@ -44,9 +45,10 @@ bool readScene(const std::string& scenePath, nlohmann::json& body) {
     return false;
   }
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  body = nlohmann::json::parse(text, nullptr, false);
-  if (body.is_discarded()) {
-    std::fprintf(stderr, "effectd render: %s is not valid JSON\n", scenePath.c_str());
+  try {
+    body = effectd::readJson(text);
+  } catch (const effectd::JsonSyntaxError& e) {
+    std::fprintf(stderr, "effectd render: %s is not valid JSON: %s\n", scenePath.c_str(), e.what());
     return false;
   }
   return true;

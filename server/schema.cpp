@@ -141,8 +141,8 @@ std::string exclusiveMembers(const json& alternatives) {
 struct SchemaRegistry::Node {
   int boolean = -1;  // a boolean schema: 0 (false) or 1 (true); -1 for an object
   const Node* ref = nullptr;
-  bool typed = false;  // has "type"
-  unsigned types = 0;  // "type" as TypeBits
+  bool typed = false;       // has "type"
+  unsigned types = 0;       // "type" as TypeBits
   std::string typeMessage;  // "must be integer or null" (", got <type>" follows)
   const json* constValue = nullptr;
   std::string constMessage;

@@ -14,6 +14,7 @@
 #include "elastic_pool.h"
 #include "encoding.h"
 #include "etag.h"
+#include "json_reader.h"
 #include "json_writer.h"
 #include "request_state.h"
 #include "resources.h"
@@ -25,51 +26,21 @@ using nlohmann::json;
 
 namespace {
 
-constexpr size_t kMaxJsonDepth = 64;
-
-// True when `body` nests arrays and objects more than `limit` deep (brackets counted outside
-// strings; malformed text is the parser's to refuse). The contract is never deeper than a few
-// levels, and a 10^5-deep document would still cost the parser memory and time for nothing.
-// One pass over the bytes, far cheaper than a parser callback on every value.
-bool nestedDeeperThan(const std::string& body, size_t limit) {
-  size_t depth = 0;
-  bool inString = false;
-  for (size_t i = 0; i < body.size(); ++i) {
-    const char c = body[i];
-    if (inString) {
-      if (c == '\\')
-        ++i;
-      else if (c == '"')
-        inString = false;
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > limit) return true;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return false;
-}
-
 json parseBody(const std::string& body) {
-  if (nestedDeeperThan(body, kMaxJsonDepth))
-    throw ApiError{400,
-                   "invalid-json",
-                   "Malformed JSON",
-                   "JSON nested deeper than 64 levels",
-                   {{"", "nested deeper than 64 levels"}},
-                   {}};
   try {
-    return json::parse(body, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/false);
-  } catch (const json::exception& e) {
-    std::string what = e.what();
-    // nlohmann messages look like "[json.exception.parse_error.101] parse error at line 1, ...".
-    auto close = what.find("] ");
+    return readJson(body);
+  } catch (const JsonSyntaxError& e) {
+    if (e.tooDeep)
+      throw ApiError{400,
+                     "invalid-json",
+                     "Malformed JSON",
+                     "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels",
+                     {{"", "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}},
+                     {}};
     throw ApiError{400,
                    "invalid-json",
                    "Malformed JSON",
-                   "request body is not valid JSON: " + (close == std::string::npos ? what : what.substr(close + 2)),
+                   std::string("request body is not valid JSON: ") + e.what(),
                    {{"", "not valid JSON"}},
                    {}};
   }
@@ -85,18 +56,20 @@ void throwIfInvalid(const std::vector<FieldError>& violations) {
 }
 
 // Parses a JSON body into `body` and checks it against `schema`, adding both steps' times to
-// `stages`. Returns the canonical request, "" when the answer is not cacheable (it asks for
-// timings): the document's CBOR, one encoding per JSON value whatever the spacing, key order or
-// number spelling, and a third of the time of writing it out as text.
-std::string parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema,
-                             json& body, Stages& stages) {
+// `stages`.
+void parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema, json& body,
+                      Stages& stages) {
   effects::Stopwatch parse;
   body = parseBody(text);
   stages.emplace_back("parse", parse.ms());
   effects::Stopwatch validate;
   throwIfInvalid(schemas.validate(schema, body));
   stages.emplace_back("validate", validate.ms());
-  if (asksForTimings(body)) return std::string();
+}
+
+// What determines a JSON request's answer: its document's CBOR, one encoding per JSON value
+// whatever the spacing, key order or number spelling, in a third of the time of the text.
+std::string canonicalJson(const json& body) {
   std::string canonical = "application/json\n";
   json::to_cbor(body, canonical);
   return canonical;
@@ -127,10 +100,8 @@ double answerBinary(const BinaryHandler& handler, const std::string& body, const
   return reply.computeMs;
 }
 
-// Runs a JSON body's handler into `answer` (JSON, or the bytes it answers with instead) and
-// frees the request document; the run's own headers go to `res` only. Returns its compute time.
 // Server-Timing's value: compute first, then its stages, then the request's own (parse, validate,
-// write).
+// etag, write).
 std::string serverTiming(double computeMs, const Stages& stages, const Stages& requestStages = {}) {
   std::string timing = "compute;dur=" + std::to_string(computeMs);
   for (const Stages* list : {&stages, &requestStages})
@@ -138,8 +109,9 @@ std::string serverTiming(double computeMs, const Stages& stages, const Stages& r
   return timing;
 }
 
-// Answers a JSON request into `answer`; its run's headers (Server-Timing included, with
-// `requestStages` and the answer's writing after the run's own) go to `res`.
+// Runs a JSON body's handler into `answer` (JSON, or the bytes it answers with instead) and
+// frees the request document; the run's own headers (Server-Timing included, with
+// `requestStages` and the answer's writing after the run's own) go to `res` only.
 void answerJson(const JsonHandler& handler, json& body, const RequestContext& ctx, CachedAnswer& answer,
                 httplib::Response& res, Stages requestStages) {
   JsonReply reply = handler(body, ctx);
@@ -355,16 +327,18 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
       return sendAnswer(*hit, inm, res);
     }
     const auto binary = route.binary.find(type);
+    const bool isBinary = binary != route.binary.end();
     json body;
-    Stages requestStages;  // parse and validate, for Server-Timing
-    // What determines the answer; "" = not cacheable.
-    const std::string canonical = binary != route.binary.end()
-                                      ? type + "\n" + query + "\n" + req.body
-                                      : parseJsonRequest(req.body, *schemas_, route.schema, body, requestStages);
-    // Deterministic answers: a strong validator per representation (request and coding).
+    Stages requestStages;  // parse, validate, etag (and write): for Server-Timing
+    if (!isBinary) parseJsonRequest(req.body, *schemas_, route.schema, body, requestStages);
+    // Deterministic answers: a strong validator per representation (request and coding), over
+    // what determines the answer; none for a JSON request that asks for timings.
     std::string tag;
-    if (!canonical.empty()) {
-      tag = etagFor(route.path, route.etagSalt ? route.etagSalt() : "", canonical, coding);
+    if (isBinary || !asksForTimings(body)) {
+      effects::Stopwatch hashing;
+      tag = etagFor(route.path, route.etagSalt ? route.etagSalt() : "",
+                    isBinary ? type + "\n" + query + "\n" + req.body : canonicalJson(body), coding);
+      requestStages.emplace_back("etag", hashing.ms());
       if (etagMatches(inm, tag)) {
         res.set_header("ETag", tag);
         res.status = 304;
@@ -377,14 +351,15 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
       }
     }
     // Admission: the estimated peak is reserved until the answer has been written.
-    const Cost cost = binary != route.binary.end() ? binary->second.cost(req.body, config_) : route.cost(body, config_);
+    const Cost cost = isBinary ? binary->second.cost(req.body, config_) : route.cost(body, config_);
     tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
     res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
 
     auto answer = std::make_shared<CachedAnswer>();
     answer->etag = tag;
-    if (binary != route.binary.end())
-      res.set_header("Server-Timing", serverTiming(answerBinary(binary->second.handler, req.body, ctx, *answer), {}));
+    if (isBinary)
+      res.set_header("Server-Timing",
+                     serverTiming(answerBinary(binary->second.handler, req.body, ctx, *answer), {}, requestStages));
     else
       answerJson(route.json, body, ctx, *answer, res, std::move(requestStages));
     encodeAnswer(coding, *answer);

@@ -5,6 +5,7 @@
 
 #include "codec.h"
 #include "config.h"
+#include "json_reader.h"
 #include "schema.h"
 
 namespace effectd {
@@ -58,6 +59,58 @@ TEST(Schema, RefusesKeywordsItDoesNotCheck) {
   using Docs = std::map<std::string, std::string>;
   EXPECT_THROW(SchemaRegistry(Docs{{"c.json", R"({"type": "string", "pattern": "^a"})"}}), std::runtime_error);
   EXPECT_THROW(SchemaRegistry(Docs{{"c.json", R"({"$ref": "#/$defs/missing"})"}}), std::runtime_error);
+}
+
+// The request reader gives nlohmann's document, value types included, and refuses what it
+// refuses (tests/fuzz/fuzz_request.cpp compares the two on every input it accepts).
+TEST(JsonReader, GivesNlohmannsDocument) {
+  for (const char* text :
+       {R"({"a": [1, -1, 0, -0, 1.5, 1e3, 18446744073709551615, 18446744073709551616,
+                              -9223372036854775808, -9223372036854775809, 1e-400, 4.9e-324], "b": {"c": null}})",
+        R"(["\u00e9\ud83d\ude00\"\\\/\b\f\n\r\t\u0000"])", "[\"\xc3\xa9\xe2\x82\xac\xf0\x9f\x98\x80\"]",
+        "\xef\xbb\xbf [true, false, null] ", R"({"a": 1, "a": [2]})", "0", "\"\"", "[]", "{}"}) {
+    const json ours = readJson(text);
+    const json theirs = json::parse(text);
+    EXPECT_EQ(ours, theirs) << text;
+    EXPECT_EQ(ours.dump(), theirs.dump()) << text;  // types too: 1 vs 1.0, unsigned vs signed
+  }
+  const json a = readJson("[1, -1, 18446744073709551616]");
+  EXPECT_TRUE(a[0].is_number_unsigned());
+  EXPECT_TRUE(a[1].is_number_integer() && !a[1].is_number_unsigned());
+  EXPECT_TRUE(a[2].is_number_float());
+  EXPECT_EQ(readJson(R"({"a": 1, "a": [2]})")["a"], json::array({2}));  // the last duplicate wins
+}
+
+TEST(JsonReader, RefusesWhatIsNotJson) {
+  // clang-format off
+  const std::vector<std::string> notJson = {
+      "", " ", "{", "[1,]", "[,1]", "{\"a\":1,}", "{\"a\" 1}", "{1:2}", "01", "1.", ".5", "+1", "1e", "-", "NaN",
+      "Infinity", "1e400", "-1e400", "tru", "nul", "\"\\x\"", "\"\\u12\"", "\"\\ud83d\"", "\"\\ude00\"",
+      "\"\xc0\x80\"", "\"\xed\xa0\x80\"", "\"\xf4\x90\x80\x80\"", "\"\xff\"", "\"\x01\"", "\"abc", "/**/ 1",
+      "[1] x", "\xef\xbb", std::string("[1]\0[", 5)};
+  // clang-format on
+  for (const std::string& text : notJson) {
+    EXPECT_THROW(readJson(text), JsonSyntaxError) << json(text).dump(-1, ' ', true, json::error_handler_t::replace);
+  }
+  try {
+    readJson("[1, 2, x]");
+    FAIL();
+  } catch (const JsonSyntaxError& e) {
+    EXPECT_EQ(e.offset, 7u);
+    EXPECT_FALSE(e.tooDeep);
+  }
+}
+
+TEST(JsonReader, RefusesDeepNestingBeforeReadingIt) {
+  std::string deep(100000, '[');
+  try {
+    readJson(deep);  // not even closed: refused at the 65th level
+    FAIL();
+  } catch (const JsonSyntaxError& e) {
+    EXPECT_TRUE(e.tooDeep);
+    EXPECT_EQ(e.offset, kMaxJsonDepth);
+  }
+  EXPECT_NO_THROW(readJson(std::string(kMaxJsonDepth, '[') + std::string(kMaxJsonDepth, ']')));
 }
 
 TEST(Codec, Base64RoundTripAndStrictness) {

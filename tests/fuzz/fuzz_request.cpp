@@ -1,4 +1,5 @@
-// libFuzzer: a JSON request body through the real path — parse (depth-capped), schema
+// libFuzzer: a JSON request body through the real path — parse (server/json_reader.h, checked
+// against nlohmann's parser on every input it accepts), schema
 // validation, the endpoint's handler — for every JSON endpoint. The first byte picks the
 // endpoint. Limits are small so that valid inputs stay fast; ApiError is the expected way out.
 #include <cstdint>
@@ -8,6 +9,7 @@
 #include "api_fog.h"
 #include "api_lightning.h"
 #include "api_tangents.h"
+#include "json_reader.h"
 #include "scene.h"
 #include "service.h"
 
@@ -53,9 +55,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const Endpoint& e = kEndpoints[data[0] % (sizeof kEndpoints / sizeof kEndpoints[0])];
   const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
-  json::parser_callback_t depth = [](int d, json::parse_event_t, json&) { return d <= 64; };
-  json body = json::parse(text, depth, /*allow_exceptions=*/false);
-  if (body.is_discarded()) return 0;
+  json body;
+  try {
+    body = effectd::readJson(text);
+  } catch (const effectd::JsonSyntaxError&) {
+    return 0;
+  }
+  // What the reader accepts, nlohmann's parser accepts as the same document.
+  const json reference = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (reference.is_discarded() || reference != body) __builtin_trap();
   if (!service.schemas().validate(e.schema, body).empty()) return 0;
   try {
     RequestContext ctx{"fuzz", config};
