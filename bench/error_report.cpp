@@ -107,11 +107,15 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
   auto layout = [&] {
     lt::Params p = layoutOf(n, volume);
     p.neighbourhood = hood;
-    p.axisGrowth = lt::calibratedAxisGrowth(p);
+    lt::calibrate(p);
     return p;
   };
   std::vector<LightningSetting> settings;
-  settings.push_back({"fast calibrated", "default: axisGrowth " + fmt(layout().axisGrowth, 3) + ", lifetime inf", layout()});
+  const lt::Params calibrated = layout();
+  settings.push_back({"fast calibrated",
+                      "default: axisGrowth " + fmt(calibrated.axisGrowth, 3) + ", lifetime " +
+                          (calibrated.lifetime ? std::to_string(calibrated.lifetime) : std::string("inf")),
+                      calibrated});
   for (int life : {2, 4, 8, 0}) {  // the paper's base 2; lifetime 4 is the paper variant
     lt::Params p = layout();
     p.axisGrowth = lt::kPaperAxisGrowth;
@@ -121,6 +125,7 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
   for (double growth : {1.5, 1.25, 1.1, 1.0}) {  // eqn 8's base, candidates never expiring
     lt::Params p = layout();
     p.axisGrowth = growth;
+    p.lifetime = 0;
     settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3), p});
   }
   if (!volume && (n <= 128 || hood == 8)) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2

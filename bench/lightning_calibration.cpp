@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
   if (grids.empty()) grids = {64, 128};
   if (etas.empty()) etas = {1, 2, 3};
   const bool calibrated = axes.empty();  // each row at calibratedAxisGrowth() of its grid and eta
-  if (lifetimes.empty()) lifetimes = {lt::Params{}.lifetime};
+  const bool calibratedLifetime = lifetimes.empty();  // each row at calibratedLifetime() of its grid and eta
   if (screenings.empty()) screenings = {lt::Params{}.screening};
   if (radii.empty()) radii = {lt::Params{}.screeningRadius};
   std::printf("| grid | eta | method | setting | D | cells (median) | tips (median) | ms/bolt |\n");
@@ -181,6 +181,7 @@ int main(int argc, char** argv) {
       }
       base.eta = eta;
       base.neighbourhood = neighbourhood ? neighbourhood : volume ? 26 : 8;
+      if (calibratedLifetime) lifetimes = {lt::calibratedLifetime(base)};
       if (dbmSeeds > 0) {
         lt::Params p = base;
         p.method = lt::Method::kDbm;

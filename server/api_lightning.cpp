@@ -190,7 +190,7 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
     p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   p.eta = body.value("eta", p.eta);
   p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
-  p.axisGrowth = lt::calibratedAxisGrowth(p);
+  lt::calibrate(p);
   if (body.value("variant", "calibrated") == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
     p.lifetime = lt::kPaperLifetime;
     p.axisGrowth = lt::kPaperAxisGrowth;

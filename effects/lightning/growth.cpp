@@ -54,36 +54,71 @@ std::optional<Error> validate(const Params& p) {
 }
 
 namespace {
-// The grid side from which N is counted within radius 3 (section 11): 256 in the
-// 8-neighbourhood, 512 in the 4-neighbourhood (whose adjacent-cell law still meets DBM at 256^2).
+// The grid side from which N is counted within a radius and the table below holds (section 11):
+// 256 in the 8-neighbourhood, 512 in the 4-neighbourhood (whose adjacent-cell law still meets
+// DBM at 256^2).
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
 
-// Section 12: with N counted within radius 3, the base per cell that meets DBM, per grid side
-// (a row: 256, 512, 1024) and eta (a column: kTableEtas), measured against DBM's bolts.
+// Sections 12 and 13: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
+// kTableEtas), measured against DBM's bolts: eqn 8's base per cell, the radius N is counted
+// within, and the candidates' lifetime (0 = forever).
+struct Setting {
+  double base;
+  int radius;
+  int lifetime;
+};
 constexpr double kTableEtas[] = {0.5, 1, 2, 3, 4};
 constexpr int kTableColumns = 5;
-constexpr double kRadiusBase8[][kTableColumns] = {
-    {1.13, 1.13, 1.13, 1.13, 1.13},         // 256^2
-    {1.085, 1.095, 1.095, 1.11, 1.11},      // 512^2
-    {1.08, 1.08, 1.08, 1.09, 1.09},        // 1024^2 (eta < 2: held, no DBM reference)
+constexpr Setting kTable8[][kTableColumns] = {
+    {{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}},        // 256^2
+    {{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}},     // 512^2
+    {{1.08, 3, 0}, {1.035, 7, 100}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}},     // 1024^2
 };
-constexpr double kRadiusBase4[][kTableColumns] = {
-    {1.095, 1.095, 1.095, 1.125, 1.125},  // 512^2 (eta 0.5 and 4: held), held beyond: no DBM reference
+constexpr Setting kTable4[][kTableColumns] = {
+    {{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}},  // 512^2 and beyond
 };
 
-// table[row][column]: rows at sides firstSide, 2 firstSide, ...; linear in log2 of the side and
-// in eta between rows and columns, held beyond the first and last of each.
+// table[row][column]: rows at sides firstSide, 2 firstSide, ...; bilinear in log2 of the side
+// and in eta between rows and columns, held beyond the first and last of each. Radius and
+// lifetime are the heaviest entry's (a step half-way between entries that differ in them), and
+// the base blends the entries that share them, so it is continuous wherever they do not change.
 template <size_t Rows>
-double tableBase(const double (&table)[Rows][kTableColumns], double firstSide, double side, double eta) {
+Setting tableSetting(const Setting (&table)[Rows][kTableColumns], double firstSide, double side, double eta) {
   const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));
   const size_t r0 = std::min(size_t(r), Rows - 1), r1 = std::min(r0 + 1, Rows - 1);
   const double e = std::clamp(eta, kTableEtas[0], kTableEtas[kTableColumns - 1]);
   size_t c0 = 0;
   while (c0 + 2 < kTableColumns && e > kTableEtas[c0 + 1]) ++c0;
-  const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]);
-  auto at = [&](size_t row) { return table[row][c0] + (table[row][c0 + 1] - table[row][c0]) * ce; };
-  return at(r0) + (at(r1) - at(r0)) * (r - double(r0));
+  const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]), re = r - double(r0);
+  const std::pair<const Setting*, double> corners[] = {{&table[r0][c0], (1 - re) * (1 - ce)},
+                                                       {&table[r0][c0 + 1], (1 - re) * ce},
+                                                       {&table[r1][c0], re * (1 - ce)},
+                                                       {&table[r1][c0 + 1], re * ce}};
+  const Setting* heaviest = corners[0].first;
+  double most = -1;
+  for (const auto& [s, w] : corners)
+    if (w > most) {
+      heaviest = s;
+      most = w;
+    }
+  Setting out{0, heaviest->radius, heaviest->lifetime};
+  double weight = 0;
+  for (const auto& [s, w] : corners)
+    if (s->radius == out.radius && s->lifetime == out.lifetime) {
+      out.base += w * s->base;
+      weight += w;
+    }
+  out.base /= weight;
+  return out;
 }
+
+// The table's setting for a 2-D grid from radiusFrom() up.
+Setting largeGridSetting(const Params& p) {
+  const double longer = std::max(p.width, p.height);
+  return p.neighbourhood == 4 ? tableSetting(kTable4, 512, longer, p.eta) : tableSetting(kTable8, 256, longer, p.eta);
+}
+
+bool fromTable(const Params& p) { return !p.depth && std::max(p.width, p.height) >= radiusFrom(p); }
 }  // namespace
 
 double calibratedAxisGrowth(const Params& p) {
@@ -92,16 +127,23 @@ double calibratedAxisGrowth(const Params& p) {
     return p.neighbourhood == 6 ? std::exp(0.32 * std::pow(32.0 / longest, 0.55))
                                 : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
   }
-  const double longer = std::max(3, std::max(p.width, p.height));
-  if (longer >= radiusFrom(p))
-    return p.neighbourhood == 4 ? tableBase(kRadiusBase4, 512, longer, p.eta) : tableBase(kRadiusBase8, 256, longer, p.eta);
+  if (fromTable(p)) return largeGridSetting(p).base;
   if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
+  const double longer = std::max(3, std::max(p.width, p.height));
   return std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35));
 }
 
 int calibratedScreeningRadius(const Params& p) {
-  const int longer = std::max(p.width, p.height);
-  return p.method == Method::kFast && !p.depth && longer >= radiusFrom(p) ? 3 : 1;
+  return p.method == Method::kFast && fromTable(p) ? largeGridSetting(p).radius : 1;
+}
+
+int calibratedLifetime(const Params& p) {
+  return p.method == Method::kFast && fromTable(p) ? largeGridSetting(p).lifetime : 0;
+}
+
+void calibrate(Params& p) {
+  p.axisGrowth = calibratedAxisGrowth(p);
+  p.lifetime = calibratedLifetime(p);
 }
 
 int screeningRadius(const Params& p) {
@@ -681,6 +723,11 @@ std::optional<Error> Grower::run() {
   s.counters["cells"] = double(bolt_.nodes.size());
   s.counters["candidatesMax"] = double(candidatesMax_);
   if (p_.method == Method::kCharges) s.counters["chargesEta"] = exponent_;
+  if (p_.method == Method::kFast) {  // the setting that ran (calibrate() or the request's own)
+    s.counters["axisGrowth"] = p_.axisGrowth;
+    s.counters["lifetime"] = p_.lifetime;
+    s.counters["screeningRadius"] = radius_;
+  }
   if (p_.method == Method::kDbm) {
     s.counters["solverIterations"] = solverIterations_;
     s.counters["residual"] = lastResidual_;

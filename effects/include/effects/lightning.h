@@ -59,24 +59,29 @@ enum class Guide { kAuto, kAstar, kNone };
 // Seed 002's literal eqn 8 and lifetime (the `paper` variant): bolts thinner than DBM's.
 inline constexpr double kPaperAxisGrowth = 2.0;
 inline constexpr int kPaperLifetime = 4;
-// The base per cell (lifetime 0) that meets DBM's statistics (docs/lightning-calibration.md):
-// 1.2 in the 8-neighbourhood below 256^2 (from 256^2 see calibratedScreeningRadius); in the
-// 4-neighbourhood the fitted base
-// falls with the grid and rises with eta, as
+// The base per cell that meets DBM's statistics (docs/lightning-calibration.md):
+// 1.2 in the 8-neighbourhood below 256^2 (lifetime 0, N of the adjacent cells); in the
+// 4-neighbourhood below 512^2 the fitted base falls with the grid and rises with eta, as
 // ln a = (0.155 + 0.06 min(eta, 3)) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
 // the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
-// longest side).
+// longest side). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) base, radius
+// and lifetime come from a table per grid and eta (sections 12 and 13): N counted within radius 3
+// and candidates that never expire, with bases 1.13 at 256^2, 1.085-1.11 at 512^2 and 1.08-1.09
+// from 1024^2 (8-neighbourhood), 1.095-1.125 from 512^2 (4-neighbourhood), rising with eta; at
+// low eta the larger grids need N within radius 7 and candidates living 100 steps (8, 1024^2 at
+// eta 1: base 1.035) or radius 5 (4, 512^2 at eta <= 1: base 1.08). Radius and lifetime are
+// the nearest entry's; the base is linear in log L and eta between entries that share them.
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
 // eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
-// the paper). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) the calibrated
-// default counts them within radius 3, with a base per cell from a table per grid and eta
-// (1.13 at 256^2; 1.085-1.11 at 512^2 and 1.08-1.09 from 1024^2 in the 8-neighbourhood,
-// 1.095-1.125 from 512^2 in the 4-neighbourhood, rising with eta), linear in log L and eta
-// between: with adjacent cells only, no base meets DBM's dimension and its mass together there
-// (docs/lightning-calibration.md sections 7, 11 and 12).
+// the paper): the table's radius from 256^2 up (512^2 in the 4-neighbourhood) for 2-D fast, else 1.
 int calibratedScreeningRadius(const Params& p);
+// Steps a fast candidate lives (0 = forever): the table's lifetime where it holds, else 0.
+int calibratedLifetime(const Params& p);
+// Sets the calibrated defaults the server uses: axisGrowth and lifetime (the radius follows from
+// screeningRadius 0).
+void calibrate(Params& p);
 // The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
 // one; 1 for every method but 2-D fast.
 int screeningRadius(const Params& p);
@@ -105,9 +110,9 @@ struct Params {
   double eta = 2.0;         // [0, 50]; seed 002: 2..3 looks like lightning
   int lifetime = 0;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
   double axisGrowth = kCalibratedAxisGrowth8;  // kFast: base of eqn 8's 2^G per cell, in [1, 64]
-                                               // (calibratedAxisGrowth() with lifetime 0 meets
-                                               // DBM's D, cells and tips; set it from there for
-                                               // grids of 256^2 and more, as the server does)
+                                               // (calibrate() sets it and the lifetime that meet
+                                               // DBM's D, cells and tips for the grid and eta,
+                                               // as the server does)
   double screening = 1.0;   // kFast: exponent of eqn 6's N (Phi ~ 1 / N^screening), in [0, 8]
   int screeningRadius = 0;  // kFast, 2-D: N counts the bolt cells within this Chebyshev radius,
                             // in [0, 7]; 1: eqn 6's adjacent cells; 0: calibratedScreeningRadius()
