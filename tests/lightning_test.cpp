@@ -118,6 +118,19 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
     EXPECT_EQ(p.lifetime, 100) << eta;
   }
   EXPECT_EQ(at(1024, 1.6).screeningRadius, 3);
+  {  // with obstacles the lifetime entries give way to radius 3 and candidates that never expire
+    Params walled = basic(1024);
+    walled.eta = 1;
+    walled.obstacles.assign(size_t(1024) * 1024, 0);
+    walled.obstacles[size_t(500) * 1024 + 10] = 1;
+    calibrate(walled);
+    EXPECT_EQ(walled.lifetime, 0);
+    EXPECT_DOUBLE_EQ(walled.axisGrowth, 1.08);
+    EXPECT_EQ(calibratedScreeningRadius(walled), 3);
+    walled.obstacles[size_t(500) * 1024 + 10] = 0;  // all clear: the open grid's entry
+    calibrate(walled);
+    EXPECT_EQ(walled.lifetime, 100);
+  }
   EXPECT_EQ(at(1024, 0.7).screeningRadius, 3);  // eta 0.5 holds 1.08 with radius 3 (no DBM reference)
   EXPECT_DOUBLE_EQ(at(1024, 0.5).axisGrowth, 1.08);
   EXPECT_EQ(at(1024, 1.6).lifetime, 0);

@@ -74,6 +74,14 @@ constexpr Setting kTable8[][kTableColumns] = {
     {{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}},     // 512^2
     {{1.08, 3, 0}, {1.035, 7, 100}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}},     // 1024^2
 };
+// The same for grids with obstacles: a finite lifetime there makes the guide's legs revive
+// their frontier again and again (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta
+// 1 with 1.035, 7, 100), so lifetime entries give way to section 12's radius-3 ones.
+constexpr Setting kTable8Obstructed[][kTableColumns] = {
+    {{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}},     // 256^2
+    {{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}},  // 512^2
+    {{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}},     // 1024^2
+};
 constexpr Setting kTable4[][kTableColumns] = {
     {{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}},  // 512^2 and beyond
 };
@@ -115,7 +123,9 @@ Setting tableSetting(const Setting (&table)[Rows][kTableColumns], double firstSi
 // The table's setting for a 2-D grid from radiusFrom() up.
 Setting largeGridSetting(const Params& p) {
   const double longer = std::max(p.width, p.height);
-  return p.neighbourhood == 4 ? tableSetting(kTable4, 512, longer, p.eta) : tableSetting(kTable8, 256, longer, p.eta);
+  if (p.neighbourhood == 4) return tableSetting(kTable4, 512, longer, p.eta);
+  const bool open = std::none_of(p.obstacles.begin(), p.obstacles.end(), [](uint8_t o) { return o != 0; });
+  return open ? tableSetting(kTable8, 256, longer, p.eta) : tableSetting(kTable8Obstructed, 256, longer, p.eta);
 }
 
 bool fromTable(const Params& p) { return !p.depth && std::max(p.width, p.height) >= radiusFrom(p); }
