@@ -9,6 +9,8 @@
 //                         [--fit] [--charges-eta E]... [--screening S]... [--volume]
 // --dbm-first-seed: DBM's bolts are seeds F ... F+S-1 (default 1), so slow references can be
 // grown a few seeds a run and pooled by hand.
+// Knobs not given (--lifetime; the radius unless --radius) take the calibrated value of each
+// row's grid and eta, as the server's default does.
 // --volume: N x N x N grids (neighbourhood 26 unless given; 6 is the other 3-D one).
 // --screening: the exponent of eqn 6's N (1 in the paper), one row (or fit) per value.
 // --charges-eta: rows for the charges method (Kim et al. 2007) with their potential raised to

@@ -170,6 +170,9 @@ std::optional<FieldError> parse(const std::string& b, Asset& out) {
     std::string data = b.substr(at + 8, len);
     if (!haveJson) {
       if (type != kJson) return FieldError{"", "the first chunk must be JSON"};
+      // glTF pads the JSON chunk with spaces; some exporters pad with zero bytes (which
+      // nlohmann's parser read as the end of the text), so trailing ones are dropped too.
+      while (!data.empty() && data.back() == '\0') data.pop_back();
       try {
         out.gltf = readJson(data);
       } catch (const JsonSyntaxError& e) {

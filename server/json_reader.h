@@ -4,10 +4,11 @@
 // duplicate keys wins; a UTF-8 byte order mark is skipped) and refusing what it refuses
 // (ill-formed UTF-8, control characters and lone surrogates in strings, leading zeros, NaN,
 // numbers beyond a double's range, comments, trailing text; nlohmann stops reading at a NUL
-// byte and so accepts anything after one, which this refuses too). About three times faster: numbers go through
-// std::from_chars and strings are copied a run of plain bytes at a time, where nlohmann's lexer reads a character at a
-// time into a token buffer and converts numbers with strtod. Nesting deeper than `maxDepth` arrays and objects is
-// refused before it costs anything.
+// byte and so accepts anything after one, which this refuses too). About five times faster (a
+// 1.8 MB mesh in the server: 2.9 ms against 16.6): numbers go through std::from_chars and
+// strings are copied a run of plain bytes at a time, where nlohmann's lexer reads a character
+// at a time into a token buffer and converts numbers with strtod. Nesting deeper than
+// `maxDepth` arrays and objects is refused when reached, before the rest is read.
 #pragma once
 
 #include <cstddef>

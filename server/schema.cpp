@@ -109,7 +109,7 @@ struct Bound {
 Bound numberBound(const json& s, const char* keyword, const char* prefix) {
   auto it = s.find(keyword);
   if (it == s.end()) return {};
-  if (!it->is_number()) throw std::runtime_error(std::string(keyword) + " must be a number");
+  if (!it->is_number()) throw std::invalid_argument(std::string(keyword) + " must be a number");
   return {true, it->get<double>(), prefix + fmtNumber(*it)};
 }
 
@@ -117,7 +117,7 @@ Bound sizeBound(const json& s, const char* keyword, const char* prefix, const ch
   auto it = s.find(keyword);
   if (it == s.end()) return {};
   if (typeBitOf(*it) != kInteger || it->get<double>() < 0)
-    throw std::runtime_error(std::string(keyword) + " must be a non-negative integer");
+    throw std::invalid_argument(std::string(keyword) + " must be a non-negative integer");
   return {true, it->get<double>(), prefix + it->dump() + suffix};
 }
 
@@ -179,7 +179,7 @@ struct SchemaRegistry::Path {
 struct SchemaRegistry::Ctx {
   std::vector<FieldError> errors;
   size_t maxErrors;
-  int depth = 0;  // schema nesting through $ref and alternatives, to stop a cyclic reference
+  int depth = 0;  // schema nesting (every check, alternatives included), to stop a cyclic $ref
   bool full() const { return errors.size() >= maxErrors; }
   void add(const Path& at, std::string message) {
     if (!full()) errors.push_back({at.str(), std::move(message)});
@@ -262,9 +262,9 @@ const SchemaRegistry::Node& SchemaRegistry::compile(const json& s, const std::st
     }
     if (auto it = s.find("allOf"); it != s.end())
       for (const auto& branch : *it) n.allOf.push_back(&compile(branch, doc));
-  } catch (const json::exception& e) {
+  } catch (const json::exception& e) {  // a keyword's value of the wrong JSON type
     throw std::runtime_error("schema " + doc + ": malformed keyword value: " + e.what());
-  } catch (const std::runtime_error& e) {
+  } catch (const std::invalid_argument& e) {  // a bound that is no number or size
     throw std::runtime_error("schema " + doc + ": " + e.what());
   }
   return n;
@@ -388,7 +388,7 @@ void SchemaRegistry::check(const Node& s, const json& v, const Path& path, Ctx& 
   // Each alternative is tried on its own (a few errors at most); the report names the one the
   // client most likely meant.
   for (const auto& alt : s.alternatives) {
-    const std::string ptr = path.str();
+    std::string ptr;  // spelled out only for a branch that misses one member
     size_t matches = 0;
     std::vector<FieldError> firstErrors;
     std::vector<std::string> missing;  // branches that fail only for a missing member
@@ -400,9 +400,10 @@ void SchemaRegistry::check(const Node& s, const json& v, const Path& path, Ctx& 
         ++matches;
       else if (firstErrors.empty() || errors.front().pointer.size() > firstErrors.front().pointer.size())
         firstErrors = errors;  // the branch that got deepest is the one the client meant
-      if (errors.size() == 1 && errors.front().message == "is required" &&
-          errors.front().pointer.rfind(ptr + "/", 0) == 0)
-        missing.push_back(errors.front().pointer.substr(ptr.size() + 1));
+      if (errors.size() == 1 && errors.front().message == "is required") {
+        if (ptr.empty()) ptr = path.str() + "/";
+        if (errors.front().pointer.rfind(ptr, 0) == 0) missing.push_back(errors.front().pointer.substr(ptr.size()));
+      }
     }
     if (alt.oneOf ? matches == 1 : matches >= 1) continue;
     if (matches > 1) {

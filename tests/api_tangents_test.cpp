@@ -1,5 +1,6 @@
 // POST /v1/tangents over HTTP: JSON meshes, binary glTF in and out, errors.
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -166,6 +167,27 @@ TEST(TangentsApi, RealGlbFromAssimpTestModels) {
     EXPECT_LT(std::abs(dot), 1e-5);
     EXPECT_NEAR(std::hypot(t[4 * v], t[4 * v + 1], t[4 * v + 2]), 1.0, 1e-5);
   }
+}
+
+// The JSON chunk padded with zero bytes instead of spaces, as some exporters write it.
+TEST(TangentsApi, GlbWithZeroPaddedJsonIsRead) {
+  const std::string g = quadGlb();
+  uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, g.data() + 12, 4);
+  std::string text = g.substr(20, jsonLength);
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  text += std::string(4 - text.size() % 4, '\0');
+  const std::string rest = g.substr(20 + jsonLength);
+  auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string padded = "glTF" + u32(2) + u32(uint32_t(12 + 8 + text.size() + rest.size())) +
+                             u32(uint32_t(text.size())) + "JSON" + text + rest;
+  glb::Asset a;
+  ASSERT_FALSE(glb::parse(padded, a).has_value());
+  EXPECT_TRUE(a.gltf.contains("meshes"));
+  TestServer s;
+  auto r = s.client().Post("/v1/tangents", padded, "model/gltf-binary");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
 }
 
 TEST(TangentsApi, BrokenGlbIsRefused) {
