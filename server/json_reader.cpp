@@ -101,28 +101,24 @@ class Reader {
       throw JsonSyntaxError(size_t(p_ - begin_), "nested deeper than " + std::to_string(maxDepth_) + " levels", true);
   }
 
+  // Skips white space, then `c` if it comes next; whether it did.
+  bool take(char c) {
+    skipSpace();
+    if (p_ == end_ || *p_ != c) return false;
+    ++p_;
+    return true;
+  }
+
   void array(json& out, size_t depth) {
     enter(depth);
     ++p_;
     out = json::array();
     auto& items = out.get_ref<json::array_t&>();
-    skipSpace();
-    if (p_ != end_ && *p_ == ']') {
-      ++p_;
-      return;
-    }
-    for (;;) {
+    if (take(']')) return;
+    do {
       value(items.emplace_back(), depth);
-      skipSpace();
-      if (p_ != end_ && *p_ == ',') {
-        ++p_;
-      } else if (p_ != end_ && *p_ == ']') {
-        ++p_;
-        return;
-      } else {
-        fail("expected ',' or ']'");
-      }
-    }
+    } while (take(','));
+    if (!take(']')) fail("expected ',' or ']'");
   }
 
   void object(json& out, size_t depth) {
@@ -130,31 +126,17 @@ class Reader {
     ++p_;
     out = json::object();
     auto& members = out.get_ref<json::object_t&>();
-    skipSpace();
-    if (p_ != end_ && *p_ == '}') {
-      ++p_;
-      return;
-    }
+    if (take('}')) return;
     std::string key;
-    for (;;) {
+    do {
       skipSpace();
       if (p_ == end_ || *p_ != '"') fail("expected a member name in double quotes");
       key.clear();
       string(key);
-      skipSpace();
-      if (p_ == end_ || *p_ != ':') fail("expected ':' after a member name");
-      ++p_;
+      if (!take(':')) fail("expected ':' after a member name");
       value(members[key], depth);  // a repeated name: the last value wins
-      skipSpace();
-      if (p_ != end_ && *p_ == ',') {
-        ++p_;
-      } else if (p_ != end_ && *p_ == '}') {
-        ++p_;
-        return;
-      } else {
-        fail("expected ',' or '}'");
-      }
-    }
+    } while (take(','));
+    if (!take('}')) fail("expected ',' or '}'");
   }
 
   // A string from its opening quote; plain runs are appended whole.

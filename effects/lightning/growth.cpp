@@ -69,29 +69,33 @@ struct Setting {
 };
 constexpr double kTableEtas[] = {0.5, 1, 2, 3, 4};
 constexpr int kTableColumns = 5;
-constexpr Setting kTable8[][kTableColumns] = {
-    {{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}},        // 256^2
-    {{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}},     // 512^2
-    {{1.08, 3, 0}, {1.035, 7, 100}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}},     // 1024^2
-};
-// The same for grids with obstacles: a finite lifetime there makes the guide's legs revive
-// their frontier again and again (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta
-// 1 with 1.035, 7, 100), so lifetime entries give way to section 12's radius-3 ones.
-constexpr Setting kTable8Obstructed[][kTableColumns] = {
-    {{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}},     // 256^2
-    {{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}},  // 512^2
-    {{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}},     // 1024^2
-};
-constexpr Setting kTable4[][kTableColumns] = {
-    {{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}},  // 512^2 and beyond
-};
+template <size_t Rows>
+using Table = std::array<std::array<Setting, kTableColumns>, Rows>;
+// Section 12 (N within radius 3, candidates that never expire). Grids with obstacles keep it
+// whole: a finite lifetime there makes the guide's legs revive their frontier again and again
+// (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta 1 with 1.035, 7, 100).
+constexpr Table<3> kTable8Obstructed = {{
+    {{{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}}},     // 256^2
+    {{{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}}},  // 512^2
+    {{{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}}},     // 1024^2
+}};
+// Open grids: the same but for 1024^2 at eta 1, where section 13's wider radius and lifetime
+// meet DBM.
+constexpr Table<3> kTable8 = [] {
+  Table<3> t = kTable8Obstructed;
+  t[2][1] = {1.035, 7, 100};
+  return t;
+}();
+constexpr Table<1> kTable4 = {{
+    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2 and beyond
+}};
 
 // table[row][column]: rows at sides firstSide, 2 firstSide, ...; bilinear in log2 of the side
 // and in eta between rows and columns, held beyond the first and last of each. Radius and
 // lifetime are the heaviest entry's (a step half-way between entries that differ in them), and
 // the base blends the entries that share them, so it is continuous wherever they do not change.
 template <size_t Rows>
-Setting tableSetting(const Setting (&table)[Rows][kTableColumns], double firstSide, double side, double eta) {
+Setting tableSetting(const Table<Rows>& table, double firstSide, double side, double eta) {
   const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));
   const size_t r0 = std::min(size_t(r), Rows - 1), r1 = std::min(r0 + 1, Rows - 1);
   const double e = std::clamp(eta, kTableEtas[0], kTableEtas[kTableColumns - 1]);
