@@ -131,11 +131,19 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
     calibrate(walled);
     EXPECT_EQ(walled.lifetime, 100);
   }
-  EXPECT_EQ(at(1024, 0.7).screeningRadius, 3);  // eta 0.5 holds 1.08 with radius 3 (no DBM reference)
-  EXPECT_DOUBLE_EQ(at(1024, 0.5).axisGrowth, 1.08);
+  for (double eta : {0.3, 0.5, 0.7}) {  // eta 0.5: radius 3, candidates that expire after 300 steps
+    const Params p = at(1024, eta);
+    EXPECT_DOUBLE_EQ(p.axisGrowth, 1.015) << eta;
+    EXPECT_EQ(p.screeningRadius, 3) << eta;
+    EXPECT_EQ(p.lifetime, 300) << eta;
+  }
+  EXPECT_EQ(at(4096, 0.5).lifetime, 300);  // held beyond the last row
   EXPECT_EQ(at(1024, 1.6).lifetime, 0);
   EXPECT_EQ(at(700, 1).screeningRadius, 3);  // 512^2's setting up to half-way (724^2)
+  EXPECT_EQ(at(700, 1).lifetime, 0);
   EXPECT_EQ(at(750, 1).screeningRadius, 7);
+  EXPECT_EQ(at(750, 1).lifetime, 73);  // a lifetime shrinks with the side below its row: 100 x 750 / 1024
+  EXPECT_EQ(at(725, 0.5).lifetime, 212);
   EXPECT_EQ(at(512, 1, 4).screeningRadius, 5);
   EXPECT_DOUBLE_EQ(at(512, 1, 4).axisGrowth, 1.08);
   EXPECT_EQ(at(512, 1, 4).lifetime, 0);
@@ -149,12 +157,15 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
         const Params p = at(side, eta, neighbourhood), e = at(side, eta + 0.01, neighbourhood),
                      g = at(side + 1, eta, neighbourhood);
         for (const auto& [q, most] : {std::pair{&e, 0.0006}, std::pair{&g, 0.0003}}) {
-          if (q->screeningRadius != p.screeningRadius || q->lifetime != p.lifetime)
+          if (q->screeningRadius != p.screeningRadius || (q->lifetime > 0) != (p.lifetime > 0)) {
             ++steps;
-          else
+          } else {
             ASSERT_LT(std::abs(q->axisGrowth - p.axisGrowth), most) << side << " " << eta;
+            ASSERT_LE(std::abs(q->lifetime - p.lifetime), 1) << side << " " << eta;
+          }
         }
         ASSERT_LE(g.axisGrowth, p.axisGrowth + 1e-12) << side << " " << eta;
+        if (g.screeningRadius == p.screeningRadius) ASSERT_GE(g.lifetime, p.lifetime) << side << " " << eta;
       }
   EXPECT_GT(steps, 0);
   EXPECT_LT(steps, 2000);  // along the half-way lines only
