@@ -59,7 +59,7 @@ namespace {
 // DBM at 256^2).
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
 
-// Sections 12 and 13: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
+// Sections 12-14: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
 // kTableEtas), measured against DBM's bolts: eqn 8's base per cell, the radius N is counted
 // within, and the candidates' lifetime (0 = forever).
 struct Setting {
@@ -96,7 +96,7 @@ constexpr Table<1> kTable4 = {{
 // lifetime are the heaviest entry's (a step half-way between entries that differ in them), and
 // the base blends the entries that share them, so it is continuous wherever they do not change.
 // Below its row's side a lifetime shrinks in proportion to the side (section 14: against DBM at
-// 724^2 the 1024^2 entries' own lifetimes grew 28-29 % too many cells, the shrunk ones 3-10 %).
+// 724^2 the 1024^2 entries' own lifetimes grew 17-28 % too many cells, the shrunk ones within 3 %).
 template <size_t Rows>
 Setting tableSetting(const Table<Rows>& table, double firstSide, double side, double eta) {
   const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));

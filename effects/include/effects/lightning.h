@@ -65,7 +65,7 @@ inline constexpr int kPaperLifetime = 4;
 // ln a = (0.155 + 0.06 min(eta, 3)) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
 // the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
 // longest side). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) base, radius
-// and lifetime come from a table per grid and eta (sections 12 and 13): N counted within radius 3
+// and lifetime come from a table per grid and eta (sections 12-14): N counted within radius 3
 // and candidates that never expire, with bases 1.13 at 256^2, 1.085-1.11 at 512^2 and 1.08-1.09
 // from 1024^2 (8-neighbourhood), 1.095-1.125 from 512^2 (4-neighbourhood), rising with eta; at
 // low eta the larger grids need candidates that expire (8-neighbourhood, the 1024^2 entries:
