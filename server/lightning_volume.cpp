@@ -164,9 +164,10 @@ std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, co
     for (const auto& s : o["spheres"]) {
       const auto c = world.toVoxels(vec3(s["center"]));
       const double r = s["radius"].get<double>() / (world.given ? world.cellSize : 1.0);
-      auto range = [&](double centre, int n, int& lo, int& hi) {
-        lo = int(std::max(0.0, std::floor(centre - r)));
-        hi = int(std::min(double(n - 1), std::ceil(centre + r)));
+      auto range = [&](double centre, int n, int& lo, int& hi) {  // lo > hi: none of the grid
+        const double l = std::max(0.0, std::floor(centre - r)), u = std::min(double(n - 1), std::ceil(centre + r));
+        lo = u >= l ? int(l) : 1;  // compared first: a centre 1e33 voxels away fits no int
+        hi = u >= l ? int(u) : 0;
       };
       int x0, x1, y0, y1, z0, z1;
       range(c[0], w, x0, x1), range(c[1], h, y0, y1), range(c[2], d, z0, z1);

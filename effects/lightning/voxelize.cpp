@@ -60,9 +60,12 @@ size_t voxelizeTriangles(int width, int height, int depth, const std::vector<dou
       const double mn = std::min({v[0][size_t(a)], v[1][size_t(a)], v[2][size_t(a)]});
       const double mx = std::max({v[0][size_t(a)], v[1][size_t(a)], v[2][size_t(a)]});
       // Voxel i covers [i, i + 1]: closed boxes touching the triangle's bounds count.
-      lo[a] = int(std::max(0.0, std::floor(mn) - 1));
-      hi[a] = int(std::min(double(size[a] - 1), std::floor(mx)));
-      if (!(mx >= 0) || !(mn <= size[a]) || lo[a] > hi[a]) outside = true;
+      const double l = std::max(0.0, std::floor(mn) - 1), u = std::min(double(size[a] - 1), std::floor(mx));
+      if (!(mx >= 0) || !(mn <= size[a]) || !(u >= l)) {  // before converting: 1e33 fits no int
+        outside = true;
+        break;
+      }
+      lo[a] = int(l), hi[a] = int(u);
     }
     if (outside) continue;
     for (int z = lo[2]; z <= hi[2]; ++z)
