@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "effects/lightning.h"
 
@@ -18,6 +19,13 @@ V3 cross(const V3& a, const V3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// The voxels i along an axis of n whose closed boxes [i, i + 1] can touch [mn, mx], clamped to
+// the grid; none when the second is below the first. Doubles: a triangle outside the grid can
+// lie 1e33 voxels away, which no int holds.
+std::pair<double, double> voxelSpan(double mn, double mx, int n) {
+  return {std::max(0.0, std::floor(mn) - 1), std::min(double(n - 1), std::floor(mx))};
+}
 
 // Whether the triangle (v0, v1, v2), relative to a box centre, overlaps the box of half side h.
 bool overlaps(const V3& v0, const V3& v1, const V3& v2, double h) {
@@ -59,9 +67,8 @@ size_t voxelizeTriangles(int width, int height, int depth, const std::vector<dou
     for (int a = 0; a < 3; ++a) {
       const double mn = std::min({v[0][size_t(a)], v[1][size_t(a)], v[2][size_t(a)]});
       const double mx = std::max({v[0][size_t(a)], v[1][size_t(a)], v[2][size_t(a)]});
-      // Voxel i covers [i, i + 1]: closed boxes touching the triangle's bounds count.
-      const double l = std::max(0.0, std::floor(mn) - 1), u = std::min(double(size[a] - 1), std::floor(mx));
-      if (!(mx >= 0) || !(mn <= size[a]) || !(u >= l)) {  // before converting: 1e33 fits no int
+      const auto [l, u] = voxelSpan(mn, mx, size[a]);
+      if (!(mx >= 0) || !(mn <= size[a]) || !(u >= l)) {  // tested before converting to int
         outside = true;
         break;
       }
@@ -93,7 +100,7 @@ size_t voxelizationWork(int width, int height, int depth, const std::vector<doub
         const double p = positions[size_t(indices[t + size_t(k)]) * 3 + size_t(a)];
         mn = std::min(mn, p), mx = std::max(mx, p);
       }
-      const double lo = std::max(0.0, std::floor(mn) - 1), hi = std::min(double(size[a] - 1), std::floor(mx));
+      const auto [lo, hi] = voxelSpan(mn, mx, size[a]);
       voxels *= hi >= lo ? size_t(hi - lo + 1) : 0;
     }
     work += voxels;
