@@ -59,7 +59,7 @@ namespace {
 // DBM at 256^2).
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
 
-// Sections 12-14: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
+// Sections 12-15: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
 // kTableEtas), measured against DBM's bolts: eqn 8's base per cell, the radius N is counted
 // within, and the candidates' lifetime (0 = forever).
 struct Setting {
@@ -74,10 +74,11 @@ using Table = std::array<std::array<Setting, kTableColumns>, Rows>;
 // Section 12 (N within radius 3, candidates that never expire). Grids with obstacles keep it
 // whole: a finite lifetime there makes the guide's legs revive their frontier again and again
 // (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta 1 with 1.035, 7, 100).
+// At eta 3, N within radius 2 up to 512^2 (section 15: radius 3 left D 0.04 low at 362^2).
 constexpr Table<3> kTable8Obstructed = {{
-    {{{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}}},     // 256^2
-    {{{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.11, 3, 0}, {1.11, 3, 0}}},  // 512^2
-    {{{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}}},     // 1024^2
+    {{{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 2, 0}, {1.13, 3, 0}}},      // 256^2
+    {{{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.115, 2, 0}, {1.11, 3, 0}}},  // 512^2
+    {{{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}}},      // 1024^2
 }};
 // Open grids: the same but for 1024^2 at eta 1 (section 13) and 0.5 (section 14), where
 // candidates that expire (with N counted over a wider square at eta 1) meet DBM.
@@ -87,57 +88,76 @@ constexpr Table<3> kTable8 = [] {
   t[2][1] = {1.035, 7, 100};
   return t;
 }();
+// Section 15: feet. An entry with a foot reaches down to the row below: just above that row it
+// runs with its foot, the setting measured there, and towards its own row the base goes linearly
+// and the lifetime geometrically in log2 of the side (the radius is the entry's, and so is a
+// lifetime of 0). A foot of base 0 is none. Where an entry differs from the row below in radius
+// or lifetime and has no foot, the step is half-way.
+constexpr Table<3> kFeet8Obstructed = [] {
+  Table<3> t{};
+  t[2][3] = {1.11, 3, 0};  // radius 3 from 513^2 at eta 3, as before radius 2 came in below
+  return t;
+}();
+constexpr Table<3> kFeet8 = [] {
+  Table<3> t = kFeet8Obstructed;
+  t[2][0] = {1.03, 3, 200};
+  t[2][1] = {1.065, 7, 100};
+  return t;
+}();
+// A foot shares its entry's radius and whether candidates expire.
+template <size_t Rows>
+constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
+  for (size_t r = 0; r < Rows; ++r)
+    for (size_t c = 0; c < kTableColumns; ++c)
+      if (feet[r][c].base > 0 &&
+          (feet[r][c].radius != table[r][c].radius || (feet[r][c].lifetime > 0) != (table[r][c].lifetime > 0)))
+        return false;
+  return true;
+}
+static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed));
 constexpr Table<1> kTable4 = {{
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2 and beyond
 }};
+constexpr Table<1> kFeet4{};
 
-// table[row][column]: rows at sides firstSide, 2 firstSide, ...; bilinear in log2 of the side
-// and in eta between rows and columns, held beyond the first and last of each. Radius and
-// lifetime are the heaviest entry's (a step half-way between entries that differ in them), and
-// the base blends the entries that share them, so it is continuous wherever they do not change.
-// Below its row's side a lifetime shrinks in proportion to the side (section 14: against DBM at
-// 724^2 the 1024^2 entries' own lifetimes grew 17-28 % too many cells, the shrunk ones within 3 %).
+// One column's setting at r = log2(side / firstSide) between rows r0 and r1 = r0 + 1 (r0 = r1
+// beyond the last row): an entry with a foot over its reach (above); else the nearer row's radius
+// and lifetime, with the base linear between rows that share them.
 template <size_t Rows>
-Setting tableSetting(const Table<Rows>& table, double firstSide, double side, double eta) {
+Setting columnSetting(const Table<Rows>& table, const Table<Rows>& feet, size_t r0, size_t r1, double re, size_t c) {
+  const Setting &lo = table[r0][c], &hi = table[r1][c], &foot = feet[r1][c];
+  if (r1 > r0 && foot.base > 0 && re > 0) {
+    const double lifetime = hi.lifetime ? foot.lifetime * std::pow(double(hi.lifetime) / foot.lifetime, re) : 0;
+    return {foot.base + re * (hi.base - foot.base), hi.radius, int(std::lround(lifetime))};
+  }
+  if (lo.radius == hi.radius && lo.lifetime == hi.lifetime) return {lo.base + re * (hi.base - lo.base), lo.radius, lo.lifetime};
+  return re <= 0.5 ? lo : hi;
+}
+
+// table[row][column]: rows at sides firstSide, 2 firstSide, ...; in log2 of the side between
+// rows (columnSetting) and linear in eta between columns, held beyond the first and last of
+// each. Radius and lifetime are the nearer column's (a step half-way between columns that differ
+// in them), and the base blends columns that share them.
+template <size_t Rows>
+Setting tableSetting(const Table<Rows>& table, const Table<Rows>& feet, double firstSide, double side, double eta) {
   const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));
   const size_t r0 = std::min(size_t(r), Rows - 1), r1 = std::min(r0 + 1, Rows - 1);
   const double e = std::clamp(eta, kTableEtas[0], kTableEtas[kTableColumns - 1]);
   size_t c0 = 0;
   while (c0 + 2 < kTableColumns && e > kTableEtas[c0 + 1]) ++c0;
   const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]), re = r - double(r0);
-  struct Corner {
-    const Setting* setting;
-    double weight;
-    size_t row;
-  };
-  const Corner corners[] = {{&table[r0][c0], (1 - re) * (1 - ce), r0},
-                            {&table[r0][c0 + 1], (1 - re) * ce, r0},
-                            {&table[r1][c0], re * (1 - ce), r1},
-                            {&table[r1][c0 + 1], re * ce, r1}};
-  const Corner* heaviest = &corners[0];
-  for (const Corner& c : corners)
-    if (c.weight > heaviest->weight) heaviest = &c;
-  const Setting& h = *heaviest->setting;
-  Setting out{0, h.radius, h.lifetime};
-  double weight = 0;
-  for (const Corner& c : corners)
-    if (c.setting->radius == h.radius && c.setting->lifetime == h.lifetime) {
-      out.base += c.weight * c.setting->base;
-      weight += c.weight;
-    }
-  out.base /= weight;
-  const double rowSide = firstSide * double(size_t(1) << heaviest->row);
-  if (out.lifetime > 0 && side < rowSide)
-    out.lifetime = std::max(1, int(std::lround(out.lifetime * side / rowSide)));
-  return out;
+  const Setting s0 = columnSetting(table, feet, r0, r1, re, c0), s1 = columnSetting(table, feet, r0, r1, re, c0 + 1);
+  if (s0.radius == s1.radius && s0.lifetime == s1.lifetime) return {s0.base + ce * (s1.base - s0.base), s0.radius, s0.lifetime};
+  return ce <= 0.5 ? s0 : s1;
 }
 
 // The table's setting for a 2-D grid from radiusFrom() up.
 Setting largeGridSetting(const Params& p) {
   const double longer = std::max(p.width, p.height);
-  if (p.neighbourhood == 4) return tableSetting(kTable4, 512, longer, p.eta);
+  if (p.neighbourhood == 4) return tableSetting(kTable4, kFeet4, 512, longer, p.eta);
   const bool open = std::none_of(p.obstacles.begin(), p.obstacles.end(), [](uint8_t o) { return o != 0; });
-  return open ? tableSetting(kTable8, 256, longer, p.eta) : tableSetting(kTable8Obstructed, 256, longer, p.eta);
+  return open ? tableSetting(kTable8, kFeet8, 256, longer, p.eta)
+              : tableSetting(kTable8Obstructed, kFeet8Obstructed, 256, longer, p.eta);
 }
 
 bool fromTable(const Params& p) { return !p.depth && std::max(p.width, p.height) >= radiusFrom(p); }
