@@ -59,7 +59,7 @@ namespace {
 // DBM at 256^2).
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? 512 : 256; }
 
-// Sections 12-15: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
+// Sections 12-16: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
 // kTableEtas), measured against DBM's bolts: eqn 8's base per cell, the radius N is counted
 // within, and the candidates' lifetime (0 = forever).
 struct Setting {
@@ -114,11 +114,17 @@ constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
         return false;
   return true;
 }
-static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed));
-constexpr Table<1> kTable4 = {{
-    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2 and beyond
+// The 4-neighbourhood (sections 12, 13, 16); at 1024^2, eta 0.5 and 1 are 512^2's held.
+constexpr Table<2> kTable4 = {{
+    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},   // 512^2
+    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.0875, 3, 0}, {1.09, 2, 0}, {1.125, 3, 0}}},  // 1024^2
 }};
-constexpr Table<1> kFeet4{};
+constexpr Table<2> kFeet4 = [] {
+  Table<2> t{};
+  t[1][3] = {1.10, 2, 0};
+  return t;
+}();
+static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed) && feetFit(kTable4, kFeet4));
 
 // One column's setting at r = log2(side / firstSide) between rows r0 and r1 = r0 + 1 (r0 = r1
 // beyond the last row): an entry with a foot over its reach (above); else the nearer row's radius
