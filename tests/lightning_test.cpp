@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -86,11 +85,11 @@ TEST(Fast, LargeGridsCountScreeningWithinRadius3) {
 }
 
 // From 256^2 up base, radius and lifetime come from the table of docs/lightning-calibration.md
-// sections 12-15: the measured values at its grids and etas; the base continuous between them
+// sections 12-16: the measured values at its grids and etas; the base continuous between them
 // wherever radius and lifetime stay (no jump as a client varies the grid or eta), which step only
-// at 512^2 (where an entry with a lifetime reaches down to) and half-way between entries that
-// differ in them; a lifetime never falling as the grid grows; held beyond; the base never rising
-// with the grid.
+// at 512^2 (where the 1024^2 entries' feet start) and half-way between entries that differ in
+// them; a lifetime never falling as the grid grows; held beyond; the base never rising with the
+// grid but at 512^2.
 TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
   auto at = [](int side, double eta, int neighbourhood = 8) {
     Params p = basic(side);
@@ -118,6 +117,11 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
   EXPECT_DOUBLE_EQ(base(512, 3, 4), 1.125);
   // Section 16: the 4-neighbourhood's 1024^2 row; at eta 3 radius 2, from a foot at 513^2.
   EXPECT_DOUBLE_EQ(base(1024, 2, 4), 1.0875);
+  EXPECT_DOUBLE_EQ(base(512, 2, 4), 1.095);
+  EXPECT_NEAR(base(513, 2, 4), 1.105, 1e-4);  // eta 2: radius 2 from the foot up to half-way
+  EXPECT_EQ(at(513, 2, 4).screeningRadius, 2);
+  EXPECT_EQ(at(724, 2, 4).screeningRadius, 2);
+  EXPECT_EQ(at(725, 2, 4).screeningRadius, 3);
   EXPECT_DOUBLE_EQ(base(1024, 3, 4), 1.09);
   EXPECT_EQ(at(1024, 3, 4).screeningRadius, 2);
   EXPECT_EQ(at(4096, 3, 4).screeningRadius, 2);
@@ -193,6 +197,7 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
   auto kind = [](const Params& q) { return std::pair{q.screeningRadius, q.lifetime > 0}; };
   for (int neighbourhood : {8, 4})
     for (int side = neighbourhood == 4 ? 512 : 256; side <= 1100; side += 1) {
+      const bool feetStart = side == 512;  // 1024^2's entries reach down to 513^2 from their feet
       // A column whose radius steps at this side joins or leaves its neighbours' blend there.
       std::vector<std::pair<double, double>> columnSteps;
       for (size_t c = 0; c < std::size(columns); ++c)
@@ -201,8 +206,9 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
       for (double eta = 0.3; eta <= 4.5; eta += 0.01) {
         const Params p = at(side, eta, neighbourhood), e = at(side, eta + 0.01, neighbourhood),
                      g = at(side + 1, eta, neighbourhood);
-        const bool besideStep = std::any_of(columnSteps.begin(), columnSteps.end(),
-                                            [&](auto range) { return eta > range.first && eta < range.second; });
+        const bool besideStep = feetStart || std::any_of(columnSteps.begin(), columnSteps.end(), [&](auto range) {
+                                  return eta > range.first && eta < range.second;
+                                });
         for (const auto& [q, most] : {std::pair{&e, 0.0006}, std::pair{&g, 0.0003}}) {
           // A step: radius, or candidates that expire against ones that do not (the table has no
           // two neighbouring entries with the same radius and different finite lifetimes).
@@ -222,7 +228,7 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
       }
     }
   EXPECT_GT(steps, 0);
-  EXPECT_LT(steps, 6000);  // of 1.2 million pairs: at 512^2 and half-way between columns only
+  EXPECT_LT(steps, 6000);  // of 1.2 million pairs: at 512^2, 724^2 (a foot's radius) and half-way between columns
 }
 
 // Kim et al.'s point-charge potential raised to eta is space-filling at DBM's eta (their

@@ -90,12 +90,12 @@ constexpr Table<3> kTable8 = [] {
 }();
 // Section 15: feet. An entry with a foot reaches down to the row below: just above that row it
 // runs with its foot, the setting measured there, and towards its own row the base goes linearly
-// and the lifetime geometrically in log2 of the side (the radius is the entry's, and so is a
-// lifetime of 0). A foot of base 0 is none. Where an entry differs from the row below in radius
-// or lifetime and has no foot, the step is half-way.
+// and the lifetime geometrically in log2 of the side (a lifetime of 0 stays 0); the radius is the
+// foot's up to half-way, then the entry's. A foot of base 0 is none. Where an entry differs from
+// the row below in radius or lifetime and has no foot, the step is half-way.
 constexpr Table<3> kFeet8Obstructed = [] {
   Table<3> t{};
-  t[2][3] = {1.11, 3, 0};  // radius 3 from 513^2 at eta 3, as before radius 2 came in below
+  t[2][3] = {1.11, 3, 0};  // eta 3: radius 3 from 513^2, from section 12's 512^2 base
   return t;
 }();
 constexpr Table<3> kFeet8 = [] {
@@ -104,23 +104,22 @@ constexpr Table<3> kFeet8 = [] {
   t[2][1] = {1.065, 7, 100};
   return t;
 }();
-// A foot shares its entry's radius and whether candidates expire.
+// A foot's candidates expire where its entry's do.
 template <size_t Rows>
 constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
   for (size_t r = 0; r < Rows; ++r)
     for (size_t c = 0; c < kTableColumns; ++c)
-      if (feet[r][c].base > 0 &&
-          (feet[r][c].radius != table[r][c].radius || (feet[r][c].lifetime > 0) != (table[r][c].lifetime > 0)))
-        return false;
+      if (feet[r][c].base > 0 && (feet[r][c].lifetime > 0) != (table[r][c].lifetime > 0)) return false;
   return true;
 }
 // The 4-neighbourhood (sections 12, 13, 16); at 1024^2, eta 0.5 and 1 are 512^2's held.
 constexpr Table<2> kTable4 = {{
-    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},   // 512^2
+    {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.0875, 3, 0}, {1.09, 2, 0}, {1.125, 3, 0}}},  // 1024^2
 }};
 constexpr Table<2> kFeet4 = [] {
   Table<2> t{};
+  t[1][2] = {1.105, 2, 0};
   t[1][3] = {1.10, 2, 0};
   return t;
 }();
@@ -134,9 +133,10 @@ Setting columnSetting(const Table<Rows>& table, const Table<Rows>& feet, size_t 
   const Setting &lo = table[r0][c], &hi = table[r1][c], &foot = feet[r1][c];
   if (r1 > r0 && foot.base > 0 && re > 0) {
     const double lifetime = hi.lifetime ? foot.lifetime * std::pow(double(hi.lifetime) / foot.lifetime, re) : 0;
-    return {foot.base + re * (hi.base - foot.base), hi.radius, int(std::lround(lifetime))};
+    return {foot.base + re * (hi.base - foot.base), re <= 0.5 ? foot.radius : hi.radius, int(std::lround(lifetime))};
   }
-  if (lo.radius == hi.radius && lo.lifetime == hi.lifetime) return {lo.base + re * (hi.base - lo.base), lo.radius, lo.lifetime};
+  if (lo.radius == hi.radius && lo.lifetime == hi.lifetime)
+    return {lo.base + re * (hi.base - lo.base), lo.radius, lo.lifetime};
   return re <= 0.5 ? lo : hi;
 }
 
@@ -153,7 +153,8 @@ Setting tableSetting(const Table<Rows>& table, const Table<Rows>& feet, double f
   while (c0 + 2 < kTableColumns && e > kTableEtas[c0 + 1]) ++c0;
   const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]), re = r - double(r0);
   const Setting s0 = columnSetting(table, feet, r0, r1, re, c0), s1 = columnSetting(table, feet, r0, r1, re, c0 + 1);
-  if (s0.radius == s1.radius && s0.lifetime == s1.lifetime) return {s0.base + ce * (s1.base - s0.base), s0.radius, s0.lifetime};
+  if (s0.radius == s1.radius && s0.lifetime == s1.lifetime)
+    return {s0.base + ce * (s1.base - s0.base), s0.radius, s0.lifetime};
   return ce <= 0.5 ? s0 : s1;
 }
 

@@ -65,17 +65,19 @@ inline constexpr int kPaperLifetime = 4;
 // ln a = (0.155 + 0.06 min(eta, 3)) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
 // the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
 // longest side). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) base, radius
-// and lifetime come from a table per grid and eta (sections 12-15): N counted within radius 3
+// and lifetime come from a table per grid and eta (sections 12-16): N counted within radius 3
 // (2 at eta 3 up to 512^2) and candidates that never expire, with bases 1.13 at 256^2,
-// 1.085-1.115 at 512^2 and 1.08-1.09 from 1024^2 (8-neighbourhood), 1.095-1.125 from 512^2
-// (4-neighbourhood), rising with eta; at low eta the larger grids need candidates that expire
-// (8-neighbourhood, the 1024^2 entries: at eta 0.5 base 1.015, lifetime 300, for eta up to 0.75;
-// at eta 1 base 1.035, N within radius 7, lifetime 100, for eta 0.75-1.5; on grids with obstacles
-// radius 3 and no lifetime, which would make the guide's legs flood a maze) or radius 5 (4, eta 1
-// and below: base 1.08, for eta up to 1.5). The 1024^2 entries at eta 0.5, 1 and 3 reach down to
-// 513^2 from a foot measured there (1.03 with lifetime 200; 1.065 with 100; 1.11), base linear
-// and lifetime geometric in log L between; elsewhere radius and lifetime are the nearer row's
-// (half-way) and column's, and the base is linear in log L and eta between entries that share them.
+// 1.085-1.115 at 512^2 and 1.08-1.09 from 1024^2 (8-neighbourhood), 1.095-1.125 at 512^2 and
+// 1.0875-1.125 from 1024^2 (4-neighbourhood; radius 2 at eta 3 from 513^2), rising with eta; at
+// low eta the larger grids need candidates that expire (8-neighbourhood, the 1024^2 entries: at
+// eta 0.5 base 1.015, lifetime 300, for eta up to 0.75; at eta 1 base 1.035, N within radius 7,
+// lifetime 100, for eta 0.75-1.5; on grids with obstacles radius 3 and no lifetime, which would
+// make the guide's legs flood a maze) or radius 5 (4, eta 1 and below: base 1.08, for eta up to
+// 1.5). The 1024^2 entries at eta 0.5, 1 and 3 reach down to 513^2 from a foot measured there
+// (1.03 with lifetime 200; 1.065 with 100; 1.11; in the 4-neighbourhood at eta 3 1.10), base
+// linear and lifetime geometric in log L between; elsewhere radius and lifetime are the nearer
+// row's (half-way) and column's, and the base is linear in log L and eta between entries that
+// share them.
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
