@@ -129,7 +129,23 @@ TEST(Fast, LargeGridSettingFollowsTheCalibrationTable) {
   EXPECT_EQ(at(513, 3, 4).screeningRadius, 2);
   EXPECT_NEAR(base(513, 3, 4), 1.10, 1e-4);
   EXPECT_DOUBLE_EQ(base(1024, 4, 4), 1.125);
-  EXPECT_DOUBLE_EQ(base(1024, 1, 4), 1.08);
+  for (double eta : {0.5, 1.0}) {  // open grids: candidates that expire, from a foot at 513^2
+    EXPECT_DOUBLE_EQ(base(1024, eta, 4), 1.015) << eta;
+    EXPECT_EQ(at(1024, eta, 4).lifetime, 75) << eta;
+    EXPECT_EQ(at(1024, eta, 4).screeningRadius, 7) << eta;
+    EXPECT_NEAR(base(513, eta, 4), 1.05, 1e-4) << eta;
+  }
+  {  // with obstacles 512^2's radius 5 and no lifetime, held
+    Params walled = basic(1024);
+    walled.neighbourhood = 4;
+    walled.eta = 1;
+    walled.obstacles.assign(size_t(1024) * 1024, 0);
+    walled.obstacles[size_t(500) * 1024 + 10] = 1;
+    calibrate(walled);
+    EXPECT_EQ(walled.lifetime, 0);
+    EXPECT_DOUBLE_EQ(walled.axisGrowth, 1.08);
+    EXPECT_EQ(calibratedScreeningRadius(walled), 5);
+  }
   EXPECT_DOUBLE_EQ(base(512, 2.5, 4), 0.5 * (1.095 + 1.125));
   EXPECT_DOUBLE_EQ(base(4096, 0.1), base(1024, 0.5));
   EXPECT_DOUBLE_EQ(base(700, 9), base(700, 4));

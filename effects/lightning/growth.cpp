@@ -112,18 +112,30 @@ constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
       if (feet[r][c].base > 0 && (feet[r][c].lifetime > 0) != (table[r][c].lifetime > 0)) return false;
   return true;
 }
-// The 4-neighbourhood (sections 12, 13, 16); at 1024^2, eta 0.5 and 1 are 512^2's held.
-constexpr Table<2> kTable4 = {{
+// The 4-neighbourhood (sections 12, 13, 16); at 1024^2 eta 4 is 512^2's, held.
+constexpr Table<2> kTable4Obstructed = {{
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.0875, 3, 0}, {1.09, 2, 0}, {1.125, 3, 0}}},  // 1024^2
 }};
-constexpr Table<2> kFeet4 = [] {
+constexpr Table<2> kFeet4Obstructed = [] {
   Table<2> t{};
   t[1][2] = {1.105, 2, 0};
   t[1][3] = {1.10, 2, 0};
   return t;
 }();
-static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed) && feetFit(kTable4, kFeet4));
+// Open grids: at 1024^2, eta 1 candidates that expire (one DBM bolt), held at eta 0.5.
+constexpr Table<2> kTable4 = [] {
+  Table<2> t = kTable4Obstructed;
+  t[1][0] = t[1][1] = {1.015, 7, 75};
+  return t;
+}();
+constexpr Table<2> kFeet4 = [] {
+  Table<2> t = kFeet4Obstructed;
+  t[1][0] = t[1][1] = {1.05, 7, 75};
+  return t;
+}();
+static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed) && feetFit(kTable4, kFeet4) &&
+              feetFit(kTable4Obstructed, kFeet4Obstructed));
 
 // One column's setting at r = log2(side / firstSide) between rows r0 and r1 = r0 + 1 (r0 = r1
 // beyond the last row): an entry with a foot over its reach (above); else the nearer row's radius
@@ -161,8 +173,10 @@ Setting tableSetting(const Table<Rows>& table, const Table<Rows>& feet, double f
 // The table's setting for a 2-D grid from radiusFrom() up.
 Setting largeGridSetting(const Params& p) {
   const double longer = std::max(p.width, p.height);
-  if (p.neighbourhood == 4) return tableSetting(kTable4, kFeet4, 512, longer, p.eta);
   const bool open = std::none_of(p.obstacles.begin(), p.obstacles.end(), [](uint8_t o) { return o != 0; });
+  if (p.neighbourhood == 4)
+    return open ? tableSetting(kTable4, kFeet4, 512, longer, p.eta)
+                : tableSetting(kTable4Obstructed, kFeet4Obstructed, 512, longer, p.eta);
   return open ? tableSetting(kTable8, kFeet8, 256, longer, p.eta)
               : tableSetting(kTable8Obstructed, kFeet8Obstructed, 256, longer, p.eta);
 }

@@ -69,15 +69,17 @@ inline constexpr int kPaperLifetime = 4;
 // (2 at eta 3 up to 512^2) and candidates that never expire, with bases 1.13 at 256^2,
 // 1.085-1.115 at 512^2 and 1.08-1.09 from 1024^2 (8-neighbourhood), 1.095-1.125 at 512^2 and
 // 1.0875-1.125 from 1024^2 (4-neighbourhood; radius 2 at eta 3 from 513^2), rising with eta; at
-// low eta the larger grids need candidates that expire (8-neighbourhood, the 1024^2 entries: at
-// eta 0.5 base 1.015, lifetime 300, for eta up to 0.75; at eta 1 base 1.035, N within radius 7,
-// lifetime 100, for eta 0.75-1.5; on grids with obstacles radius 3 and no lifetime, which would
-// make the guide's legs flood a maze) or radius 5 (4, eta 1 and below: base 1.08, for eta up to
-// 1.5). The 1024^2 entries at eta 0.5, 1 and 3 reach down to 513^2 from a foot measured there
-// (1.03 with lifetime 200; 1.065 with 100; 1.11; in the 4-neighbourhood at eta 3 1.10), base
-// linear and lifetime geometric in log L between; elsewhere radius and lifetime are the nearer
-// row's (half-way) and column's, and the base is linear in log L and eta between entries that
-// share them.
+// low eta the larger grids need candidates that expire (the 1024^2 entries of open grids:
+// 8-neighbourhood, eta 0.5: base 1.015, lifetime 300, for eta up to 0.75; eta 1: base 1.035, N
+// within radius 7, lifetime 100, for eta 0.75-1.5; 4-neighbourhood, eta up to 1.5: base 1.015,
+// radius 7, lifetime 75; on grids with obstacles no lifetime, which would make the guide's legs
+// flood a maze) or radius 5 (4-neighbourhood at 512^2, eta 1 and below: base 1.08, for eta up to
+// 1.5). Most 1024^2 entries reach down to 513^2 from a foot measured there (8-neighbourhood: 1.03
+// with lifetime 200 at eta 0.5, 1.065 with 100 at eta 1, 1.11 at eta 3; 4-neighbourhood: 1.05
+// with 75 at eta up to 1, 1.105 with radius 2 at eta 2, 1.10 at eta 3), base linear and
+// lifetime geometric in log L between, the radius the foot's up to half-way; elsewhere radius and
+// lifetime are the nearer row's (half-way) and column's, and the base is linear in log L and eta
+// between entries that share them.
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
