@@ -104,15 +104,19 @@ constexpr Table<3> kFeet8 = [] {
   t[2][1] = {1.065, 7, 100};
   return t;
 }();
-// A foot's candidates expire where its entry's do.
+// A foot stands on a row below its entry, counts N within a radius of at least 1, and its
+// candidates expire where its entry's do.
 template <size_t Rows>
 constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
   for (size_t r = 0; r < Rows; ++r)
-    for (size_t c = 0; c < kTableColumns; ++c)
-      if (feet[r][c].base > 0 && (feet[r][c].lifetime > 0) != (table[r][c].lifetime > 0)) return false;
+    for (size_t c = 0; c < kTableColumns; ++c) {
+      const Setting& f = feet[r][c];
+      if (f.base > 0 && (r == 0 || f.radius < 1 || (f.lifetime > 0) != (table[r][c].lifetime > 0))) return false;
+    }
   return true;
 }
-// The 4-neighbourhood (sections 12, 13, 16); at 1024^2 eta 4 is 512^2's, held.
+// The 4-neighbourhood (sections 12, 13, 16); at 1024^2 eta 4 (and, with obstacles, 0.5 and 1)
+// is 512^2's, held.
 constexpr Table<2> kTable4Obstructed = {{
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.0875, 3, 0}, {1.09, 2, 0}, {1.125, 3, 0}}},  // 1024^2

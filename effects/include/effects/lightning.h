@@ -66,7 +66,7 @@ inline constexpr int kPaperLifetime = 4;
 // the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
 // longest side). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) base, radius
 // and lifetime come from a table per grid and eta (sections 12-16): N counted within radius 3
-// (2 at eta 3 up to 512^2) and candidates that never expire, with bases 1.13 at 256^2,
+// (8-neighbourhood: 2 at eta 3 up to 512^2) and candidates that never expire, bases 1.13 at 256^2,
 // 1.085-1.115 at 512^2 and 1.08-1.09 from 1024^2 (8-neighbourhood), 1.095-1.125 at 512^2 and
 // 1.0875-1.125 from 1024^2 (4-neighbourhood; radius 2 at eta 3 from 513^2), rising with eta; at
 // low eta the larger grids need candidates that expire (the 1024^2 entries of open grids:
