@@ -186,31 +186,38 @@ Setting largeGridSetting(const Params& p) {
 }
 
 bool fromTable(const Params& p) { return !p.depth && std::max(p.width, p.height) >= radiusFrom(p); }
-}  // namespace
 
-double calibratedAxisGrowth(const Params& p) {
+// The calibrated setting of a grid, from one look at its obstacles: the table's from radiusFrom()
+// up (its radius and lifetime for 2-D fast only), else eqn 8's base from the laws below with
+// radius 1 and no lifetime.
+Setting calibratedSetting(const Params& p) {
   if (p.depth) {  // docs/lightning-calibration.md section 10
     const double longest = std::max({3, p.width, p.height, p.depth});
-    return p.neighbourhood == 6 ? std::exp(0.32 * std::pow(32.0 / longest, 0.55))
-                                : std::exp(0.25 * std::pow(32.0 / longest, 0.6));
+    return {p.neighbourhood == 6 ? std::exp(0.32 * std::pow(32.0 / longest, 0.55))
+                                 : std::exp(0.25 * std::pow(32.0 / longest, 0.6)),
+            1, 0};
   }
-  if (fromTable(p)) return largeGridSetting(p).base;
-  if (p.neighbourhood != 4) return kCalibratedAxisGrowth8;
+  if (fromTable(p)) {
+    const Setting s = largeGridSetting(p);
+    return p.method == Method::kFast ? s : Setting{s.base, 1, 0};
+  }
+  if (p.neighbourhood != 4) return {kCalibratedAxisGrowth8, 1, 0};
   const double longer = std::max(3, std::max(p.width, p.height));
-  return std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35));
+  return {std::exp((0.155 + 0.06 * std::min(p.eta, 3.0)) * std::pow(128.0 / longer, 0.35)), 1, 0};
 }
+}  // namespace
 
-int calibratedScreeningRadius(const Params& p) {
-  return p.method == Method::kFast && fromTable(p) ? largeGridSetting(p).radius : 1;
-}
+double calibratedAxisGrowth(const Params& p) { return calibratedSetting(p).base; }
 
-int calibratedLifetime(const Params& p) {
-  return p.method == Method::kFast && fromTable(p) ? largeGridSetting(p).lifetime : 0;
-}
+int calibratedScreeningRadius(const Params& p) { return calibratedSetting(p).radius; }
+
+int calibratedLifetime(const Params& p) { return calibratedSetting(p).lifetime; }
 
 void calibrate(Params& p) {
-  p.axisGrowth = calibratedAxisGrowth(p);
-  p.lifetime = calibratedLifetime(p);
+  const Setting s = calibratedSetting(p);
+  p.axisGrowth = s.base;
+  p.lifetime = s.lifetime;
+  if (p.screeningRadius == 0) p.screeningRadius = s.radius;
 }
 
 int screeningRadius(const Params& p) {

@@ -89,8 +89,8 @@ int calibratedScreeningRadius(const Params& p);
 // Steps a fast candidate lives (0 = forever): the table's lifetime where it holds (from an entry's
 // foot to its row, geometric in the side), else 0.
 int calibratedLifetime(const Params& p);
-// Sets the calibrated defaults the server uses: axisGrowth and lifetime (the radius follows from
-// screeningRadius 0).
+// Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth,
+// lifetime and, where it is 0, screeningRadius.
 void calibrate(Params& p);
 // The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
 // one; 1 for every method but 2-D fast.
