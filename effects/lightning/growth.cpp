@@ -127,15 +127,20 @@ constexpr Table<2> kFeet4Obstructed = [] {
   t[1][3] = {1.10, 2, 0};
   return t;
 }();
-// Open grids: at 1024^2, eta 1 candidates that expire (one DBM bolt), held at eta 0.5.
+// Open grids: candidates that expire at 1024^2, eta 1 (one DBM bolt), and at eta 0.5 from 512^2
+// (section 16: 512^2's 1.08 grew 14 % too few cells there; held beyond, eta 1's entry grew 63 %
+// too few at 724^2).
 constexpr Table<2> kTable4 = [] {
   Table<2> t = kTable4Obstructed;
-  t[1][0] = t[1][1] = {1.015, 7, 75};
+  t[0][0] = {1.03, 7, 200};
+  t[1][0] = {1.0075, 7, 300};
+  t[1][1] = {1.015, 7, 75};
   return t;
 }();
 constexpr Table<2> kFeet4 = [] {
   Table<2> t = kFeet4Obstructed;
-  t[1][0] = t[1][1] = {1.05, 7, 75};
+  t[1][0] = {1.03, 7, 200};
+  t[1][1] = {1.05, 7, 75};
   return t;
 }();
 static_assert(feetFit(kTable8, kFeet8) && feetFit(kTable8Obstructed, kFeet8Obstructed) && feetFit(kTable4, kFeet4) &&
@@ -157,9 +162,9 @@ Setting columnSetting(const Table<Rows>& table, const Table<Rows>& feet, size_t 
 }
 
 // table[row][column]: rows at sides firstSide, 2 firstSide, ...; in log2 of the side between
-// rows (columnSetting) and linear in eta between columns, held beyond the first and last of
-// each. Radius and lifetime are the nearer column's (a step half-way between columns that differ
-// in them), and the base blends columns that share them.
+// rows (columnSetting) and in eta between columns, held beyond the first and last of each.
+// Columns that share the radius and whether candidates expire blend: the base linearly, the
+// lifetime geometrically; elsewhere the nearer column's (a step half-way between columns).
 template <size_t Rows>
 Setting tableSetting(const Table<Rows>& table, const Table<Rows>& feet, double firstSide, double side, double eta) {
   const double r = std::clamp(std::log2(side / firstSide), 0.0, double(Rows - 1));
@@ -169,8 +174,10 @@ Setting tableSetting(const Table<Rows>& table, const Table<Rows>& feet, double f
   while (c0 + 2 < kTableColumns && e > kTableEtas[c0 + 1]) ++c0;
   const double ce = (e - kTableEtas[c0]) / (kTableEtas[c0 + 1] - kTableEtas[c0]), re = r - double(r0);
   const Setting s0 = columnSetting(table, feet, r0, r1, re, c0), s1 = columnSetting(table, feet, r0, r1, re, c0 + 1);
-  if (s0.radius == s1.radius && s0.lifetime == s1.lifetime)
-    return {s0.base + ce * (s1.base - s0.base), s0.radius, s0.lifetime};
+  if (s0.radius == s1.radius && (s0.lifetime > 0) == (s1.lifetime > 0)) {
+    const double lifetime = s0.lifetime ? s0.lifetime * std::pow(double(s1.lifetime) / s0.lifetime, ce) : 0;
+    return {s0.base + ce * (s1.base - s0.base), s0.radius, int(std::lround(lifetime))};
+  }
   return ce <= 0.5 ? s0 : s1;
 }
 
@@ -217,7 +224,6 @@ void calibrate(Params& p) {
   const Setting s = calibratedSetting(p);
   p.axisGrowth = s.base;
   p.lifetime = s.lifetime;
-  if (p.screeningRadius == 0) p.screeningRadius = s.radius;
 }
 
 int screeningRadius(const Params& p) {

@@ -71,26 +71,28 @@ inline constexpr int kPaperLifetime = 4;
 // 1.0875-1.125 from 1024^2 (4-neighbourhood; radius 2 at eta 3 from 513^2), rising with eta; at
 // low eta the larger grids need candidates that expire (the 1024^2 entries of open grids:
 // 8-neighbourhood, eta 0.5: base 1.015, lifetime 300, for eta up to 0.75; eta 1: base 1.035, N
-// within radius 7, lifetime 100, for eta 0.75-1.5; 4-neighbourhood, eta up to 1.5: base 1.015,
-// radius 7, lifetime 75; on grids with obstacles no lifetime, which would make the guide's legs
-// flood a maze) or radius 5 (4-neighbourhood at 512^2, eta 1 and below: base 1.08, for eta up to
-// 1.5). Most 1024^2 entries reach down to 513^2 from a foot measured there (8-neighbourhood: 1.03
-// with lifetime 200 at eta 0.5, 1.065 with 100 at eta 1, 1.11 at eta 3; 4-neighbourhood: 1.05
-// with 75 at eta up to 1, 1.105 with radius 2 at eta 2, 1.10 at eta 3), base linear and
-// lifetime geometric in log L between, the radius the foot's up to half-way; elsewhere radius and
-// lifetime are the nearer row's (half-way) and column's, and the base is linear in log L and eta
-// between entries that share them.
+// within radius 7, lifetime 100, for eta 0.75-1.5; 4-neighbourhood, N within radius 7: eta 1:
+// base 1.015, lifetime 75; eta 0.5: base 1.0075, lifetime 300, and at 512^2 already 1.03 with
+// lifetime 200; on grids with obstacles no lifetime, which would make the guide's legs flood a
+// maze) or radius 5 (4-neighbourhood at 512^2: base 1.08 for eta up to 1.5, on open grids from
+// eta 0.75). Most 1024^2 entries reach down to 513^2 from a foot measured
+// there (8-neighbourhood: 1.03 with lifetime 200 at eta 0.5, 1.065 with 100 at eta 1, 1.11 at
+// eta 3; 4-neighbourhood: 1.03 with 200 at eta 0.5, 1.05 with 75 at eta 1, 1.105 with radius 2
+// at eta 2, 1.10 at eta 3), base linear and lifetime geometric in log L between, the radius the
+// foot's up to half-way; elsewhere radius and lifetime are the nearer row's (half-way). Columns
+// that share the radius and whether candidates expire blend, the base linear and the lifetime
+// geometric in eta; elsewhere the nearer column's.
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
 // eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
 // the paper): the table's radius from 256^2 up (512^2 in the 4-neighbourhood) for 2-D fast, else 1.
 int calibratedScreeningRadius(const Params& p);
-// Steps a fast candidate lives (0 = forever): the table's lifetime where it holds (from an entry's
-// foot to its row, geometric in the side), else 0.
+// Steps a fast candidate lives (0 = forever): the table's lifetime where it holds (geometric in
+// the side from an entry's foot to its row, and in eta between columns), else 0.
 int calibratedLifetime(const Params& p);
-// Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth,
-// lifetime and, where it is 0, screeningRadius.
+// Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth and
+// lifetime (the radius follows from screeningRadius 0 when the bolt grows).
 void calibrate(Params& p);
 // The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
 // one; 1 for every method but 2-D fast.
