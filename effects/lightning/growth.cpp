@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "capacitance.h"
+#include "deep_field.h"
 #include "grid.h"
 #include "laplace.h"
 #include "laplace3.h"
@@ -300,7 +301,8 @@ class Grower {
   double boundary(Cell c);
   std::optional<Error> growSegment(size_t k);
   std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
-  std::unique_ptr<detail::Potential> dbmProblem(Cell target, Solver solver) const;
+  std::unique_ptr<detail::DeepField> dbmProblem(Cell target, Solver solver) const;
+  const std::vector<Cell>& candidateCells();
   void reviveFrontier(int from, size_t segmentFirstNode);
   void weighCandidates(std::vector<double>& logPhi);
   void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
@@ -318,7 +320,9 @@ class Grower {
   detail::CellMap<float> boundaryMemo_;  // kFast 2-D: B per cell once computed (0 = not yet)
   detail::SceneBoundary<detail::BoundaryMap> boundaryMap_;
   detail::SceneBoundary<detail::VolumeBoundary> volumeMap_;  // 3-D
-  std::unique_ptr<detail::Potential> laplace_, reference_;
+  std::unique_ptr<detail::DeepField> laplace_, reference_;
+  std::vector<Cell> probes_;        // the candidates' cells, for DeepField::solve
+  std::vector<double> dbmLogPhi_;   // kDbm: their log Phi from it
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
   // The power the candidates' Phi is raised to: eta, or for kCharges the charges exponent.
@@ -449,10 +453,7 @@ void Grower::logWeights(std::vector<double>& out) {
       for (size_t i = 0; i < cands_.size(); ++i) out[i] = fastLogPhi(cands_[i]);
       break;
     case Method::kDbm:
-      for (size_t i = 0; i < cands_.size(); ++i) {
-        double phi = laplace_->phi(cands_[i].cell);
-        out[i] = phi > 0 ? std::log(phi) : kNegInf;
-      }
+      out = dbmLogPhi_;  // DeepField::solve's, for the candidates in order
       break;
     case Method::kCharges: {
       // Kim et al. 2007: phi_i = sum_j (1 - R1/r_ij), R1 = h/2, with the target as the positive
@@ -588,7 +589,6 @@ size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vect
 double Grower::stepError(const std::vector<double>& logPhi) {
   // Total-variation distance between this method's candidate distribution and the one the
   // converged Laplace solution gives on the same bolt state (over all free bolt neighbours).
-  reference_->solve(Solver::kMgpcg, 1e-10);
   std::vector<double> p;
   const double pSum = candidateWeights(logPhi, exponent_, p);
   for (double& v : p) v /= pSum;
@@ -601,17 +601,11 @@ double Grower::stepError(const std::vector<double>& logPhi) {
     }
   std::sort(cells.begin(), cells.end());
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-  std::vector<double> refPhi(cells.size());
-  double top = 0;
-  for (size_t k = 0; k < cells.size(); ++k) {
-    refPhi[k] = std::max(0.0, reference_->phi(g_.cellAt(cells[k])));
-    top = std::max(top, refPhi[k]);
-  }
-  double refSum = 0;
-  for (double& phi : refPhi) {
-    phi = (p_.eta == 0 || top <= 0) ? 1.0 : std::pow(phi / top, p_.eta);  // now the weight
-    refSum += phi;
-  }
+  probes_.resize(cells.size());
+  for (size_t k = 0; k < cells.size(); ++k) probes_[k] = g_.cellAt(cells[k]);
+  std::vector<double> refLogPhi, refPhi;
+  reference_->solve(Solver::kMgpcg, 1e-10, probes_, refLogPhi);
+  const double refSum = candidateWeights(refLogPhi, p_.eta, refPhi);  // the weights
   double tv = 0;
   std::vector<double> mine(cells.size(), 0.0);
   double outside = 0;  // probability this method puts outside the reference support (none in practice)
@@ -646,7 +640,7 @@ std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
 // The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1.
 // The capacitance solver takes 2-D problems whose fixed cells (obstacles, bolt, target) leave
 // room for the bolt to grow within its direct limit; the rest go to the iterative solvers.
-std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target, Solver solver) const {
+std::unique_ptr<detail::DeepField> Grower::dbmProblem(Cell target, Solver solver) const {
   std::unique_ptr<detail::Potential> lap;
   size_t fixedCells = bolt_.nodes.size() + 1;
   for (uint8_t o : p_.obstacles) fixedCells += o != 0;
@@ -657,11 +651,18 @@ std::unique_ptr<detail::Potential> Grower::dbmProblem(Cell target, Solver solver
     lap = std::make_unique<detail::Laplace3>(p_.width, p_.height, p_.depth);
   else
     lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
+  auto field = std::make_unique<detail::DeepField>(std::move(lap), p_.width, p_.height, p_.depth);
   for (size_t i = 0; i < g_.cells(); ++i)
-    if (!p_.obstacles.empty() && p_.obstacles[i]) lap->fix(g_.cellAt(i), 0.0);
-  for (const Node& n : bolt_.nodes) lap->fix(n.cell, 0.0);
-  lap->fix(target, 1.0);
-  return lap;
+    if (!p_.obstacles.empty() && p_.obstacles[i]) field->fix(g_.cellAt(i), 0.0);
+  for (const Node& n : bolt_.nodes) field->fix(n.cell, 0.0);
+  field->fix(target, 1.0);
+  return field;
+}
+
+const std::vector<Cell>& Grower::candidateCells() {
+  probes_.resize(cands_.size());
+  for (size_t i = 0; i < cands_.size(); ++i) probes_[i] = cands_[i].cell;
+  return probes_;
 }
 
 // Every candidate expired or the sub-bolt is boxed in: the candidates around the segment's
@@ -676,7 +677,7 @@ void Grower::reviveFrontier(int from, size_t segmentFirstNode) {
 // converged solution when measured.
 void Grower::weighCandidates(std::vector<double>& logPhi) {
   if (laplace_) {
-    solverIterations_ += laplace_->solve(p_.solver, p_.tolerance);
+    solverIterations_ += laplace_->solve(p_.solver, p_.tolerance, candidateCells(), dbmLogPhi_);
     (laplace_->direct() ? directSteps_ : iterativeSteps_) += 1;
   }
   logWeights(logPhi);
@@ -750,12 +751,20 @@ std::optional<Error> Grower::growSegment(size_t k) {
       weighCandidates(logPhi);
       pick = sample(logPhi, exponent_, rng_, scratch);
     }
+    if (laplace_ && laplace_->exhausted())
+      return overLimit("/grid", "the field at the bolt fell below 1e-" + std::to_string(5 * detail::DeepField::kMaxStages) +
+                                    " of the target's, beyond what the exact solver resolves");
     Candidate chosen = cands_[pick];
     last = addNode(chosen.cell, chosen.parent);
     addCandidatesAround(last);
     followWaypoints(chosen.cell, waypoints, wp);
   }
-  if (laplace_) lastResidual_ = laplace_->residual();
+  if (laplace_) {
+    lastResidual_ = laplace_->residual();
+    double& deepest = bolt_.stats.counters["deepestStage"];
+    deepest = std::max(deepest, double(laplace_->deepestStage()));
+    bolt_.stats.counters["stageSolves"] += laplace_->stageSolves();
+  }
   ++step_;
   reserved_.at(g_.index(target)) = 0;
   addNode(target, last);

@@ -1,0 +1,165 @@
+#include "deep_field.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
+#include "laplace3.h"
+
+namespace effects::lightning::detail {
+
+DeepField::DeepField(std::unique_ptr<Potential> base, int width, int height, int depth)
+    : w_(width), h_(height), d_(depth), cells_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))),
+      base_(std::move(base)), zero_(cells_, 0) {}
+
+DeepField::~DeepField() = default;
+
+Cell DeepField::cellAt(size_t i) const {
+  const size_t w = size_t(w_), h = size_t(h_);
+  return Cell{int(i % w), int(i / w % h), int(i / (w * h))};
+}
+
+void DeepField::fix(Cell c, double value) {
+  const size_t i = index(c);
+  base_->fix(c, value);
+  if (value == 0.0)
+    zero_[i] = 1;
+  else
+    targets_.emplace_back(c, value);
+  if (!stage_) return;
+  // A cell fixed inside the frozen region (the bolt reached it, which kPop should have
+  // prevented, or a new target) drops the stages down to one where it is an unknown.
+  while (k_ > 0 && (value != 0.0 || (cutStage_[i] != 0 && cutStage_[i] <= k_))) pop();
+  if (stage_) stage_->fix(c, value);
+}
+
+std::unique_ptr<Potential> DeepField::build(int stage) const {
+  std::unique_ptr<Potential> lap;
+  if (d_)
+    lap = std::make_unique<Laplace3>(w_, h_, d_);
+  else
+    lap = std::make_unique<Laplace>(w_, h_);
+  for (size_t i = 0; i < cells_; ++i) {
+    if (zero_[i]) {
+      lap->fix(cellAt(i), 0.0);
+    } else if (stage > 0 && cutStage_[i] != 0 && cutStage_[i] <= stage) {
+      // Cells frozen at earlier stages lie deep inside the region (a neighbour of an unknown is
+      // within a factor 2 d of it, d the dimension); only the newest cut's values reach the
+      // unknowns.
+      lap->fix(cellAt(i), cutStage_[i] == stage ? cutValue_[i] : 0.0);
+    }
+  }
+  if (stage == 0)
+    for (const auto& [c, v] : targets_) lap->fix(c, v);
+  return lap;
+}
+
+double DeepField::largest(const std::vector<Cell>& probes, bool& inRegion) {
+  double top = 0;
+  inRegion = false;
+  const Potential& cur = current();
+  phi_.resize(probes.size());
+  for (size_t i = 0; i < probes.size(); ++i) {
+    if (k_ > 0) {
+      const uint16_t s = cutStage_[index(probes[i])];
+      if (s != 0 && s <= k_) inRegion = true;
+    }
+    phi_[i] = cur.phi(probes[i]);
+    top = std::max(top, phi_[i]);
+  }
+  return top;
+}
+
+void DeepField::deepen() {
+  if (k_ == kMaxStages) {
+    exhausted_ = true;
+    return;
+  }
+  if (cutStage_.empty()) {
+    cutStage_.assign(cells_, 0);
+    cutValue_.assign(cells_, 0.0);
+  }
+  const Potential& cur = current();
+  const uint16_t next = uint16_t(k_ + 1);
+  size_t cut = 0;
+  for (size_t i = 0; i < cells_; ++i) {
+    if (zero_[i] || cutStage_[i]) continue;
+    const double v = cur.phi(cellAt(i));  // the fixed value on fixed cells (the target)
+    if (v >= kCut) {
+      cutStage_[i] = next;
+      cutValue_[i] = v / kCut;
+      ++cut;
+    }
+  }
+  if (cut == 0) {  // no field left to cut at: nothing a further stage could resolve
+    exhausted_ = true;
+    return;
+  }
+  k_ = next;
+  deepest_ = std::max(deepest_, k_);
+  stage_ = build(k_);
+  ++stageSolves_;
+}
+
+void DeepField::pop() {
+  for (size_t i = 0; i < cells_; ++i)
+    if (cutStage_[i] == k_) cutStage_[i] = 0;
+  --k_;
+  if (k_ > 0) {
+    stage_ = build(k_);
+    ++stageSolves_;
+  } else {
+    stage_.reset();
+  }
+}
+
+int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi) {
+  // Stage 0 runs at the request's solver and tolerance while that resolves the candidates to
+  // 1 % (their largest potential at least 100 times the tolerance); below, at a tolerance
+  // relative to that potential, down to kStageTolerance. Cut stages run MGPCG at kStageTolerance.
+  double tol = tolerance;
+  int it = k_ ? current().solve(Solver::kMgpcg, kStageTolerance) : base_->solve(solver, tol);
+  for (int pass = 0; pass < 4 * kMaxStages; ++pass) {  // each pass moves a stage or a tolerance
+    bool inRegion = false;
+    const double top = largest(probes, inRegion);
+    if (k_ > 0 && (inRegion || top > kPop)) {
+      pop();
+      tol = kStageTolerance;
+      it += k_ ? current().solve(Solver::kMgpcg, kStageTolerance) : base_->solve(solver, tol);
+      continue;
+    }
+    if (k_ == 0 && !base_->direct() && top < 100 * tol && tol > kStageTolerance) {
+      tol = std::max(kStageTolerance, std::min(tol * 1e-3, top * 1e-4));
+      it += base_->solve(solver == Solver::kCg ? Solver::kCg : Solver::kMgpcg, tol);
+      continue;
+    }
+    if (top < kDeepen && !exhausted_) {
+      if (k_ == 0 && base_->direct()) {
+        // The capacitance solver's sums cancel at these potentials, and a cut reads every
+        // cell: stage 0 goes over to the iterative solver.
+        base_ = build(0);
+        ++stageSolves_;
+        tol = kStageTolerance;
+        it += base_->solve(Solver::kMgpcg, tol);
+        continue;
+      }
+      if (k_ == 0 && tol > kStageTolerance) {
+        tol = kStageTolerance;
+        it += base_->solve(Solver::kMgpcg, tol);
+        continue;
+      }
+      deepen();
+      if (!exhausted_) {
+        it += stage_->solve(Solver::kMgpcg, kStageTolerance);
+        continue;
+      }
+    }
+    break;
+  }
+  logPhi.resize(probes.size());
+  const double scale = k_ * std::log(kCut);
+  for (size_t i = 0; i < probes.size(); ++i) logPhi[i] = std::log(std::max(phi_[i], DBL_MIN)) + scale;
+  return it;
+}
+
+}  // namespace effects::lightning::detail
