@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 namespace effectd {
 
@@ -65,7 +67,21 @@ class Reader {
   }
 
  private:
-  [[noreturn]] void fail(const char* what) const { throw JsonSyntaxError(size_t(p_ - begin_), what); }
+  [[noreturn]] void fail(const char* what) const { throw JsonSyntaxError(size_t(p_ - begin_), what, false, pointer()); }
+
+  // The JSON pointer of the value being read (RFC 6901), for the error: which field is broken.
+  std::string pointer() const {
+    std::string out;
+    for (const auto& [key, index] : path_) {
+      out += '/';
+      if (!key) {
+        out += std::to_string(index);
+        continue;
+      }
+      for (char c : *key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    }
+    return out;
+  }
 
   void skipSpace() {
     while (p_ != end_ && (*p_ == ' ' || *p_ == '\n' || *p_ == '\r' || *p_ == '\t')) ++p_;
@@ -115,9 +131,12 @@ class Reader {
     out = json::array();
     auto& items = out.get_ref<json::array_t&>();
     if (take(']')) return;
+    path_.emplace_back(nullptr, 0);
     do {
+      path_.back().second = items.size();
       value(items.emplace_back(), depth);
     } while (take(','));
+    path_.pop_back();
     if (!take(']')) fail("expected ',' or ']'");
   }
 
@@ -134,7 +153,9 @@ class Reader {
       key.clear();
       string(key);
       if (!take(':')) fail("expected ':' after a member name");
+      path_.emplace_back(&key, 0);
       value(members[key], depth);  // a repeated name: the last value wins
+      path_.pop_back();
     } while (take(','));
     if (!take('}')) fail("expected ',' or '}'");
   }
@@ -285,6 +306,7 @@ class Reader {
   const char* begin_;
   const char* end_;
   size_t maxDepth_;
+  std::vector<std::pair<const std::string*, size_t>> path_;  // member name (or null) and index per level
 };
 
 }  // namespace

@@ -15,17 +15,21 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
 namespace effectd {
 
-// Why a text is not JSON: a message naming what was expected, at a byte offset.
+// Why a text is not JSON: a message naming what was expected, at a byte offset, and the JSON
+// pointer of the value being read there ("" at the top level).
 struct JsonSyntaxError : std::runtime_error {
-  JsonSyntaxError(size_t offset, const std::string& message, bool tooDeep = false)
-      : std::runtime_error(message + " at byte " + std::to_string(offset)), offset(offset), tooDeep(tooDeep) {}
+  JsonSyntaxError(size_t offset, const std::string& message, bool tooDeep = false, std::string pointer = "")
+      : std::runtime_error(message + " at byte " + std::to_string(offset) + (pointer.empty() ? "" : " (in " + pointer + ")")),
+        offset(offset), tooDeep(tooDeep), pointer(std::move(pointer)) {}
   size_t offset;
-  bool tooDeep;  // refused for nesting deeper than maxDepth
+  bool tooDeep;         // refused for nesting deeper than maxDepth
+  std::string pointer;  // where: "/fog/density", "/mesh/positions/7"
 };
 
 // How deep a client's JSON (a request, a scene file, a glTF's JSON chunk) may nest arrays and

@@ -41,7 +41,7 @@ json parseBody(const std::string& body) {
                    "invalid-json",
                    "Malformed JSON",
                    std::string("request body is not valid JSON: ") + e.what(),
-                   {{"", "not valid JSON"}},
+                   {{e.pointer, "not valid JSON"}},
                    {}};
   }
 }

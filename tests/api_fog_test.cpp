@@ -77,6 +77,25 @@ TEST(FogApi, SmallestTableForAnError) {
   EXPECT_LT(j["table"]["size"].get<int>(), 256);
 }
 
+// A maxError no table within the size limit meets, and a default range beyond the contract's
+// largest number: 422s whose messages carry the numbers (not "0.000000"), naming the field.
+TEST(FogApi, UnreachableErrorAndRangeAre422WithTheirNumbers) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "HEIGHT"}, {"density", 0.05}}}, {"table", {{"maxError", 1e-15}}}};
+  auto p = expectProblem(s.postJson("/v1/fog", req), 422);
+  EXPECT_EQ(p["errors"][0]["pointer"], "/table/maxError");
+  const std::string message = p["errors"][0]["message"];
+  EXPECT_EQ(message.find("0.000000"), std::string::npos) << message;
+  EXPECT_NE(message.find("1e-15"), std::string::npos) << message;
+  // GL_EXP at density 1e-300 reaches 1/255 at 5.5e300, beyond what a request may send back.
+  req = {{"fog", {{"fogType", "GL_EXP"}, {"density", 1e-300}}}, {"table", {{"size", 16}}}};
+  p = expectProblem(s.postJson("/v1/fog", req), 422);
+  EXPECT_EQ(p["errors"][0]["pointer"], "/table/range");
+  req["table"]["range"] = {0, 1e300};
+  auto r = s.postJson("/v1/fog", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+}
+
 TEST(FogApi, RegionsAndSamples) {
   TestServer s;
   json req = {{"fog", {{"fogType", "DISTANCE_EXP2"}, {"distanceCoefficient", 0.01}}},

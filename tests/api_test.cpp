@@ -155,6 +155,17 @@ TEST(Api, MalformedJsonIs400) {
     auto p = expectProblem(s.postJson("/v1/fog", body), 400);
     EXPECT_EQ(p.value("type", ""), "https://effectd.dev/problems/invalid-json") << body;
   }
+  // The pointer names the value being read where the text broke.
+  const std::pair<std::string, std::string> where[] = {{R"({"fog": {"fogType": "GL_EXP", "density": NaN}})", "/fog/density"},
+                                                       {R"({"samples": {"points": [[0, 0, 0], [1, 2, -Infinity]]}})", "/samples/points/1/2"},
+                                                       {R"({"a~b/c": tru})", "/a~0b~1c"},
+                                                       {"{\"fog\": {", "/fog"},
+                                                       {"[1, 2", ""}};
+  for (const auto& [body, pointer] : where) {
+    auto p = expectProblem(s.postJson("/v1/fog", body), 400);
+    ASSERT_EQ(p["errors"].size(), 1u) << body;
+    EXPECT_EQ(p["errors"][0]["pointer"], pointer) << body;
+  }
 }
 
 TEST(Api, DeepNestingIsRefusedQuickly) {

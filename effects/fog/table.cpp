@@ -1,6 +1,8 @@
 // Fog colour tables: sampling, their interpolation error, and the smallest size for an error.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "effects/fog.h"
 
@@ -175,6 +177,13 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
 
 namespace {
 
+// A number for a message, to 3 significant digits ("2.31e-07", not to_string's "0.000000").
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 // Table entries for N distances (and M elevations, for height fog's 2D tables).
 size_t entries(bool twoD, size_t n, size_t m) { return n * (twoD ? m : 1); }
 
@@ -226,8 +235,9 @@ Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD,
     best = errorFor(hi);
     ++measurements;
     if (best.value().maxError > o.maxError && hi == cap)
-      return unsatisfiable("/maxError", "error " + std::to_string(best.value().maxError) +
-                                            " at the size limit is above the requested maximum");
+      return unsatisfiable("/maxError", "error " + shortNumber(best.value().maxError) + " at the size limit (" +
+                                            std::to_string(entries(twoD, hi, hi)) + " entries) is above the requested maximum " +
+                                            shortNumber(o.maxError));
   }
   while (hi - lo > 1) {
     size_t mid = lo + (hi - lo) / 2;
@@ -253,9 +263,12 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   double start = o.rangeStart.value_or(0.0);
   double end = o.rangeEnd ? *o.rangeEnd : completeDistance(fog, o.cameraHeight);
   if (!std::isfinite(start) || start < 0.0) return invalid("/range/0", "must be a finite distance >= 0");
-  if (!o.rangeEnd && !(std::isfinite(end) && end > start))
-    return unsatisfiable("/range", "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) at a finite "
-                                   "distance beyond range[0]; give range explicitly");
+  // The contract's numbers stop at 1e300 (common.json's finite): a default range end beyond it
+  // could not be sent back as the request's range.
+  constexpr double kLargestDistance = 1e300;
+  if (!o.rangeEnd && !(std::isfinite(end) && end > start && end <= kLargestDistance))
+    return unsatisfiable("/range", "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) within "
+                                   "1e300 beyond range[0]; give range explicitly");
   if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
 
   constexpr int kSub1D = 8, kSub2D = 4;
