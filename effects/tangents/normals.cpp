@@ -1,21 +1,28 @@
 // Normals for the tangent steps: given ones normalised; missing ones angle-weighted over all
 // corners at the same position, or flat (every corner its own vertex).
+#include <atomic>
+
 #include "steps.h"
 #include "weld.h"
 
 namespace effects::tangents {
 
-// A vertex with no usable triangle gets +z.
-std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel) {
+// A vertex with no usable triangle (or a given normal of zero length) gets +z, counted.
+std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel, size_t& replaced) {
   const size_t n = mesh.positions.size();
   std::vector<dvec3> out(n, dvec3(0));
+  std::atomic<size_t> zero{0};
   if (!mesh.normals.empty()) {
     forRange(parallel, n, kParallelGrain, [&](size_t begin, size_t end) {
+      size_t z = 0;
       for (size_t i = begin; i < end; ++i) {
         dvec3 v = normalizeOrZero(dvec3(mesh.normals[i]));
+        z += !notZero(v);
         out[i] = notZero(v) ? v : dvec3(0, 0, 1);
       }
+      zero += z;
     });
+    replaced = zero;
     return out;
   }
   std::vector<uint32_t> at = weld<3>(n, [&](size_t i, float* k) {
@@ -33,8 +40,10 @@ std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel) {
       sum[at[mesh.indices[t + c]]] += cornerAngle(a, b) * fn;
     }
   }
+  replaced = 0;
   for (size_t i = 0; i < n; ++i) {
     dvec3 v = normalizeOrZero(sum[at[i]]);
+    replaced += !notZero(v);
     out[i] = notZero(v) ? v : dvec3(0, 0, 1);
   }
   return out;

@@ -55,8 +55,9 @@ inline constexpr size_t kParallelGrain = 10000;
 inline constexpr size_t kGroupGrain = 1000;
 
 // A unit normal per vertex: given ones normalised; missing ones angle-weighted over every
-// corner at the same position (welded, weld.h); +z where no triangle has area.
-std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel);
+// corner at the same position (welded, weld.h); +z where no triangle has area or a given normal
+// has zero length (`replaced` counts those vertices).
+std::vector<dvec3> vertexNormals(const Mesh& mesh, Parallel* parallel, size_t& replaced);
 // Every corner its own vertex with the face normal (glTF's rule for meshes without normals);
 // cornerToInput[c] = the input vertex of corner c.
 Mesh flatExpanded(const Mesh& mesh, std::vector<uint32_t>& cornerToInput);

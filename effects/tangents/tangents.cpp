@@ -84,7 +84,8 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   const Mesh& mesh = flat ? expanded : meshIn;
   const size_t triCount = mesh.indices.size() / 3;
   // 2. A unit normal per vertex.
-  const std::vector<dvec3> normals = vertexNormals(mesh, options.parallel);
+  size_t replacedNormals = 0;
+  const std::vector<dvec3> normals = vertexNormals(mesh, options.parallel, replacedNormals);
   // 3. A tangent per corner by the requested method; MikkTSpace also when it is the reference.
   const bool needMikk = options.mode == Mode::kMikkTSpace || options.measureError;
   MikkStats mikkStats;
@@ -115,7 +116,8 @@ Result<Output> generate(const Mesh& meshIn, const Options& options) {
   st.counters = {{"triangles", double(triCount)},
                  {"inputVertices", double(meshIn.positions.size())},
                  {"outputVertices", double(out.remap.size())},
-                 {"fallbackCorners", double(fallbacks)}};
+                 {"fallbackCorners", double(fallbacks)},
+                 {"replacedNormals", double(replacedNormals)}};  // zero-length: +z
   if (needMikk) {
     st.counters["degenerateTriangles"] = double(mikkStats.degenerateTriangles);
     st.counters["zeroUvAreaTriangles"] = double(mikkStats.zeroUvArea);
