@@ -1,13 +1,15 @@
 // The error-against-run-time report: every effect's methods and settings on fixed seeds,
-// run time (median of repeats) against error to that effect's reference. Writes
-//   <out>/error-vs-time.md          a table per effect, a plot per effect, a conclusion each
+// run time (median and interquartile range of repeats) against error to that effect's
+// reference. Writes
+//   <out>/error-vs-time.md          a summary (Pareto fronts, a choice per budget), then a table,
+//                                   a plot and a conclusion per section
 //   <out>/error-vs-time.json        the same numbers, for tests and tools
 //   <out>/error-vs-time/<name>.png  log-log plots drawn with gnuplot (Debian's gnuplot-nox)
 //
-//   build/bench/error_report [--quick] [--out DIR] [--no-plots] [--only lightning|lightning3d|fog|tangents|film]
-// Default DIR is docs/. --quick is the reduced configuration the test suite runs. --only
-// measures one effect and replaces its sections in the existing report (the others keep the
-// numbers of the run that made them).
+//   build/bench/error_report [--quick] [--out DIR] [--no-plots] [--stamp TEXT]
+// Default DIR is docs/. --quick is the reduced configuration the test suite runs. --stamp is the
+// line naming the command, commit, date and machine (scripts/report.sh passes it). Every section
+// comes from this one run: the report is regenerated whole (scripts/report.sh).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -46,7 +48,38 @@ struct Point {
   double ms = 0;        // median run time
   double error = 0;     // against the section's reference
   std::string note;     // extra column
+  double q1 = 0, q3 = 0;  // the run time's interquartile range (repeats, or seeds for bolts)
+  int repeats = 0;
+  std::string group;  // what a client fixes before choosing (a grid, a fog type, a mesh): the
+                      // summary's Pareto fronts and choices are per group
 };
+
+// Median and quartiles (linear between order statistics) of run times.
+struct Timing {
+  double median = 0, q1 = 0, q3 = 0;
+  int n = 0;
+};
+Timing spreadOf(std::vector<double> v) {
+  Timing t;
+  t.n = int(v.size());
+  if (v.empty()) return t;
+  std::sort(v.begin(), v.end());
+  auto q = [&](double f) {
+    const double at = f * double(v.size() - 1);
+    const size_t i = size_t(at);
+    return i + 1 < v.size() ? v[i] + (v[i + 1] - v[i]) * (at - double(i)) : v[i];
+  };
+  t.median = q(0.5), t.q1 = q(0.25), t.q3 = q(0.75);
+  return t;
+}
+Point pointOf(std::string series, std::string setting, const Timing& t, double error, std::string note = "") {
+  Point p;
+  p.series = std::move(series), p.setting = std::move(setting), p.error = error, p.note = std::move(note);
+  p.ms = t.median, p.q1 = t.q1, p.q3 = t.q3, p.repeats = t.n;
+  return p;
+}
+// Whether two run times are a tie: their interquartile ranges overlap.
+bool tie(const Point& a, const Point& b) { return a.q1 <= b.q3 && b.q1 <= a.q3; }
 
 struct Section {
   std::string id, title, reference, errorName, timeName, settingName, noteName;
@@ -55,19 +88,14 @@ struct Section {
   double timeScale = 1;  // ms -> the unit shown (1000 for us)
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
-double timeMs(int repeats, const std::function<void()>& f) {
+Timing timeMs(int repeats, const std::function<void()>& f) {
   std::vector<double> t;
   for (int i = 0; i < repeats; ++i) {
     effects::Stopwatch w;
     f();
     t.push_back(w.ms());
   }
-  return median(t);
+  return spreadOf(t);
 }
 
 std::string fmt(double v, int digits = 3) {
@@ -198,15 +226,18 @@ void lightningRows(bool quick, int n, int hood, bool volume, Section& tv, Sectio
     const auto [mean, sd] = meanSd(dims);
     // One curve per method, grid and neighbourhood; the setting varies along it.
     const std::string series = s.series + " " + grid;
-    fd.points.push_back({series, s.setting, median(times), std::abs(mean - dRef),
-                         fmt(mean, 3) + " ± " + fmt(sd, 2) + " (" + std::to_string(dims.size()) + " seeds)"});
+    const Timing t = spreadOf(times);  // over seeds: each seed is a different bolt
+    fd.points.push_back(pointOf(series, s.setting, t, std::abs(mean - dRef),
+                                fmt(mean, 3) + " ± " + fmt(sd, 2) + " (" + std::to_string(dims.size()) + " seeds)"));
+    fd.points.back().group = grid;
     if (tvs.empty()) continue;
     const auto [tvMean, tvSd] = meanSd(tvs);
-    tv.points.push_back({series, s.setting, median(times), tvMean,
-                         "± " + fmt(tvSd, 2) + " (" + std::to_string(tvs.size()) + " seeds)"});
+    tv.points.push_back(pointOf(series, s.setting, t, tvMean, "± " + fmt(tvSd, 2) + " (" + std::to_string(tvs.size()) + " seeds)"));
+    tv.points.back().group = grid;
   }
-  fd.points.push_back({"dbm reference " + grid, "D_ref", 0, 0,
-                       fmt(dRef, 3) + " ± " + fmt(dRefSd, 2) + " (" + std::to_string(refD.size()) + " seeds)"});
+  fd.points.push_back(pointOf("dbm reference " + grid, "D_ref", Timing{}, 0,
+                              fmt(dRef, 3) + " ± " + fmt(dRefSd, 2) + " (" + std::to_string(refD.size()) + " seeds)"));
+  fd.points.back().group = grid;
 }
 
 void lightning(bool quick, Section& tv, Section& fd) {
@@ -222,7 +253,8 @@ void lightning(bool quick, Section& tv, Section& fd) {
       {}};
   fd = {"lightning-fd",
         "Lightning: fractal dimension against DBM",
-        "mean box-counting dimension D_ref of DBM (MGPCG, tolerance 1e-8) at the same size and seeds",
+        "mean box-counting dimension D_ref of exact DBM (the default solver: the capacitance method while its limit "
+        "allows, then MGPCG at tolerance 1e-8) at the same size and seeds",
         "abs(mean D − D_ref)",
         "ms per bolt (median)",
         "setting",
@@ -232,6 +264,84 @@ void lightning(bool quick, Section& tv, Section& fd) {
   const std::vector<int> sizes = quick ? std::vector<int>{32} : std::vector<int>{64, 128, 256};
   for (int n : sizes)
     for (int hood : {8, 4}) lightningRows(quick, n, hood, false, tv, fd);
+}
+
+// What a player sees, against exact DBM over seeds: cells, tips and D (lt::shapeDistance: each
+// difference in standard errors of the two means), in the open layout and in a 3-wide channel
+// whose field ahead of the bolt falls far below double's range (DeepField). A bolt that fills
+// its channel scores in the hundreds.
+void lightningShape(bool quick, Section& out) {
+  out = {"lightning-shape",
+         "Lightning: cells, tips and D against exact DBM, in seed-noise units",
+         "exact DBM (capacitance, then MGPCG at 1e-8; DeepField below 1e-8) on the same layout over as many seeds",
+         "largest |mean difference| / standard error of cells, tips, D",
+         "ms per bolt (median)",
+         "setting",
+         "cells, tips, D (method / DBM)",
+         {},
+         {}};
+  const int seeds = quick ? 6 : 20;
+  struct Layout {
+    std::string name;
+    lt::Params params;
+  };
+  std::vector<Layout> layouts;
+  for (int n : quick ? std::vector<int>{32} : std::vector<int>{64, 128}) layouts.push_back({std::to_string(n) + "² open", layoutOf(n, false)});
+  {
+    const int length = quick ? 128 : 512;
+    lt::Params c = layoutOf(32, false);
+    c.width = 3, c.height = length;
+    c.start = {1, 0};
+    c.targets = {{1, length - 1}};
+    lt::calibrate(c);
+    layouts.push_back({"3 × " + std::to_string(length) + " channel", c});
+  }
+  for (const Layout& l : layouts) {
+    auto shapes = [&](lt::Params p, std::vector<double>* times) {
+      std::vector<lt::BoltShape> v;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        p.seed = uint64_t(seed);
+        auto b = lt::grow(p);
+        if (!b.ok()) continue;
+        v.push_back(lt::shapeOf(b.value(), p.width, p.height, p.depth));
+        if (times) times->push_back(b.value().stats.elapsedMs);
+      }
+      return v;
+    };
+    lt::Params ref = l.params;
+    ref.method = lt::Method::kDbm;
+    ref.tolerance = 1e-8;
+    std::vector<double> refTimes;
+    const auto refShapes = shapes(ref, &refTimes);
+    std::vector<std::pair<std::string, lt::Params>> settings;
+    settings.push_back({"fast calibrated", l.params});
+    lt::Params paper = l.params;
+    paper.axisGrowth = lt::kPaperAxisGrowth, paper.lifetime = 4;
+    settings.push_back({"fast paper (lifetime 4)", paper});
+    lt::Params charges = l.params;
+    charges.method = lt::Method::kCharges;
+    settings.push_back({"charges calibrated", charges});
+    for (double tol : {1e-1, 1e-2, 1e-4}) {
+      lt::Params d = l.params;
+      d.method = lt::Method::kDbm, d.solver = lt::Solver::kMgpcg, d.tolerance = tol;
+      settings.push_back({"dbm-mgpcg tol " + fmt(tol, 1), d});
+    }
+    for (const auto& [name, p] : settings) {
+      std::vector<double> times;
+      const auto d = lt::shapeDistance(shapes(p, &times), refShapes);
+      const std::string note = fmt(d.mean.cells, 4) + " / " + fmt(d.refMean.cells, 4) + ", " + fmt(d.mean.tips, 3) + " / " +
+                               fmt(d.refMean.tips, 3) + ", " + fmt(d.mean.dimension, 3) + " / " + fmt(d.refMean.dimension, 3) +
+                               " (z " + fmt(d.cells, 2) + ", " + fmt(d.tips, 2) + ", " + fmt(d.dimension, 2) + "; " +
+                               std::to_string(times.size()) + " seeds)";
+      out.points.push_back(pointOf(name.substr(0, name.find(" tol")) + " " + l.name,
+                                   name.find(" tol") == std::string::npos ? "default" : name.substr(name.find(" tol") + 1),
+                                   spreadOf(times), d.worst, note));
+      out.points.back().group = l.name;
+    }
+    out.points.push_back(pointOf("dbm exact " + l.name, "reference", spreadOf(refTimes), 0,
+                                 std::to_string(refShapes.size()) + " seeds"));
+    out.points.back().group = l.name;
+  }
 }
 
 // The same two sections for 3-D grids (26-neighbourhood): 32^3 (16^3 in the quick run).
@@ -298,11 +408,12 @@ void fog(bool quick, Section& tables, Section& march) {
       o.elevations = twoD ? n : 0;
       o.cameraHeight = 5;
       o.measureError = false;
-      const double ms = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
+      const Timing t = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
       o.measureError = true;
       auto table = fg::buildTable(f, o);
-      tables.points.push_back({name, std::to_string(n) + (twoD ? " × " + std::to_string(n) : ""), ms,
-                               table.ok() ? table.value().maxError : NAN, ""});
+      tables.points.push_back(pointOf(name, std::to_string(n) + (twoD ? " × " + std::to_string(n) : ""), t,
+                                      table.ok() ? table.value().maxError : NAN));
+      tables.points.back().group = name;
     }
   };
   for (fg::FogType t :
@@ -342,19 +453,19 @@ void fog(bool quick, Section& tables, Section& march) {
   for (int i = 0; i < 64; ++i) dirs.push_back(-0.3 + 0.6 * i / 63.0);
   auto exact = [&](double dy) { return std::exp(-fg::heightOpticalDepth(a, b, h, oy, dy, dist)); };
   volatile double sink = 0;
-  const double closedMs = timeMs(quick ? 5 : 51, [&] {
+  const Timing closed = timeMs(quick ? 5 : 51, [&] {
     for (double dy : dirs) sink = sink + exact(dy);
   });
-  march.points.push_back({"closed form", "exact", closedMs, 0, ""});
+  march.points.push_back(pointOf("closed form", "exact", closed, 0));
   for (int steps : quick ? std::vector<int>{4, 16, 64} : std::vector<int>{4, 8, 16, 32, 64, 128, 256, 512, 1024}) {
     double worst = 0;
     for (double dy : dirs)
       worst =
           std::max(worst, std::abs(std::exp(-fg::heightOpticalDepthMarched(a, b, h, oy, dy, dist, steps)) - exact(dy)));
-    const double ms = timeMs(quick ? 5 : 21, [&] {
+    const Timing t = timeMs(quick ? 5 : 21, [&] {
       for (double dy : dirs) sink = sink + std::exp(-fg::heightOpticalDepthMarched(a, b, h, oy, dy, dist, steps));
     });
-    march.points.push_back({"ray marching", std::to_string(steps) + " steps", ms, worst, ""});
+    march.points.push_back(pointOf("ray marching", std::to_string(steps) + " steps", t, worst));
   }
 }
 
@@ -380,8 +491,10 @@ void tangents(bool quick, Section& out) {
     for (tg::Mode mode : {tg::Mode::kMikkTSpace, tg::Mode::kPerVertex, tg::Mode::kPerTriangle}) {
       tg::Options o;
       o.mode = mode;
-      const double ms = timeMs(quick ? 3 : 7, [&] { (void)tg::generate(m.mesh, o); }) * per100k;
-      Point p{tg::toString(mode), m.name, ms, 0, "—"};
+      Timing t = timeMs(quick ? 5 : 9, [&] { (void)tg::generate(m.mesh, o); });
+      t.median *= per100k, t.q1 *= per100k, t.q3 *= per100k;
+      Point p = pointOf(tg::toString(mode), m.name, t, 0, "—");
+      p.group = m.name;
       if (mode != tg::Mode::kMikkTSpace) {
         o.measureError = true;
         auto r = tg::generate(m.mesh, o);
@@ -398,7 +511,7 @@ void tangents(bool quick, Section& out) {
 void thinFilm(bool quick, Section& out) {
   out = {"thin-film",
          "Soap bubble: thin-film colour table against 1 nm spectral sampling",
-         "400 wavelength samples (1 nm) on a 32 x 32 sub-grid of the table",
+         "400 wavelength samples (1 nm) at a 32 x 32 sub-grid of the timed table's own texels",
          "mean CIE76 ΔE*ab",
          quick ? "ms per 64² table (median)" : "ms per 256² table (median)",
          "wavelength samples",
@@ -411,11 +524,10 @@ void thinFilm(bool quick, Section& out) {
     o.width = o.height = quick ? 64 : 256;
     o.wavelengths = w;
     o.measureError = false;
-    const double ms = timeMs(quick ? 1 : (w > 100 ? 3 : 5), [&] { (void)bb::thinFilmTable(o); });
-    o.measureError = true;
-    o.width = o.height = 32;  // the error is measured on the sub-grid either way
+    const Timing time = timeMs(quick ? 3 : 5, [&] { (void)bb::thinFilmTable(o); });
+    o.measureError = true;  // the same table: its texels at a 32 x 32 sub-grid against 1 nm
     auto t = bb::thinFilmTable(o);
-    out.points.push_back({"Airy + CIE 1931", std::to_string(w), ms, t.value().meanDeltaE, fmt(t.value().maxDeltaE, 3)});
+    out.points.push_back(pointOf("Airy + CIE 1931", std::to_string(w), time, t.value().meanDeltaE, fmt(t.value().maxDeltaE, 3)));
   }
 }
 
@@ -486,7 +598,14 @@ void conclude(std::vector<Section>& sections) {
                    ->setting
             << ";";
       }
-      c << " tables cost microseconds, so size them by the error bound, not by time.";
+      const Point* slowest = nullptr;
+      for (const auto& p : s.points)
+        if (!slowest || p.ms > slowest->ms) slowest = &p;
+      const Point* quickest = fastestWithin(s, 1.0);
+      if (slowest && quickest)
+        c << " a table costs " << fmt(quickest->ms * 1000) << " µs (" << quickest->series << " " << quickest->setting
+          << ") to " << fmt(slowest->ms * 1000) << " µs (" << slowest->series << " " << slowest->setting
+          << "); below a millisecond, size a table by its error bound, not by its time.";
     } else if (s.id == "fog-height-march") {
       const Point* exact = &s.points.front();
       const Point* enough = fastestWithin(s, 1.0 / 255, "ray marching");
@@ -503,11 +622,32 @@ void conclude(std::vector<Section>& sections) {
         if (p.series == "perVertex") vert = p.ms, vertErr = p.error;
         if (p.series == "perTriangle") triErr = p.error;
       }
-      c << "On the smooth sphere perVertex is " << fmt(mikk / std::max(vert, 1e-9), 2)
-        << "× faster than MikkTSpace at a mean " << fmt(vertErr, 2) << "° (perTriangle " << fmt(triErr, 2)
-        << "°); but normal maps are baked in MikkTSpace, any mismatch shows as seams, and mirrored UVs break the "
-           "averaged "
-           "frames (see the torus): MikkTSpace is the default for a reason.";
+      const Point *mikkP = nullptr, *vertP = nullptr;
+      for (const auto& p : s.points)
+        if (p.setting == s.points.front().setting) {
+          if (p.series == "mikktspace") mikkP = &p;
+          if (p.series == "perVertex") vertP = &p;
+        }
+      c << "On the smooth sphere perVertex ";
+      if (mikkP && vertP && tie(*mikkP, *vertP))
+        c << "ties with MikkTSpace in time (their interquartile ranges overlap: " << fmt(vert) << " and " << fmt(mikk)
+          << " ms)";
+      else
+        c << "is " << fmt(mikk / std::max(vert, 1e-9), 2) << "× as fast as MikkTSpace";
+      c << " at a mean " << fmt(vertErr, 2) << "° (perTriangle " << fmt(triErr, 2)
+        << "°); normal maps are baked in MikkTSpace, any mismatch shows as seams, and mirrored UVs break the "
+           "averaged frames (see the torus): MikkTSpace is the default.";
+    } else if (s.id == "lightning-shape") {
+      c << "Indistinguishable from exact DBM at these seeds (every measure within 2 standard errors):";
+      bool any = false;
+      for (const auto& p : s.points)
+        if (p.setting != "reference" && p.error <= 2) c << " " << p.series << " " << p.setting << ";", any = true;
+      if (!any) c << " none;";
+      c << " furthest:";
+      const Point* far = nullptr;
+      for (const auto& p : s.points)
+        if (p.setting != "reference" && (!far || p.error > far->error)) far = &p;
+      if (far) c << " " << far->series << " " << far->setting << " (" << fmt(far->error, 3) << " standard errors: " << far->note << ").";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
       if (jnd)
@@ -519,11 +659,100 @@ void conclude(std::vector<Section>& sections) {
 }
 
 // ---- output -------------------------------------------------------------------------------------
+// A section's time as shown: the median and, over several repeats, its interquartile range.
+std::string timeText(const Section& s, const Point& p) {
+  if (p.ms <= 0) return "—";
+  std::string t = fmt(p.ms * s.timeScale);
+  if (p.repeats > 1) t += " [" + fmt(p.q1 * s.timeScale) + ", " + fmt(p.q3 * s.timeScale) + "]";
+  return t;
+}
+
+// The points of a group that no other point beats on both axes (as fast or faster and strictly
+// closer), fastest first.
+std::vector<const Point*> paretoFront(const Section& s, const std::string& group) {
+  std::vector<const Point*> pts;
+  for (const auto& p : s.points)
+    if (p.group == group && p.ms > 0 && std::isfinite(p.error)) pts.push_back(&p);
+  std::sort(pts.begin(), pts.end(), [](const Point* a, const Point* b) { return a->ms < b->ms || (a->ms == b->ms && a->error < b->error); });
+  std::vector<const Point*> front;
+  for (const Point* p : pts)
+    if (front.empty() || p->error < front.back()->error) front.push_back(p);
+  return front;
+}
+
+// The budgets a client chooses by: a slice of a frame, a loading screen, offline baking.
+struct Budget {
+  const char* name;
+  double ms;
+};
+constexpr Budget kBudgets[] = {{"interactive (≤ 1 ms)", 1.0}, {"loading screen (≤ 100 ms)", 100.0}, {"offline (any time)", INFINITY}};
+
+// The closest point of a group whose median time fits the budget (ties in error: the faster).
+const Point* choiceWithin(const Section& s, const std::string& group, double budgetMs) {
+  const Point* best = nullptr;
+  for (const auto& p : s.points)
+    if (p.group == group && p.ms > 0 && p.ms <= budgetMs && std::isfinite(p.error) &&
+        (!best || p.error < best->error || (p.error == best->error && p.ms < best->ms)))
+      best = &p;
+  return best;
+}
+
+// A section's groups in report order.
+std::vector<std::string> groupsOf(const Section& s) {
+  std::vector<std::string> out;
+  for (const auto& p : s.points)
+    if (std::find(out.begin(), out.end(), p.group) == out.end()) out.push_back(p.group);
+  return out;
+}
+
+// The summary at the top: per section and group, its Pareto front of error against time and the choice
+// for each budget, all read off the numbers below.
+std::string summaryMarkdown(const std::vector<Section>& sections) {
+  std::ostringstream md;
+  md << "## Summary: what to choose\n\n"
+     << "Per section and what a client fixes first (a grid, a fog type, a mesh): the **Pareto front** (no other setting is as fast and closer to the reference), fastest "
+        "first, and the closest setting whose median time fits each budget. Times are per the section's unit; "
+        "error 0 is the reference itself. Computed from the tables below by the generator, not written by hand.\n\n"
+     << "| section | error metric | Pareto front (time, error) |";
+  for (const Budget& b : kBudgets) md << " " << b.name << " |";
+  md << "\n|---|---|---|";
+  for (size_t i = 0; i < std::size(kBudgets); ++i) md << "---|";
+  md << "\n";
+  for (const Section& s : sections) {
+    const std::string unit = s.timeScale == 1000 ? " µs" : " ms";
+    auto show = [&](const Point* p) {
+      return p->series + " " + p->setting + " (" + fmt(p->ms * s.timeScale) + unit + ", " + fmt(p->error, 2) + ")";
+    };
+    for (const std::string& group : groupsOf(s)) {
+      md << "| " << s.title << (group.empty() ? "" : ": " + group) << " | " << s.errorName << " (time: " << s.timeName
+         << ") | ";
+      const auto front = paretoFront(s, group);
+      for (size_t i = 0; i < front.size(); ++i) md << (i ? " → " : "") << show(front[i]);
+      md << " |";
+      for (const Budget& b : kBudgets) {
+        const Point* c = choiceWithin(s, group, b.ms);
+        md << " " << (c ? show(c) : std::string("nothing fits")) << " |";
+      }
+      md << "\n";
+    }
+  }
+  md << "\n";
+  return md.str();
+}
+
 void plot(const Section& s, const fs::path& dir) {
   std::map<std::string, std::vector<const Point*>> series;
+  double floorError = INFINITY;
   for (const auto& p : s.points)
-    if (p.ms > 0 && p.error > 0 && std::isfinite(p.error)) series[p.series].push_back(&p);
-  if (series.empty()) return;
+    if (p.ms > 0 && p.error > 0 && std::isfinite(p.error)) series[p.series].push_back(&p), floorError = std::min(floorError, p.error);
+  // Error 0 (a reference, an exact method) has no place on a log axis: drawn at the floor, a
+  // decade under the smallest nonzero error, with its own marker.
+  std::vector<const Point*> exact;
+  for (const auto& p : s.points)
+    if (p.ms > 0 && p.error == 0) exact.push_back(&p);
+  if (series.empty() && exact.empty()) return;
+  if (!std::isfinite(floorError)) floorError = 1;
+  const double floorAt = floorError / 10;
   const fs::path data = dir / (s.id + ".dat"), script = dir / (s.id + ".gp");
   std::ofstream d(data);
   for (const auto& [name, pts] : series) {
@@ -531,20 +760,24 @@ void plot(const Section& s, const fs::path& dir) {
     for (const Point* p : pts) d << p->ms * s.timeScale << " " << p->error << "\n";
     d << "\n\n";
   }
+  for (const Point* p : exact) d << "# exact: " << p->series << "\n" << p->ms * s.timeScale << " " << floorAt << "\n\n\n";
   d.close();
   std::ofstream g(script);
+  const size_t curves = series.size() + exact.size();
   // Many curves: the key goes below the plot in three columns and the picture grows to hold it.
-  const bool many = series.size() > 16;
-  const int height = many ? 560 + 15 * int((series.size() + 2) / 3) : 520;
+  const bool many = curves > 16;
+  const int height = many ? 560 + 15 * int((curves + 2) / 3) : 520;
   g << "set terminal pngcairo noenhanced size " << (many ? 1000 : 800) << "," << height << " font 'sans,10'\n"
     << "set output '" << (dir / (s.id + ".png")).string() << "'\n"
     << "set title \"" << s.title << "\"\n"
     << "set logscale xy\nset grid\n"
-    << (many ? "set key outside below maxcols 3 maxrows " + std::to_string((series.size() + 2) / 3) + "\n"
+    << (many ? "set key outside below maxcols 3 maxrows " + std::to_string((curves + 2) / 3) + "\n"
              : std::string("set key outside right top\n"))
-    << "set xlabel \"" << s.timeName << "\"\nset ylabel \"" << s.errorName << "\"\n"
-    << "set format y '%.0e'\n"
-    << "plot ";
+    << "set xlabel \"" << s.timeName << ", log scale\"\nset ylabel \"" << s.errorName
+    << ", log scale" << (exact.empty() ? "" : " (error 0 drawn at the floor, open diamonds)") << "\"\n"
+    << "set format y '%.0e'\n";
+  if (!exact.empty()) g << "set arrow from graph 0, first " << floorAt << " to graph 1, first " << floorAt << " nohead dt 3 lc rgb 'gray'\n";
+  g << "plot ";
   int i = 0;
   for (const auto& [name, pts] : series) {
     // gnuplot cycles 8 colours: past them, another point shape and dashes tell curves apart.
@@ -553,6 +786,9 @@ void plot(const Section& s, const fs::path& dir) {
       << (round == 0 ? 7 : round == 1 ? 5 : 9) << " dt " << (round + 1) << " ps 0.8 title '" << name << "'";
     ++i;
   }
+  for (size_t k = 0; k < exact.size(); ++k, ++i)
+    g << (i ? ", " : "") << "'" << data.string() << "' index " << i << " with points lc " << (i % 8 + 1)
+      << " pt 12 ps 2 title '" << exact[k]->series << " (error 0)'";
   g << "\n";
   g.close();
   const std::string cmd = "gnuplot '" + script.string() + "'";
@@ -566,62 +802,54 @@ std::string sectionMarkdown(const Section& s, bool withPlot, json& entry) {
   std::ostringstream md;
   md << "## " << s.title << "\n\nReference: " << s.reference << ".\n\n";
   if (withPlot) md << "![" << s.title << "](error-vs-time/" << s.id << ".png)\n\n";
-  md << "| method | " << s.settingName << " | " << s.timeName << " | " << s.errorName << " |"
+  md << "| method | " << s.settingName << " | " << s.timeName << " [interquartile range] | " << s.errorName << " |"
      << (s.noteName.empty() ? "" : " " + s.noteName + " |") << "\n|---|---|---|---|"
      << (s.noteName.empty() ? "" : "---|") << "\n";
   json pts = json::array();
   for (const Point& p : s.points) {
-    md << "| " << p.series << " | " << p.setting << " | " << (p.ms > 0 ? fmt(p.ms * s.timeScale) : "—") << " | "
-       << fmt(p.error) << " |" << (s.noteName.empty() ? "" : " " + p.note + " |") << "\n";
+    md << "| " << p.series << " | " << p.setting << " | " << timeText(s, p) << " | " << fmt(p.error) << " |"
+       << (s.noteName.empty() ? "" : " " + p.note + " |") << "\n";
     pts.push_back({{"series", p.series},
                    {"setting", p.setting},
                    {"ms", p.ms},
+                   {"msQ1", p.q1},
+                   {"msQ3", p.q3},
+                   {"repeats", p.repeats},
                    {"error", std::isfinite(p.error) ? json(p.error) : json()},
                    {"note", p.note}});
   }
   md << "\n**Conclusion.** " << s.conclusion << "\n\n";
-  entry = {{"title", s.title},
-           {"errorMetric", s.errorName},
-           {"reference", s.reference},
-           {"points", pts},
-           {"conclusion", s.conclusion}};
+  json front = json::object(), budgets = json::object();
+  for (const std::string& group : groupsOf(s)) {
+    for (const Point* p : paretoFront(s, group)) front[group].push_back(p->series + " " + p->setting);
+    for (const Budget& b : kBudgets) {
+      const Point* c = choiceWithin(s, group, b.ms);
+      budgets[group][b.name] = c ? json(c->series + " " + c->setting) : json();
+    }
+  }
+  entry = {{"title", s.title},      {"errorMetric", s.errorName}, {"reference", s.reference}, {"points", pts},
+           {"conclusion", s.conclusion}, {"pareto", front},        {"budgets", budgets}};
   return md.str();
 }
 
-std::string slurpText(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Writes the report; with `splice`, only `sections` are replaced in an existing report (each
-// from its "## title" line to the next section), the others kept as they were measured.
-void write(const std::vector<Section>& sections, const fs::path& out, bool quick, bool plots, bool splice) {
+// Writes the whole report from this run's sections.
+void write(const std::vector<Section>& sections, const fs::path& out, bool quick, bool plots, const std::string& stamp) {
   fs::create_directories(out / "error-vs-time");
-  const fs::path mdPath = out / "error-vs-time.md", jsonPath = out / "error-vs-time.json";
-  std::string md = splice ? slurpText(mdPath) : "";
-  json j = splice && fs::exists(jsonPath) ? json::parse(slurpText(jsonPath)) : json::object();
-  if (!splice)
-    md = std::string("# Error against run time\n\n") + "Generated by `build/bench/error_report" +
-         (quick ? " --quick" : "") +
-         "` (Release build, this repository's machine; one run). Every number below comes from that command; rerun "
-         "it to regenerate the tables and plots. Times are medians of repeats; errors are measured against each "
-         "effect's reference, named per section.\n\n";
+  json j = json::object();
+  std::string md = std::string("# Error against run time\n\n") +
+                   (stamp.empty() ? "Generated by `build/bench/error_report" + std::string(quick ? " --quick" : "") + "`."
+                                  : stamp) +
+                   " One run: every number below comes from it. Times are the median over repeats (or, for bolts, "
+                   "over seeds) with the interquartile range in brackets; two times whose ranges overlap are a tie. "
+                   "Errors are measured on the configuration that is timed, against each section's reference.\n\n";
+  md += summaryMarkdown(sections);
+  j["stamp"] = stamp;
   for (const Section& s : sections) {
     if (plots) plot(s, out / "error-vs-time");
-    const std::string chunk = sectionMarkdown(s, fs::exists(out / "error-vs-time" / (s.id + ".png")), j[s.id]);
-    const std::string head = "## " + s.title + "\n";
-    const size_t at = splice ? md.find(head) : std::string::npos;
-    if (at == std::string::npos) {
-      md += chunk;
-    } else {
-      const size_t next = md.find("\n## ", at + head.size());
-      md.replace(at, next == std::string::npos ? std::string::npos : next + 1 - at, chunk);
-    }
+    md += sectionMarkdown(s, fs::exists(out / "error-vs-time" / (s.id + ".png")), j[s.id]);
   }
-  std::ofstream(mdPath) << md;
-  std::ofstream(jsonPath) << j.dump(1) << "\n";
+  std::ofstream(out / "error-vs-time.md") << md;
+  std::ofstream(out / "error-vs-time.json") << j.dump(1) << "\n";
 }
 
 }  // namespace
@@ -629,8 +857,7 @@ void write(const std::vector<Section>& sections, const fs::path& out, bool quick
 int main(int argc, char** argv) {
   bool quick = false, plots = true;
   fs::path out = "docs";
-  std::string only;  // one effect's sections, spliced into the existing report
-  const std::vector<std::string> effects = {"lightning", "lightning3d", "fog", "tangents", "film"};
+  std::string stamp;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--quick")
@@ -639,17 +866,12 @@ int main(int argc, char** argv) {
       plots = false;
     else if (a == "--out" && i + 1 < argc)
       out = argv[++i];
-    else if (a == "--only" && i + 1 < argc && std::count(effects.begin(), effects.end(), argv[i + 1]))
-      only = argv[++i];
+    else if (a == "--stamp" && i + 1 < argc)
+      stamp = argv[++i];
     else {
-      std::fprintf(stderr, "usage: error_report [--quick] [--out DIR] [--no-plots] [--only lightning|lightning3d|fog|tangents|film]\n");
+      std::fprintf(stderr, "usage: error_report [--quick] [--out DIR] [--no-plots] [--stamp TEXT]\n");
       return 2;
     }
-  }
-  if (!only.empty() && !fs::exists(out / "error-vs-time.md")) {
-    std::fprintf(stderr, "error_report: --only replaces sections of %s, which does not exist\n",
-                 (out / "error-vs-time.md").c_str());
-    return 2;
   }
   if (plots && std::system("gnuplot --version >/dev/null 2>&1") != 0) {
     std::fprintf(
@@ -660,37 +882,35 @@ int main(int argc, char** argv) {
   std::vector<Section> sections;
   effects::Stopwatch total;
   auto step = [&](const char* what) { std::fprintf(stderr, "[%6.1f s] %s\n", total.ms() / 1000, what); };
-  auto wanted = [&](const std::string& e) { return only.empty() || only == e; };
-  if (wanted("lightning")) {
+  {
     step("lightning");
     Section tv, fd;
     lightning(quick, tv, fd);
     sections.insert(sections.end(), {tv, fd});
   }
-  if (wanted("lightning3d")) {
+  step("lightning shapes");
+  sections.emplace_back();
+  lightningShape(quick, sections.back());
+  {
     step("lightning in 3-D");
     Section tv, fd;
     lightning3d(quick, tv, fd);
     sections.insert(sections.end(), {tv, fd});
   }
-  if (wanted("fog")) {
+  {
     step("fog");
     Section tables, march;
     fog(quick, tables, march);
     sections.insert(sections.end(), {tables, march});
   }
-  if (wanted("tangents")) {
-    step("tangents");
-    sections.emplace_back();
-    tangents(quick, sections.back());
-  }
-  if (wanted("film")) {
-    step("thin film");
-    sections.emplace_back();
-    thinFilm(quick, sections.back());
-  }
+  step("tangents");
+  sections.emplace_back();
+  tangents(quick, sections.back());
+  step("thin film");
+  sections.emplace_back();
+  thinFilm(quick, sections.back());
   conclude(sections);
-  write(sections, out, quick, plots, !only.empty());
+  write(sections, out, quick, plots, stamp);
   step(("wrote " + (out / "error-vs-time.md").string()).c_str());
   return 0;
 }

@@ -653,12 +653,13 @@ TEST(Lightning, MultigridConvergesIndependentlyOfGridAndObstacles) {
       }
   }
   // Warm-started growth: the coarse operators are patched near each new bolt cell, not
-  // rebuilt; a wrong patch would show as many iterations per step.
+  // rebuilt; a wrong patch would show as many iterations per step (each step solves to
+  // tolerance x the candidates' largest potential, about 1e-9 here: DeepField).
   Params p = basic(96, Method::kDbm);
   p.solver = Solver::kMgpcg;
   auto b = grow(p);
   ASSERT_TRUE(b.ok());
-  EXPECT_LE(b.value().stats.counters.at("solverIterations") / b.value().stats.counters.at("steps"), 5.0);
+  EXPECT_LE(b.value().stats.counters.at("solverIterations") / b.value().stats.counters.at("steps"), 7.0);
   EXPECT_LE(b.value().stats.counters.at("residual"), p.tolerance);
 }
 

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <map>
 
 #include <unistd.h>
@@ -41,11 +43,23 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
   ASSERT_TRUE(fs::exists(out / "error-vs-time.md"));
   std::ifstream in(out / "error-vs-time.json");
   const json r = json::parse(in);
-  for (const char* id : {"lightning-tv", "lightning-fd", "lightning3d-tv", "lightning3d-fd", "fog-tables",
-                         "fog-height-march", "tangents", "thin-film"}) {
+  for (const char* id : {"lightning-tv", "lightning-fd", "lightning-shape", "lightning3d-tv", "lightning3d-fd",
+                         "fog-tables", "fog-height-march", "tangents", "thin-film"}) {
     SCOPED_TRACE(id);
     ASSERT_TRUE(r.contains(id));
     EXPECT_FALSE(r[id]["conclusion"].get<std::string>().empty());
+    // Every timed point carries its spread; every group a Pareto front and a choice per budget.
+    for (const auto& p : r[id]["points"]) {
+      if (p["ms"].get<double>() <= 0) continue;
+      EXPECT_GE(p["repeats"].get<int>(), 3) << p;
+      EXPECT_LE(p["msQ1"].get<double>(), p["ms"].get<double>()) << p;
+      EXPECT_GE(p["msQ3"].get<double>(), p["ms"].get<double>()) << p;
+    }
+    ASSERT_FALSE(r[id]["pareto"].empty());
+    for (const auto& [group, front] : r[id]["pareto"].items()) {
+      EXPECT_FALSE(front.empty()) << group;
+      EXPECT_TRUE(r[id]["budgets"][group].contains("offline (any time)")) << group;
+    }
     if (plots) {
       EXPECT_TRUE(fs::exists(out / "error-vs-time" / (std::string(id) + ".png")));
     }
@@ -58,6 +72,18 @@ TEST(ErrorReport, QuickRunWritesTheReportAndErrorsShrinkWhereSettingsConverge) {
     EXPECT_EQ(errorsOf(r["lightning-fd"], "fast calibrated " + grid).size(), 1u) << grid;
     EXPECT_EQ(errorsOf(r["lightning-fd"], "fast paper " + grid, "variant paper").size(), 1u) << grid;
   }
+  // Shapes against exact DBM in seed-noise units, in the open layout and in the 3-wide channel
+  // (where the field ahead of the bolt falls below 1e-40): the reference and three MGPCG
+  // tolerances in each.
+  EXPECT_EQ(errorsOf(r["lightning-shape"], "dbm exact 3 × 128 channel").size(), 1u);
+  EXPECT_EQ(errorsOf(r["lightning-shape"], "dbm-mgpcg 3 × 128 channel").size(), 3u);
+  EXPECT_EQ(errorsOf(r["lightning-shape"], "fast calibrated 32² open").size(), 1u);
+  const std::string md = [&] {
+    std::ifstream m(out / "error-vs-time.md");
+    return std::string(std::istreambuf_iterator<char>(m), {});
+  }();
+  EXPECT_NE(md.find("## Summary: what to choose"), std::string::npos);
+  EXPECT_LT(md.find("## Summary"), md.find("## Lightning"));
   // 3-D: the same, on 16^3 in the 26-neighbourhood.
   expectShrinks(errorsOf(r["lightning3d-tv"], "dbm-mgpcg 16³, 26-nbhd"), "3-D dbm TV over tolerance");
   EXPECT_EQ(errorsOf(r["lightning3d-fd"], "fast calibrated 16³, 26-nbhd").size(), 1u);

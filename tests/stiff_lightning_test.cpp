@@ -109,6 +109,29 @@ TEST(StiffLightning, PocketDepthDoesNotChangeGrowthInIt) {
   EXPECT_NEAR(deep / shallow, 1.0, 0.12);
 }
 
+// The shape measure sees a bolt that fills its channel: against exact DBM in a 3 x 256 channel,
+// other DBM seeds are indistinguishable (every measure within 4 standard errors) and Eden growth
+// (eta 0: the filled channel that exact DBM returned before DeepField) is far off.
+TEST(StiffLightning, ShapeDistanceSeesAFilledChannel) {
+  auto shapes = [](double eta, uint64_t first, int n) {
+    std::vector<BoltShape> out;
+    for (uint64_t s = first; s < first + uint64_t(n); ++s) {
+      auto r = grow(channel(3, 256, eta, s));
+      EXPECT_TRUE(r.ok());
+      if (r.ok()) out.push_back(shapeOf(r.value(), 3, 256));
+    }
+    return out;
+  };
+  const auto ref = shapes(2, 1, 6);
+  const ShapeDistance same = shapeDistance(shapes(2, 101, 6), ref), filled = shapeDistance(shapes(0, 1, 6), ref);
+  printf("other DBM seeds: z cells %.2f, tips %.2f, D %.2f; filled: z cells %.1f (%.0f against %.0f), tips %.1f, D %.1f\n",
+         same.cells, same.tips, same.dimension, filled.cells, filled.mean.cells, filled.refMean.cells, filled.tips,
+         filled.dimension);
+  EXPECT_LT(same.worst, 4.0);
+  EXPECT_GT(filled.worst, 10.0);
+  EXPECT_GT(filled.cells, 10.0);
+}
+
 // eta -> 0 is uniform growth (Eden): at eta 1e-6 every weight is within 1e-3 of 1, even for
 // candidates whose potential underflows (none may drop out), so the bolt fills the channel as
 // densely as at eta 0.

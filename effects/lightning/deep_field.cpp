@@ -114,23 +114,23 @@ void DeepField::pop() {
 }
 
 int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi) {
-  // Stage 0 runs at the request's solver and tolerance while that resolves the candidates to
-  // 1 % (their largest potential at least 100 times the tolerance); below, at a tolerance
-  // relative to that potential, down to kStageTolerance. Cut stages run MGPCG at kStageTolerance.
-  double tol = tolerance;
-  int it = k_ ? current().solve(Solver::kMgpcg, kStageTolerance) : base_->solve(solver, tol);
-  for (int pass = 0; pass < 4 * kMaxStages; ++pass) {  // each pass moves a stage or a tolerance
+  // The residual goal (relative to ||b||) is the tolerance times the candidates' largest
+  // potential, so that their potentials come out right to about `tolerance` relative wherever
+  // the field is: the last step's largest to start with, then this step's if it fell.
+  int it = 0;
+  double goal = 0;
+  auto run = [&](double g) {
+    goal = g;
+    it += current().solve(k_ ? Solver::kMgpcg : solver, g);
+  };
+  run(std::max(kStageTolerance, tolerance * estimate_));
+  double top = 0;
+  for (int pass = 0; pass < 4 * kMaxStages; ++pass) {  // each pass moves a stage or the goal
     bool inRegion = false;
-    const double top = largest(probes, inRegion);
+    top = largest(probes, inRegion);
     if (k_ > 0 && (inRegion || top > kPop)) {
       pop();
-      tol = kStageTolerance;
-      it += k_ ? current().solve(Solver::kMgpcg, kStageTolerance) : base_->solve(solver, tol);
-      continue;
-    }
-    if (k_ == 0 && !base_->direct() && top < 100 * tol && tol > kStageTolerance) {
-      tol = std::max(kStageTolerance, std::min(tol * 1e-3, top * 1e-4));
-      it += base_->solve(solver == Solver::kCg ? Solver::kCg : Solver::kMgpcg, tol);
+      run(std::max(kStageTolerance, tolerance * top * kCut));
       continue;
     }
     if (top < kDeepen && !exhausted_) {
@@ -139,23 +139,27 @@ int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& p
         // cell: stage 0 goes over to the iterative solver.
         base_ = build(0);
         ++stageSolves_;
-        tol = kStageTolerance;
-        it += base_->solve(Solver::kMgpcg, tol);
+        run(kStageTolerance);
         continue;
       }
-      if (k_ == 0 && tol > kStageTolerance) {
-        tol = kStageTolerance;
-        it += base_->solve(Solver::kMgpcg, tol);
+      if (goal > kStageTolerance) {  // a cut needs the values near kCut right
+        run(kStageTolerance);
         continue;
       }
       deepen();
       if (!exhausted_) {
-        it += stage_->solve(Solver::kMgpcg, kStageTolerance);
+        run(kStageTolerance);
         continue;
       }
+      break;
+    }
+    if (!current().direct() && goal > kStageTolerance && goal > 2 * tolerance * top) {
+      run(std::max(kStageTolerance, tolerance * top));
+      continue;
     }
     break;
   }
+  estimate_ = top > 0 ? top : 1.0;
   logPhi.resize(probes.size());
   const double scale = k_ * std::log(kCut);
   for (size_t i = 0; i < probes.size(); ++i) logPhi[i] = std::log(std::max(phi_[i], DBL_MIN)) + scale;

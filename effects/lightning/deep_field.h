@@ -12,6 +12,8 @@
 // scale is kept beside). A frozen cell's value is right while the bolt is far from it: the
 // bolt's effect on a cell at potential kCut is of the order (P / kCut)^2 relative; when P rises
 // above kPop the stage is dropped and the one below solved again with the bolt as it is now.
+// Every solve stops at a residual of tolerance x P (relative to ||b||, at least kStageTolerance):
+// the request's tolerance is the candidates' relative accuracy, not the target's.
 // Nothing in this is about channels: deep pockets behind obstacles and 3-D tubes take the same
 // path, and a bolt whose candidates stay above kDeepen (every open grid) never leaves stage 0.
 #pragma once
@@ -71,6 +73,7 @@ class DeepField {
   std::unique_ptr<Potential> base_;   // stage 0
   std::unique_ptr<Potential> stage_;  // stage k_ >= 1 (null at stage 0)
   int k_ = 0, deepest_ = 0, stageSolves_ = 0;
+  double estimate_ = 1;             // the candidates' largest potential at the last solve (its stage)
   bool exhausted_ = false;
   std::vector<uint8_t> zero_;       // cells fixed at 0 (outside the problem: obstacles, bolt)
   std::vector<std::pair<Cell, double>> targets_;  // cells stage 0 fixes at a non-zero value

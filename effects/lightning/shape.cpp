@@ -178,4 +178,45 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height, i
                               });
 }
 
+BoltShape shapeOf(const Bolt& bolt, int width, int height, int depth) {
+  std::vector<char> hasChild(bolt.nodes.size(), 0);
+  std::vector<Cell> cells;
+  cells.reserve(bolt.nodes.size());
+  for (const Node& n : bolt.nodes) {
+    if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
+    cells.push_back(n.cell);
+  }
+  BoltShape out;
+  out.cells = double(cells.size());
+  out.tips = double(std::count(hasChild.begin(), hasChild.end(), 0));
+  out.dimension = depth ? fractalDimension(cells, width, height, depth) : fractalDimension(cells, width, height);
+  return out;
+}
+
+ShapeDistance shapeDistance(const std::vector<BoltShape>& method, const std::vector<BoltShape>& reference) {
+  // Mean and the variance of the mean of one measure over a set.
+  auto stats = [](const std::vector<BoltShape>& v, double BoltShape::*m, double& mean, double& varMean) {
+    mean = 0;
+    for (const BoltShape& b : v) mean += b.*m / double(v.size());
+    double var = 0;
+    for (const BoltShape& b : v) var += (b.*m - mean) * (b.*m - mean);
+    varMean = v.size() > 1 ? var / double(v.size() - 1) / double(v.size()) : 0.0;
+  };
+  ShapeDistance d;
+  if (method.empty() || reference.empty()) return d;
+  for (auto [m, z] : {std::pair{&BoltShape::cells, &ShapeDistance::cells}, std::pair{&BoltShape::tips, &ShapeDistance::tips},
+                      std::pair{&BoltShape::dimension, &ShapeDistance::dimension}}) {
+    double ma, va, mr, vr;
+    stats(method, m, ma, va);
+    stats(reference, m, mr, vr);
+    d.mean.*m = ma;
+    d.refMean.*m = mr;
+    const double diff = std::fabs(ma - mr), se = std::sqrt(va + vr);
+    // No spread on either side (a forced bolt): equal is 0, different is a certain difference.
+    d.*z = se > 0 ? diff / se : diff > 1e-12 * std::max(1.0, std::fabs(mr)) ? 1e9 : 0.0;
+    d.worst = std::max(d.worst, d.*z);
+  }
+  return d;
+}
+
 }  // namespace effects::lightning

@@ -135,7 +135,8 @@ struct Params {
                             // in 3-D 26 (faces, edges and corners) or 6 (faces)
   Guide guide = Guide::kAuto;
   Solver solver = Solver::kCapacitance;  // kDbm
-  double tolerance = 1e-6;  // kDbm, iterative solvers: relative residual ||r|| / ||b||, in [1e-12, 1e-1]
+  double tolerance = 1e-6;  // kDbm, iterative solvers: the candidates' relative accuracy (each step
+                            // solves to ||r|| / ||b|| <= tolerance x their largest Phi), in [1e-12, 1e-1]
   uint64_t seed = 1;
   size_t maxSteps = 2'000'000;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
@@ -167,6 +168,21 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height);
 // The same in 3-D: cubes of side 1, 2, 4, ... up to a quarter of the smallest side, the
 // minimum over eight offsets.
 double fractalDimension(const std::vector<Cell>& cells, int width, int height, int depth);
+
+// What a player sees of a bolt, for comparing methods over seeds: cells, tips (cells nothing
+// grew from) and the box-counting dimension D on the bolt's grid.
+struct BoltShape {
+  double cells = 0, tips = 0, dimension = 0;
+};
+BoltShape shapeOf(const Bolt& bolt, int width, int height, int depth = 0);
+// Two sets of bolts (a method's, a reference's; each over seeds) compared on their mean cells,
+// tips and D, each difference in units of its standard error (Welch: sqrt(s_a^2/n_a +
+// s_r^2/n_r)); `worst` is the largest. About 2 or less: indistinguishable at these seeds.
+struct ShapeDistance {
+  double cells = 0, tips = 0, dimension = 0, worst = 0;
+  BoltShape mean, refMean;
+};
+ShapeDistance shapeDistance(const std::vector<BoltShape>& method, const std::vector<BoltShape>& reference);
 
 // ---- for tests and the error report --------------------------------------------------
 // Converged potential of the DBM problem for a given bolt (Phi = 0 on bolt, obstacles and
