@@ -2,10 +2,17 @@
 // the version shipped by Blender): weld, set aside coincident-corner triangles, per-triangle
 // first-order derivatives, edge adjacency, groups by the "4 rule" (a vertex, its connected
 // triangles of one UV orientation), sub-groups by frame agreement (180 degree threshold, the
-// default genTangSpaceDefault uses), angle-weighted averages. It is written in double with
-// explicit stacks instead of recursion, and the neighbour pairing uses a counting sort that
-// yields the same (i0, i1, face) order as the reference's quicksorts.
+// default genTangSpaceDefault uses), angle-weighted averages. The arithmetic that decides a
+// result is the reference's float arithmetic, operation for operation (the "F" helpers below):
+// the per-triangle derivatives, the projections into a vertex's plane, the corner angles and
+// their weighted sum. On a UV sphere whose pole vertices lie sin(pi) ~ 1e-16 apart, a pole
+// triangle's derivative is the difference of two edges that cancels to exactly 0 in float; the
+// reference then drops that triangle's term, and double kept a unit vector along the 1e-16 edge
+// (32 degrees off at the poles). The bookkeeping is written with explicit stacks instead of
+// recursion, and the neighbour pairing uses a counting sort that yields the same (i0, i1, face)
+// order as the reference's quicksorts.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -17,7 +24,20 @@
 namespace effects::tangents {
 namespace {
 
-constexpr double kFloatMin = 1.17549435e-38;  // FLT_MIN: the reference's "not zero" bound on UV area
+// mikktspace.c's SVec3 helpers, in float and in its order of operations (the file is built with
+// -ffp-contract=off: no fused multiply-adds the reference does not do).
+using fvec3 = glm::vec3;
+bool notZeroF(float x) { return std::fabs(x) > FLT_MIN; }
+bool vNotZeroF(const fvec3& v) { return notZeroF(v.x) || notZeroF(v.y) || notZeroF(v.z); }
+float dotF(const fvec3& a, const fvec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+fvec3 scaleF(float f, const fvec3& v) { return fvec3(f * v.x, f * v.y, f * v.z); }
+float lengthF(const fvec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+fvec3 normalizeF(const fvec3& v) { return scaleF(1 / lengthF(v), v); }
+// v projected into the plane of n, normalised where not zero (the reference's "project" steps).
+fvec3 projectF(const fvec3& v, const fvec3& n) {
+  const fvec3 r = v - scaleF(dotF(n, v), n);
+  return vNotZeroF(r) ? normalizeF(r) : r;
+}
 
 // Plain data, filled in whole by initTriInfo (in parallel, so that the threads first touch the
 // pages of their own range). The edge pairing and the groups walk only the links, 16 bytes a
@@ -30,7 +50,7 @@ struct TriLinks {
   uint8_t grouped;  // bit i: corner i has its group
 };
 struct TriDerivatives {
-  dvec3 os, ot;  // unit first-order derivatives, sign-adjusted by orientation (or zero)
+  fvec3 os, ot;  // unit first-order derivatives, sign-adjusted by orientation (or zero)
 };
 
 struct Group {
@@ -92,8 +112,6 @@ class Mikk {
   }
 
  private:
-  dvec3 pos(uint32_t v) const { return dvec3(mesh_.positions[v]); }
-  dvec2 uv(uint32_t v) const { return dvec2(mesh_.uvs[v]); }
   uint32_t corner(size_t g, uint32_t i) const { return tri_[g][i]; }
 
   void initTriInfo() {
@@ -104,20 +122,22 @@ class Mikk {
       TriLinks& ti = links_[g];
       TriDerivatives& d = derivatives_[g];
       ti = {{-1, -1, -1}, false, true, false, 0};
-      d = {dvec3(0), dvec3(0)};
-      dvec3 v1 = pos(corner(g, 0)), v2 = pos(corner(g, 1)), v3 = pos(corner(g, 2));
-      dvec2 t1 = uv(corner(g, 0)), t2 = uv(corner(g, 1)), t3 = uv(corner(g, 2));
-      double t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
-      dvec3 d1 = v2 - v1, d2 = v3 - v1;
-      double area = t21x * t31y - t21y * t31x;  // signed UV area x 2
-      dvec3 os = t31y * d1 - t21y * d2;         // mikktspace.c eq 18
-      dvec3 ot = -t31x * d1 + t21x * d2;        // eq 19
+      d = {fvec3(0), fvec3(0)};
+      const fvec3 &v1 = mesh_.positions[corner(g, 0)], &v2 = mesh_.positions[corner(g, 1)],
+                  &v3 = mesh_.positions[corner(g, 2)];
+      const glm::vec2 &t1 = mesh_.uvs[corner(g, 0)], &t2 = mesh_.uvs[corner(g, 1)], &t3 = mesh_.uvs[corner(g, 2)];
+      const float t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
+      const fvec3 d1 = v2 - v1, d2 = v3 - v1;
+      const float area = t21x * t31y - t21y * t31x;                 // signed UV area x 2
+      const fvec3 os = scaleF(t31y, d1) - scaleF(t21y, d2);         // mikktspace.c eq 18
+      const fvec3 ot = scaleF(-t31x, d1) + scaleF(t21x, d2);        // eq 19
       ti.orientPreserving = area > 0;
-      if (std::abs(area) > kFloatMin) {
-        double lenOs = glm::length(os), lenOt = glm::length(ot), s = ti.orientPreserving ? 1.0 : -1.0;
-        if (lenOs > 0) d.os = (s / lenOs) * os;
-        if (lenOt > 0) d.ot = (s / lenOt) * ot;
-        if (lenOs > 0 && lenOt > 0) ti.groupWithAny = false;
+      if (notZeroF(area)) {
+        const float absArea = std::fabs(area), lenOs = lengthF(os), lenOt = lengthF(ot);
+        const float s = ti.orientPreserving ? 1.0f : -1.0f;
+        if (notZeroF(lenOs)) d.os = scaleF(s / lenOs, os);
+        if (notZeroF(lenOt)) d.ot = scaleF(s / lenOt, ot);
+        if (notZeroF(lenOs / absArea) && notZeroF(lenOt / absArea)) ti.groupWithAny = false;
       } else {
         ti.zeroUvArea = true;
       }
@@ -210,7 +230,6 @@ class Mikk {
     if (left >= 0) stack.push_back(uint32_t(left));
   }
 
-  dvec3 projected(const dvec3& v, const dvec3& n) const { return normalizeOrZero(projectToPlane(v, n)); }
 
   // Reference: GenerateTSpaces + EvalTspace. A face's sub-group is the set of group faces
   // whose projected frames are not opposite to its own (the unit vectors' dot > -1 for both
@@ -228,14 +247,14 @@ class Mikk {
     std::vector<std::pair<std::vector<Member>, dvec3>> subgroups;
     for (size_t g = begin; g < end; ++g) {
       const Group& grp = groups_[g];
-      const dvec3 n = normals_[grp.vertex];
+      const fvec3 n = fvec3(normals_[grp.vertex]);
       const Member* faces = members_.data() + grp.first;
       const size_t k = (g + 1 < groups_.size() ? groups_[g + 1].first : members_.size()) - grp.first;
       os.resize(k);
       ot.resize(k);
       for (size_t a = 0; a < k; ++a) {
-        os[a] = projected(derivatives_[faces[a].face].os, n);
-        ot[a] = projectToPlane(derivatives_[faces[a].face].ot, n);  // normalised below only if needed
+        os[a] = dvec3(projectF(derivatives_[faces[a].face].os, n));
+        ot[a] = dvec3(projectF(derivatives_[faces[a].face].ot, n));
       }
       auto agree = [&](size_t a, size_t b, bool otUnit) {
         if (a == b || links_[faces[a].face].groupWithAny || links_[faces[b].face].groupWithAny) return true;
@@ -251,7 +270,6 @@ class Mikk {
         store(grp, faces, k, evalTSpace(faces, k, os.data(), n));
         continue;
       }
-      for (size_t a = 0; a < k; ++a) ot[a] = normalizeOrZero(ot[a]);
       subgroups.clear();
       std::optional<dvec3> wholeTangent;
       for (size_t a = 0; a < k; ++a) {
@@ -271,7 +289,7 @@ class Mikk {
           auto it = std::find_if(subgroups.begin(), subgroups.end(), same);
           if (it == subgroups.end()) {
             std::vector<dvec3> subsetOs(subset.size());
-            for (size_t i = 0; i < subset.size(); ++i) subsetOs[i] = projected(derivatives_[subset[i].face].os, n);
+            for (size_t i = 0; i < subset.size(); ++i) subsetOs[i] = dvec3(projectF(derivatives_[subset[i].face].os, n));
             subgroups.emplace_back(subset, evalTSpace(subset.data(), subset.size(), subsetOs.data(), n));
             it = subgroups.end() - 1;
           }
@@ -319,25 +337,27 @@ class Mikk {
     }
   }
 
-  // Angle-weighted average of the faces' tangents `os` (already projected into n's plane).
-  // The corners' cosines are taken a batch at a time before their arc cosines, so the
-  // projections of one corner overlap the library calls of another.
-  dvec3 evalTSpace(const Member* faces, size_t count, const dvec3* os, const dvec3& n) const {
+  // Angle-weighted average of the faces' tangents `os` (already projected into n's plane), in
+  // the reference's float arithmetic (EvalTspace). The corners' cosines are taken a batch at a
+  // time before their arc cosines, so the projections of one corner overlap the library calls
+  // of another.
+  dvec3 evalTSpace(const Member* faces, size_t count, const dvec3* os, const fvec3& n) const {
     constexpr size_t kBatch = 16;
-    double cosine[kBatch];
-    dvec3 sum(0);
+    float cosine[kBatch];
+    fvec3 sum(0);
     for (size_t first = 0; first < count; first += kBatch) {
       const size_t last = std::min(count, first + kBatch);
       for (size_t a = first; a < last; ++a) {
         const uint32_t f = faces[a].face, i = faces[a].corner;
-        dvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
-        dvec3 v1 = projected(p0 - p1, n), v2 = projected(p2 - p1, n);
-        cosine[a - first] = std::clamp(glm::dot(v1, v2), -1.0, 1.0);
+        const fvec3 &p1 = mesh_.positions[corner(f, i)], &p0 = mesh_.positions[corner(f, (i + 2) % 3)],
+                    &p2 = mesh_.positions[corner(f, (i + 1) % 3)];
+        const fvec3 v1 = projectF(p0 - p1, n), v2 = projectF(p2 - p1, n);
+        cosine[a - first] = std::clamp(dotF(v1, v2), -1.0f, 1.0f);
       }
       for (size_t a = first; a < last; ++a)
-        if (!links_[faces[a].face].groupWithAny) sum += std::acos(cosine[a - first]) * os[a];
+        if (!links_[faces[a].face].groupWithAny) sum = sum + scaleF(float(std::acos(double(cosine[a - first]))), fvec3(os[a]));
     }
-    return normalizeOrZero(sum);
+    return vNotZeroF(sum) ? dvec3(normalizeF(sum)) : dvec3(0);
   }
 
   // Corners of coincident-corner triangles take the frame of the first healthy corner at the

@@ -14,7 +14,10 @@ import { generateTangents } from 'mikktspace';
 const base = process.argv[2];
 const objFiles = process.argv.slice(3);
 
-function uvSphere(rings, segments) {  // seam at u = 0/1 (duplicated column), poles per segment
+// seam at u = 0/1 (duplicated column), poles per segment. With `poleSlivers` every band keeps
+// both triangles: at the poles one of them joins two pole vertices sin(pi) ~ 1.2e-16 apart, a
+// triangle of area ~1e-16 that is not degenerate to MikkTSpace (its corners differ).
+function uvSphere(rings, segments, poleSlivers = false) {
   const p = [], n = [], uv = [], idx = [];
   for (let r = 0; r <= rings; r++) {
     const th = Math.PI * r / rings;
@@ -28,10 +31,11 @@ function uvSphere(rings, segments) {  // seam at u = 0/1 (duplicated column), po
   for (let r = 0; r < rings; r++)
     for (let s = 0; s < segments; s++) {
       const a = r * row + s, b = a + row;
-      if (r > 0) idx.push(a, a + 1, b);
-      if (r < rings - 1) idx.push(a + 1, b + 1, b);
+      if (r > 0 || poleSlivers) idx.push(a, a + 1, b);
+      if (r < rings - 1 || poleSlivers) idx.push(a + 1, b + 1, b);
     }
-  return { name: 'uv sphere with seam', positions: p, normals: n, uvs: uv, indices: idx };
+  return { name: poleSlivers ? 'uv sphere with 1e-16-area pole triangles' : 'uv sphere with seam', positions: p, normals: n,
+           uvs: uv, indices: idx };
 }
 
 function torus(R, r, nu, nv) {  // seams in both directions
@@ -105,7 +109,7 @@ async function service(mesh) {
   return res.json();
 }
 
-const meshes = [uvSphere(24, 48), torus(1, 0.35, 48, 24), mirrored(40, 20), ...objFiles.map(obj)];
+const meshes = [uvSphere(24, 48), uvSphere(24, 48, true), torus(1, 0.35, 48, 24), mirrored(40, 20), ...objFiles.map(obj)];
 let failed = false;
 for (const mesh of meshes) {
   const out = await service(mesh);
