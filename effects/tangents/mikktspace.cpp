@@ -67,7 +67,7 @@ struct Member {  // a good triangle and which of its corners is the group's vert
 class Mikk {
  public:
   Mikk(const Mesh& mesh, const std::vector<dvec3>& normals, Parallel* parallel, CornerTangents& out)
-      : mesh_(mesh), normals_(normals), parallel_(parallel), out_(out) {}
+      : mesh_(mesh), normals_(normals), parallel_(parallel), out_(out), scale_(powerOfTwoScale(mesh)) {}
 
   MikkStats run() {
     const size_t triCount = mesh_.indices.size() / 3;
@@ -113,6 +113,17 @@ class Mikk {
 
  private:
   uint32_t corner(size_t g, uint32_t i) const { return tri_[g][i]; }
+  // The reference's float squares overflow past |x| ~ 1e19 and underflow below ~1e-19, where its
+  // tangents fall back to the placeholder. Positions beyond 2^+-20 are scaled by a power of two
+  // towards 1, which is exact in float and changes no rounding: the frames are the reference's
+  // at any scale, and bit for bit the same wherever the reference itself does not overflow.
+  static float powerOfTwoScale(const Mesh& m) {
+    float top = 0;
+    for (const glm::vec3& p : m.positions) top = std::max({top, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (!(top > 0) || !std::isfinite(top) || (top >= 0x1p-20f && top <= 0x1p20f)) return 1.0f;
+    return std::ldexp(1.0f, -std::ilogb(top));
+  }
+  fvec3 pos(uint32_t v) const { return scale_ == 1.0f ? mesh_.positions[v] : scaleF(scale_, mesh_.positions[v]); }
 
   void initTriInfo() {
     forRange(parallel_, good_.size(), kParallelGrain, [this](size_t begin, size_t end) { initTriInfo(begin, end); });
@@ -123,8 +134,7 @@ class Mikk {
       TriDerivatives& d = derivatives_[g];
       ti = {{-1, -1, -1}, false, true, false, 0};
       d = {fvec3(0), fvec3(0)};
-      const fvec3 &v1 = mesh_.positions[corner(g, 0)], &v2 = mesh_.positions[corner(g, 1)],
-                  &v3 = mesh_.positions[corner(g, 2)];
+      const fvec3 v1 = pos(corner(g, 0)), v2 = pos(corner(g, 1)), v3 = pos(corner(g, 2));
       const glm::vec2 &t1 = mesh_.uvs[corner(g, 0)], &t2 = mesh_.uvs[corner(g, 1)], &t3 = mesh_.uvs[corner(g, 2)];
       const float t21x = t2.x - t1.x, t21y = t2.y - t1.y, t31x = t3.x - t1.x, t31y = t3.y - t1.y;
       const fvec3 d1 = v2 - v1, d2 = v3 - v1;
@@ -349,8 +359,7 @@ class Mikk {
       const size_t last = std::min(count, first + kBatch);
       for (size_t a = first; a < last; ++a) {
         const uint32_t f = faces[a].face, i = faces[a].corner;
-        const fvec3 &p1 = mesh_.positions[corner(f, i)], &p0 = mesh_.positions[corner(f, (i + 2) % 3)],
-                    &p2 = mesh_.positions[corner(f, (i + 1) % 3)];
+        const fvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
         const fvec3 v1 = projectF(p0 - p1, n), v2 = projectF(p2 - p1, n);
         cosine[a - first] = std::clamp(dotF(v1, v2), -1.0f, 1.0f);
       }
@@ -387,6 +396,7 @@ class Mikk {
   const std::vector<dvec3>& normals_;
   Parallel* parallel_;
   CornerTangents& out_;
+  const float scale_;  // powerOfTwoScale
   std::vector<uint32_t> good_;                // triangles that take part, in input order
   std::vector<std::array<uint32_t, 3>> tri_;  // their welded corners
   Buffer<TriLinks> links_;                    // per good triangle
