@@ -263,7 +263,10 @@ void lightning(bool quick, Section& tv, Section& fd) {
         {}};
   const std::vector<int> sizes = quick ? std::vector<int>{32} : std::vector<int>{64, 128, 256};
   for (int n : sizes)
-    for (int hood : {8, 4}) lightningRows(quick, n, hood, false, tv, fd);
+    for (int hood : {8, 4}) {
+      std::fprintf(stderr, "           %d², %d-neighbourhood\n", n, hood);
+      lightningRows(quick, n, hood, false, tv, fd);
+    }
 }
 
 // What a player sees, against exact DBM over seeds: cells, tips and D (lt::shapeDistance: each
@@ -328,14 +331,17 @@ void lightningShape(bool quick, Section& out) {
     }
     for (const auto& [name, p] : settings) {
       std::vector<double> times;
-      const auto d = lt::shapeDistance(shapes(p, &times), refShapes);
+      const auto methodShapes = shapes(p, &times);
+      const auto d = lt::shapeDistance(methodShapes, refShapes);
+      // Fewer than two bolts on a side (failed growths) have no spread to measure against.
+      const double score = methodShapes.size() < 2 || refShapes.size() < 2 ? NAN : d.worst;
       const std::string note = fmt(d.mean.cells, 4) + " / " + fmt(d.refMean.cells, 4) + ", " + fmt(d.mean.tips, 3) + " / " +
                                fmt(d.refMean.tips, 3) + ", " + fmt(d.mean.dimension, 3) + " / " + fmt(d.refMean.dimension, 3) +
                                " (z " + fmt(d.cells, 2) + ", " + fmt(d.tips, 2) + ", " + fmt(d.dimension, 2) + "; " +
                                std::to_string(times.size()) + " seeds)";
       out.points.push_back(pointOf(name.substr(0, name.find(" tol")) + " " + l.name,
                                    name.find(" tol") == std::string::npos ? "default" : name.substr(name.find(" tol") + 1),
-                                   spreadOf(times), d.worst, note));
+                                   spreadOf(times), score, note));
       out.points.back().group = l.name;
     }
     out.points.push_back(pointOf("dbm exact " + l.name, "reference", spreadOf(refTimes), 0,
@@ -646,7 +652,7 @@ void conclude(std::vector<Section>& sections) {
       c << " furthest:";
       const Point* far = nullptr;
       for (const auto& p : s.points)
-        if (p.setting != "reference" && (!far || p.error > far->error)) far = &p;
+        if (p.setting != "reference" && std::isfinite(p.error) && (!far || p.error > far->error)) far = &p;
       if (far) c << " " << far->series << " " << far->setting << " (" << fmt(far->error, 3) << " standard errors: " << far->note << ").";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
@@ -667,16 +673,20 @@ std::string timeText(const Section& s, const Point& p) {
   return t;
 }
 
-// The points of a group that no other point beats on both axes (as fast or faster and strictly
-// closer), fastest first.
+// The points of a group that no other point beats on both axes (as fast or faster, or tied in
+// time, and strictly closer), fastest first.
 std::vector<const Point*> paretoFront(const Section& s, const std::string& group) {
   std::vector<const Point*> pts;
   for (const auto& p : s.points)
     if (p.group == group && p.ms > 0 && std::isfinite(p.error)) pts.push_back(&p);
   std::sort(pts.begin(), pts.end(), [](const Point* a, const Point* b) { return a->ms < b->ms || (a->ms == b->ms && a->error < b->error); });
+  // Slower but tied in time (interquartile ranges overlap) and closer: it takes the faster's place.
   std::vector<const Point*> front;
-  for (const Point* p : pts)
-    if (front.empty() || p->error < front.back()->error) front.push_back(p);
+  for (const Point* p : pts) {
+    if (!front.empty() && !(p->error < front.back()->error)) continue;
+    while (!front.empty() && tie(*front.back(), *p) && p->error < front.back()->error) front.pop_back();
+    front.push_back(p);
+  }
   return front;
 }
 

@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 quick=0
 [ "${1:-}" = "--quick" ] && quick=1
 scripts/build.sh -DEFFECTD_BENCH=ON >/dev/null
-stamp() { python3 -c 'import sys; sys.path.insert(0, "scripts"); from report_stamp import stamp; print(stamp(sys.argv[1]))' "$1"; }
+stamp() { python3 -c 'import sys; sys.path.insert(0, "scripts"); from report_stamp import stamp; print(stamp(sys.argv[1], "error-vs-time.md"))' "$1"; }
 if [ $quick = 1 ]; then
   out=build/report-quick
   mkdir -p "$out"

@@ -153,9 +153,10 @@ json uniforms(const bb::Params& p, const bb::ThicknessOptions& film, const std::
   return out;
 }
 
-// The wobbled icosphere with its MikkTSpace frames (and per-vertex final vectors and rim
-// when the body gives a camera).
-bb::Mesh buildMesh(const json& body, const bb::Params& params, const bb::Features& features, double t,
+// The icosphere with its MikkTSpace frames (and per-vertex final vectors and rim when the body
+// gives a camera): wobbled at `time` when `wobbled`, else the rest shape (the shader that comes
+// with it displaces the vertices itself).
+bb::Mesh buildMesh(const json& body, const bb::Params& params, const bb::Features& features, double t, bool wobbled,
                    const RequestContext& ctx) {
   const json m = body.value("mesh", json::object());
   bb::MeshOptions o;
@@ -163,8 +164,11 @@ bb::Mesh buildMesh(const json& body, const bb::Params& params, const bb::Feature
   o.maxLevel = kMaxIcosphereLevel;
   o.radius = m.value("radius", 1.0);
   o.t = t;
-  o.wobble = features.wobble;
+  o.wobble = features.wobble && wobbled;
   o.parallel = ctx.parallel;
+  // The rest shape comes with a shader that wobbles it: the same float32 limit holds.
+  if (features.wobble && !wobbled)
+    if (auto e = bb::wobbleFits(params, o.radius)) throwError(*e, ctx.at + "/mesh");
   if (body.contains("camera")) o.camera = toVec3(body["camera"]);
   auto r = bb::icosphere(params, o);
   if (!r.ok()) {
@@ -175,12 +179,13 @@ bb::Mesh buildMesh(const json& body, const bb::Params& params, const bb::Feature
 }
 
 // The mesh as flat arrays; uvOrigin top-left negates tangent w, as /v1/tangents does.
-json meshJson(bb::Mesh mesh, bool topLeft) {
+json meshJson(bb::Mesh mesh, bool topLeft, bool wobbled) {
   if (topLeft)
     for (auto& t : mesh.tangents) t.w = -t.w;
   json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
              {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
-             {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices}};
+             {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices},
+             {"wobbled", wobbled}};
   if (!mesh.finalVectors.empty()) {
     mj["finalVectors"] = flat<3>(mesh.finalVectors);
     mj["rim"] = mesh.rim;
@@ -362,7 +367,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = film ? "thin-film" : "seed000";
   if (body.value("format", "json") == "glb") {  // the whole bubble as one file instead of JSON
-    const bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
+    const bb::Mesh mesh = buildMesh(body, params, features, t, true, ctx);  // no shader in a GLB
     reply.computeMs = mesh.stats.elapsedMs;
     if (film && features.thickness) {
       const bb::ThicknessField field = thicknessField(params, filmOptions, t, ctx);
@@ -385,10 +390,13 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   addShaderParts(body, include, params, features, filmOptions, lights, t, out, reply);
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
-    bb::Mesh mesh = buildMesh(body, params, features, t, ctx);
+    // One wobble, not two: with the shader (whose vertex stage wobbles by uWobble*) the mesh is
+    // the rest shape; alone it carries the wobble at `time`.
+    const bool wobbled = features.wobble && !include.has("shader");
+    bb::Mesh mesh = buildMesh(body, params, features, t, wobbled, ctx);
     reply.computeMs += mesh.stats.elapsedMs;
     stats.push_back(statsJson(mesh.stats));
-    out["mesh"] = meshJson(std::move(mesh), body.value("uvOrigin", "bottom-left") == "top-left");
+    out["mesh"] = meshJson(std::move(mesh), body.value("uvOrigin", "bottom-left") == "top-left", wobbled);
   }
   if (include.has("thickness")) {
     const bb::ThicknessField field = thicknessField(params, filmOptions, t, ctx);
@@ -407,7 +415,7 @@ JsonReply handleBubble(const json& body, const RequestContext& ctx) {
                 {"iridescenceIor", params.n2},
                 {"iridescenceThicknessMinimum", gltf.minNm},
                 {"iridescenceThicknessMaximum", gltf.maxNm}};
-    out["gltf"] = {{"KHR_materials_iridescence", ext}};
+    out["gltf"] = {{"KHR_materials_iridescence", ext}, {"KHR_materials_ior", {{"ior", baseIor(params, gltf)}}}};
     if (film && features.thickness)
       out["gltf"]["thicknessTexture"] =
           "iridescenceThicknessTexture: the thickness texture (include thickness) with G = nm / "

@@ -10,12 +10,12 @@ using nlohmann::json;
 
 namespace {
 
-// KHR_materials_transmission + ior make the film see-through with the right refraction;
-// KHR_materials_iridescence (when the feature is on) gives it thin-film colour.
-// The thickness texture, when there is one, is texture 0.
+// KHR_materials_transmission makes the film see-through; KHR_materials_iridescence (when the
+// film is iridescent) gives it thin-film colour. The thickness texture, when there is one, is
+// texture 0.
 json material(const effects::bubble::Params& p, const GltfFilm& film) {
   json extensions = {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}},
-                     {"KHR_materials_ior", {{"ior", p.n2}}}};
+                     {"KHR_materials_ior", {{"ior", baseIor(p, film)}}}};
   if (film.iridescent) {
     extensions["KHR_materials_iridescence"] = {{"iridescenceFactor", 1.0},
                                                {"iridescenceIor", p.n2},

@@ -23,10 +23,12 @@ namespace {
 constexpr size_t kJsonBodyFactor = 6;
 constexpr size_t kBinaryBodyFactor = 2;  // the bytes and the buffers decoded from them
 // Headers a browser on another origin may read (CORS), and may send.
+// Every header a page may need to read, every X- header the service sends among them
+// (tests/api_tangents_test.cpp EveryXHeaderIsExposedToAllowedOrigins).
 constexpr const char* kExposedHeaders =
-    "ETag, Server-Timing, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, X-Render-Passes, "
-    "X-Shader-Cache, X-Shader-Compile-Ms, "
-    "X-Render-Ms, X-Shader-Variants-Compiled, Retry-After";
+    "ETag, Server-Timing, Retry-After, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, "
+    "X-Render-Passes, X-Render-Ms, X-Shader-Cache, X-Shader-Compile-Ms, X-Shader-Variants-Compiled, X-Tangents, "
+    "X-Frame-Count, X-Frame-Rate, X-Flipbook-Columns, X-Flipbook-Rows, X-Content-Type-Options";
 constexpr const char* kAllowedRequestHeaders = "Content-Type, If-None-Match, X-Request-ID";
 
 // The error handler: a bare status (no body from a handler) gets its problem document.

@@ -1,12 +1,14 @@
 // POST /v1/bubble over HTTP: include-driven output, feature-driven shaders and uniforms,
 // long times, errors.
 #include <cmath>
+#include <tuple>
 #include <cstring>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "codec.h"
+#include "glb.h"
 #include "test_server.h"
 
 namespace effectd::testing {
@@ -115,6 +117,57 @@ TEST(BubbleApi, MeshThinFilmGltfAndMotion) {
   EXPECT_TRUE(j["uniforms"].contains("uThickness"));
   EXPECT_FALSE(j.contains("shader"));
   EXPECT_EQ(j["stats"].size(), 2u);
+}
+
+// One wobble, not two: with the shader (its vertex stage wobbles by uWobble*) the mesh is the
+// rest sphere; asked for alone it carries the wobble at `time`; the answer says which.
+TEST(BubbleApi, MeshWithTheShaderIsTheRestShape) {
+  TestServer s;
+  auto radii = [](const json& mesh) {
+    double lo = 1e9, hi = 0;
+    const auto& p = mesh["positions"];
+    for (size_t i = 0; i + 2 < p.size(); i += 3) {
+      const double r = std::hypot(p[i].get<double>(), p[i + 1].get<double>(), p[i + 2].get<double>());
+      lo = std::min(lo, r), hi = std::max(hi, r);
+    }
+    return std::pair{lo, hi};
+  };
+  json req = {{"time", 3}, {"mesh", {{"level", 2}}}, {"include", {"mesh", "shader", "uniforms"}}};
+  auto r = s.postJson("/v1/bubble", req);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_FALSE(j["mesh"]["wobbled"].get<bool>());
+  EXPECT_NE(j["shader"].dump().find("uWobbleAmplitude"), std::string::npos);
+  auto [lo, hi] = radii(j["mesh"]);
+  EXPECT_NEAR(lo, 1.0, 1e-6);
+  EXPECT_NEAR(hi, 1.0, 1e-6);
+  req["include"] = {"mesh"};
+  j = json::parse(s.postJson("/v1/bubble", req)->body);
+  EXPECT_TRUE(j["mesh"]["wobbled"].get<bool>());
+  std::tie(lo, hi) = radii(j["mesh"]);
+  EXPECT_GT(hi - lo, 0.01);
+}
+
+// The GLB's material: an iridescent film has air behind it (base ior 1, the film's n2 as
+// iridescenceIor), so glTF viewers' iridescence shows over the whole face; without iridescence
+// the base is the film's index.
+TEST(BubbleApi, GlbBaseIorIsAirBehindAnIridescentFilm) {
+  TestServer s;
+  auto materialOf = [&](const json& req) {
+    auto r = s.postJson("/v1/bubble", req);
+    EXPECT_EQ(r->status, 200) << r->body.substr(0, 300);
+    glb::Asset a;
+    EXPECT_FALSE(glb::parse(r->body, a).has_value());
+    return a.gltf["materials"][0]["extensions"];
+  };
+  json film = materialOf({{"format", "glb"}, {"mesh", {{"level", 1}}}});
+  EXPECT_EQ(film["KHR_materials_ior"]["ior"].get<double>(), 1.0);
+  EXPECT_NEAR(film["KHR_materials_iridescence"]["iridescenceIor"].get<double>(), 1.33, 1e-12);
+  json plain = materialOf({{"format", "glb"}, {"shading", "paper"}, {"mesh", {{"level", 1}}}});
+  EXPECT_FALSE(plain.contains("KHR_materials_iridescence"));
+  EXPECT_NEAR(plain["KHR_materials_ior"]["ior"].get<double>(), 1.33, 1e-12);
+  json j = json::parse(s.postJson("/v1/bubble", json{{"include", {"gltf"}}})->body);
+  EXPECT_EQ(j["gltf"]["KHR_materials_ior"]["ior"].get<double>(), 1.0);
 }
 
 TEST(BubbleApi, BadInputNamesTheField) {

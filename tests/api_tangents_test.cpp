@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "glb.h"
@@ -114,6 +115,41 @@ std::string quadGlb() {
   a.gltf["accessors"][size_t(pos)]["max"] = {1, 1, 0};
   a.gltf["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", idx}}}}}};
   return glb::serialize(a);
+}
+
+// A page on another origin can read every X- header the service sends (the tangents report of
+// a GLB, an animation's frame count and rate, a flipbook's layout, the renderer's), not only the
+// JSON answers' ones.
+TEST(TangentsApi, EveryXHeaderIsExposedToAllowedOrigins) {
+  Config c = TestServer::quietConfig();
+  c.corsOrigins = {"https://game.example"};
+  TestServer s(c);
+  const httplib::Headers origin = {{"Origin", "https://game.example"}};
+  auto scene = [](const char* format) {
+    return json{{"width", 64},
+                {"height", 64},
+                {"frames", {{"count", 4}, {"fps", 8}, {"format", format}}},
+                {"lightning", {{"grid", {{"width", 32}, {"height", 32}}}, {"start", {16, 0}}, {"targets", {{16, 31}}}}}}
+        .dump();
+  };
+  std::vector<httplib::Result> answers;
+  answers.push_back(s.client().Post("/v1/tangents", origin, quadGlb(), "model/gltf-binary"));
+  answers.push_back(s.client().Post("/v1/render", origin, scene("gif"), "application/json"));
+  answers.push_back(s.client().Post("/v1/render", origin, scene("flipbook"), "application/json"));
+  answers.push_back(s.client().Post("/v1/fog", origin, R"({"fog":{"fogType":"GL_EXP"}})", "application/json"));
+  std::set<std::string> seen;
+  for (const auto& r : answers) {
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body.substr(0, 300);
+    const std::string exposed = ", " + r->get_header_value("Access-Control-Expose-Headers") + ",";
+    for (const auto& [name, value] : r->headers)
+      if (name.rfind("X-", 0) == 0) {
+        seen.insert(name);
+        EXPECT_NE(exposed.find(", " + name + ","), std::string::npos) << name << " is not in" << exposed;
+      }
+  }
+  for (const char* h : {"X-Tangents", "X-Frame-Count", "X-Frame-Rate", "X-Flipbook-Columns", "X-Flipbook-Rows"})
+    EXPECT_TRUE(seen.count(h)) << h << " was not sent";
 }
 
 TEST(TangentsApi, GlbGetsTangentsAndFlatNormals) {

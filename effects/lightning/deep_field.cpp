@@ -10,7 +10,7 @@ namespace effects::lightning::detail {
 
 DeepField::DeepField(std::unique_ptr<Potential> base, int width, int height, int depth)
     : w_(width), h_(height), d_(depth), cells_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))),
-      base_(std::move(base)), zero_(cells_, 0) {}
+      field_(std::move(base)), zero_(cells_, 0) {}
 
 DeepField::~DeepField() = default;
 
@@ -21,16 +21,18 @@ Cell DeepField::cellAt(size_t i) const {
 
 void DeepField::fix(Cell c, double value) {
   const size_t i = index(c);
-  base_->fix(c, value);
+  // A target the bolt reached (fixed at 0 now) is no longer a source.
+  targets_.erase(std::remove_if(targets_.begin(), targets_.end(), [&](const auto& t) { return t.first == c; }),
+                 targets_.end());
   if (value == 0.0)
     zero_[i] = 1;
   else
     targets_.emplace_back(c, value);
-  if (!stage_) return;
   // A cell fixed inside the frozen region (the bolt reached it, which kPop should have
-  // prevented, or a new target) drops the stages down to one where it is an unknown.
+  // prevented, or a new target) drops the stages down to one where it is an unknown; that
+  // stage is built when next solved, with the cell in it.
   while (k_ > 0 && (value != 0.0 || (cutStage_[i] != 0 && cutStage_[i] <= k_))) pop();
-  if (stage_) stage_->fix(c, value);
+  if (field_) field_->fix(c, value);
 }
 
 std::unique_ptr<Potential> DeepField::build(int stage) const {
@@ -54,6 +56,42 @@ std::unique_ptr<Potential> DeepField::build(int stage) const {
   return lap;
 }
 
+bool DeepField::reachable(const std::vector<Cell>& probes) const {
+  std::vector<uint8_t> seen(cells_, 0);
+  std::vector<size_t> queue;
+  for (const auto& [c, v] : targets_) {
+    seen[index(c)] = 1;
+    queue.push_back(index(c));
+  }
+  const size_t w = size_t(w_), plane = w * size_t(h_);
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const size_t i = queue[head];
+    const Cell c = cellAt(i);
+    auto visit = [&](bool inside, size_t j) {
+      if (inside && !seen[j] && !zero_[j]) seen[j] = 1, queue.push_back(j);
+    };
+    visit(c.x > 0, i - 1);
+    visit(c.x + 1 < w_, i + 1);
+    visit(c.y > 0, i - w);
+    visit(c.y + 1 < h_, i + w);
+    if (d_) {
+      visit(c.z > 0, i - plane);
+      visit(c.z + 1 < d_, i + plane);
+    }
+  }
+  for (const Cell& c : probes)
+    if (seen[index(c)]) return true;
+  return false;
+}
+
+Potential& DeepField::current() {
+  if (!field_) {  // dropped by a pop: this stage anew, from the cells fixed so far
+    field_ = build(k_);
+    ++stageSolves_;
+  }
+  return *field_;
+}
+
 double DeepField::largest(const std::vector<Cell>& probes, bool& inRegion) {
   double top = 0;
   inRegion = false;
@@ -70,10 +108,10 @@ double DeepField::largest(const std::vector<Cell>& probes, bool& inRegion) {
   return top;
 }
 
-void DeepField::deepen() {
+bool DeepField::deepen() {
   if (k_ == kMaxStages) {
     exhausted_ = true;
-    return;
+    return false;
   }
   if (cutStage_.empty()) {
     cutStage_.assign(cells_, 0);
@@ -91,26 +129,21 @@ void DeepField::deepen() {
       ++cut;
     }
   }
-  if (cut == 0) {  // no field left to cut at: nothing a further stage could resolve
-    exhausted_ = true;
-    return;
-  }
+  if (cut == 0) return false;  // no field left to cut at
   k_ = next;
   deepest_ = std::max(deepest_, k_);
-  stage_ = build(k_);
-  ++stageSolves_;
+  // One solver hierarchy at a time: the stage below is built again when the bolt comes back.
+  field_.reset();
+  current();
+  return true;
 }
 
 void DeepField::pop() {
   for (size_t i = 0; i < cells_; ++i)
     if (cutStage_[i] == k_) cutStage_[i] = 0;
   --k_;
-  if (k_ > 0) {
-    stage_ = build(k_);
-    ++stageSolves_;
-  } else {
-    stage_.reset();
-  }
+  field_.reset();     // built when next solved (a fix() may pop several stages first)
+  estimate_ *= kCut;  // the candidates' potential in the scale of the stage below
 }
 
 int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi) {
@@ -125,6 +158,7 @@ int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& p
   };
   run(std::max(kStageTolerance, tolerance * estimate_));
   double top = 0;
+  bool checkedReach = false;
   for (int pass = 0; pass < 4 * kMaxStages; ++pass) {  // each pass moves a stage or the goal
     bool inRegion = false;
     top = largest(probes, inRegion);
@@ -133,12 +167,22 @@ int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& p
       run(std::max(kStageTolerance, tolerance * top * kCut));
       continue;
     }
+    // No field reaches the candidates where no path of unknown cells joins them to a target (a
+    // bolt sealed off by a diagonal wall that the 5-point Laplacian sees as closed): they are
+    // weighed alike, as with no field at all, and what a solve shows there is rounding. A
+    // potential of 0 elsewhere is one that underflowed.
     if (top < kDeepen && !exhausted_) {
-      if (k_ == 0 && base_->direct()) {
+      if (!checkedReach) {
+        checkedReach = true;
+        if (!reachable(probes)) {
+          std::fill(phi_.begin(), phi_.end(), 0.0);
+          break;
+        }
+      }
+      if (k_ == 0 && field_->direct()) {
         // The capacitance solver's sums cancel at these potentials, and a cut reads every
         // cell: stage 0 goes over to the iterative solver.
-        base_ = build(0);
-        ++stageSolves_;
+        field_.reset();
         run(kStageTolerance);
         continue;
       }
@@ -146,12 +190,12 @@ int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& p
         run(kStageTolerance);
         continue;
       }
-      deepen();
-      if (!exhausted_) {
-        run(kStageTolerance);
-        continue;
+      if (!deepen()) {
+        if (!exhausted_) std::fill(phi_.begin(), phi_.end(), 0.0);  // nothing to cut: no field
+        break;
       }
-      break;
+      run(kStageTolerance);
+      continue;
     }
     if (!current().direct() && goal > kStageTolerance && goal > 2 * tolerance * top) {
       run(std::max(kStageTolerance, tolerance * top));

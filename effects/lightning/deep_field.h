@@ -29,8 +29,10 @@ namespace effects::lightning::detail {
 
 class DeepField {
  public:
-  // base: the problem as built (stage 0), obstacles, bolt and target already fixed; it may be
-  // the direct capacitance solver, which a stage-0 cut replaces by the iterative one.
+  // base: the solver of stage 0, nothing fixed yet (fix() fixes the obstacles, bolt and target
+  // in it). It may be the direct capacitance solver, which a cut replaces by the iterative one.
+  // One solver hierarchy lives at a time (a stage below is built again when the bolt comes
+  // back to it); the stages add 11 bytes a cell.
   DeepField(std::unique_ptr<Potential> base, int width, int height, int depth);
   ~DeepField();
   // Fixes a cell at a value in every stage: 0 (obstacles, bolt cells) or the target's 1.
@@ -42,14 +44,15 @@ class DeepField {
   // normal double of that stage, so that eta near 0 still weighs it (Phi^eta -> 1). Returns the
   // solver iterations, every stage's included.
   int solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi);
-  double residual() const { return current().residual(); }
-  bool direct() const { return !stage_ && base_->direct(); }
+  double residual() { return current().residual(); }
+  bool direct() { return k_ == 0 && current().direct(); }
   // The deepest stage reached so far (0: never cut).
   int deepestStage() const { return deepest_; }
   // Stages made or remade (each a solve from scratch).
   int stageSolves() const { return stageSolves_; }
   // Whether the stages ran out (kMaxStages): the field is below about 1e-(5 * 65535) of the
-  // target's, and the potentials the candidates get are not resolved.
+  // target's, and the potentials the candidates get are not resolved. (Where no field reaches
+  // the candidates at all, they are weighed alike instead, as DBM with no field does.)
   bool exhausted() const { return exhausted_; }
 
   static constexpr double kDeepen = 1e-8;            // P below this: cut a new stage
@@ -59,19 +62,21 @@ class DeepField {
   static constexpr int kMaxStages = 65535;
 
  private:
-  Potential& current() const { return stage_ ? *stage_ : *base_; }
+  Potential& current();  // the current stage's solver, built if a pop dropped it
   size_t index(Cell c) const { return (size_t(c.z) * size_t(h_) + size_t(c.y)) * size_t(w_) + size_t(c.x); }
   Cell cellAt(size_t i) const;
   std::unique_ptr<Potential> build(int stage) const;  // from scratch: zero cells, the stage's cut (stage 0: the targets)
-  void deepen();
+  bool deepen();  // cuts a stage; false where none was (nothing to cut, or kMaxStages)
+  // Whether a path of cells not fixed at 0 (4 or 6 neighbours, the Laplacian's) joins a probe
+  // to a target: where none does, the field there is exactly 0.
+  bool reachable(const std::vector<Cell>& probes) const;
   void pop();
   // The largest potential at the probes in the current stage (phi_ keeps them all).
   double largest(const std::vector<Cell>& probes, bool& inRegion);
 
   int w_, h_, d_;
   size_t cells_;
-  std::unique_ptr<Potential> base_;   // stage 0
-  std::unique_ptr<Potential> stage_;  // stage k_ >= 1 (null at stage 0)
+  std::unique_ptr<Potential> field_;  // the current stage's solver (null: build it when needed)
   int k_ = 0, deepest_ = 0, stageSolves_ = 0;
   double estimate_ = 1;             // the candidates' largest potential at the last solve (its stage)
   bool exhausted_ = false;

@@ -114,14 +114,19 @@ class Mikk {
  private:
   uint32_t corner(size_t g, uint32_t i) const { return tri_[g][i]; }
   // The reference's float squares overflow past |x| ~ 1e19 and underflow below ~1e-19, where its
-  // tangents fall back to the placeholder. Positions beyond 2^+-20 are scaled by a power of two
-  // towards 1, which is exact in float and changes no rounding: the frames are the reference's
-  // at any scale, and bit for bit the same wherever the reference itself does not overflow.
+  // tangents fall back to the placeholder. A mesh whose triangles reach beyond 2^60 or stay
+  // within 2^-60 is scaled by a power of two towards 1 (exact in float, the same rounding but
+  // near FLT_MIN): the reference's frames at any scale. Within, nothing is scaled and the
+  // arithmetic is the reference's bit for bit.
   static float powerOfTwoScale(const Mesh& m) {
     float top = 0;
-    for (const glm::vec3& p : m.positions) top = std::max({top, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    if (!(top > 0) || !std::isfinite(top) || (top >= 0x1p-20f && top <= 0x1p20f)) return 1.0f;
-    return std::ldexp(1.0f, -std::ilogb(top));
+    for (uint32_t v : m.indices)
+      if (v < m.positions.size()) {
+        const glm::vec3& p = m.positions[v];
+        top = std::max({top, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+      }
+    if (!(top > 0) || !std::isfinite(top) || (top >= 0x1p-60f && top <= 0x1p60f)) return 1.0f;
+    return std::ldexp(1.0f, std::clamp(-std::ilogb(top), -126, 126));
   }
   fvec3 pos(uint32_t v) const { return scale_ == 1.0f ? mesh_.positions[v] : scaleF(scale_, mesh_.positions[v]); }
 
@@ -268,7 +273,9 @@ class Mikk {
       }
       auto agree = [&](size_t a, size_t b, bool otUnit) {
         if (a == b || links_[faces[a].face].groupWithAny || links_[faces[b].face].groupWithAny) return true;
-        return glm::dot(os[a], os[b]) > -1.0 && (otUnit ? glm::dot(ot[a], ot[b]) > -1.0 : glm::dot(ot[a], ot[b]) >= 0.0);
+        // The reference's test, in its float arithmetic: fCosS > -1 and fCosT > -1.
+        return dotF(fvec3(os[a]), fvec3(os[b])) > -1.0f &&
+               (otUnit ? dotF(fvec3(ot[a]), fvec3(ot[b])) > -1.0f : glm::dot(ot[a], ot[b]) >= 0.0);
       };
       bool whole = nearTogether(faces, k, os.data(), ot.data());
       if (!whole) {
@@ -324,7 +331,7 @@ class Mikk {
     if (first == k) return true;
     const dvec3 s0 = os[first], t0 = ot[first];
     const double t0Squared = glm::dot(t0, t0);
-    constexpr double kLongest = 1 + 1e-9;
+    constexpr double kLongest = 1 + 1e-6;  // float-normalised vectors: |v|^2 - 1 up to ~1e-7
     if (t0Squared < 1e-100 || !(glm::dot(s0, s0) <= kLongest)) return false;
     for (size_t a = first + 1; a < k; ++a) {
       if (links_[faces[a].face].groupWithAny) continue;
@@ -351,20 +358,29 @@ class Mikk {
   // the reference's float arithmetic (EvalTspace). The corners' cosines are taken a batch at a
   // time before their arc cosines, so the projections of one corner overlap the library calls
   // of another.
+  // The float sum runs in ascending face order, as the reference sums its sorted members.
   dvec3 evalTSpace(const Member* faces, size_t count, const dvec3* os, const fvec3& n) const {
     constexpr size_t kBatch = 16;
     float cosine[kBatch];
     fvec3 sum(0);
+    thread_local std::vector<uint32_t> order;
+    order.resize(count);
+    for (size_t a = 0; a < count; ++a) order[a] = uint32_t(a);
+    if (!std::is_sorted(faces, faces + count, [](const Member& x, const Member& y) { return x.face < y.face; }))
+      std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return faces[x].face < faces[y].face; });
     for (size_t first = 0; first < count; first += kBatch) {
       const size_t last = std::min(count, first + kBatch);
-      for (size_t a = first; a < last; ++a) {
+      for (size_t j = first; j < last; ++j) {
+        const size_t a = order[j];
         const uint32_t f = faces[a].face, i = faces[a].corner;
         const fvec3 p1 = pos(corner(f, i)), p0 = pos(corner(f, (i + 2) % 3)), p2 = pos(corner(f, (i + 1) % 3));
         const fvec3 v1 = projectF(p0 - p1, n), v2 = projectF(p2 - p1, n);
-        cosine[a - first] = std::clamp(dotF(v1, v2), -1.0f, 1.0f);
+        cosine[j - first] = std::clamp(dotF(v1, v2), -1.0f, 1.0f);
       }
-      for (size_t a = first; a < last; ++a)
-        if (!links_[faces[a].face].groupWithAny) sum = sum + scaleF(float(std::acos(double(cosine[a - first]))), fvec3(os[a]));
+      for (size_t j = first; j < last; ++j) {
+        const size_t a = order[j];
+        if (!links_[faces[a].face].groupWithAny) sum = sum + scaleF(float(std::acos(double(cosine[j - first]))), fvec3(os[a]));
+      }
     }
     return vNotZeroF(sum) ? dvec3(normalizeF(sum)) : dvec3(0);
   }
