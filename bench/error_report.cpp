@@ -750,6 +750,22 @@ std::string summaryMarkdown(const std::vector<Section>& sections) {
   return md.str();
 }
 
+// A label in lines of about `width` characters (gnuplot's "\n" in a double-quoted string).
+std::string wrapped(const std::string& text, size_t width) {
+  std::string out;
+  size_t line = 0;
+  for (size_t i = 0; i < text.size();) {
+    size_t end = text.find(' ', i);
+    if (end == std::string::npos) end = text.size();
+    if (line > 0 && line + (end - i) > width) out += "\\n", line = 0;
+    else if (line > 0) out += ' ', ++line;
+    out.append(text, i, end - i);
+    line += end - i;
+    i = end + 1;
+  }
+  return out;
+}
+
 void plot(const Section& s, const fs::path& dir) {
   std::map<std::string, std::vector<const Point*>> series;
   double floorError = INFINITY;
@@ -770,12 +786,17 @@ void plot(const Section& s, const fs::path& dir) {
     for (const Point* p : pts) d << p->ms * s.timeScale << " " << p->error << "\n";
     d << "\n\n";
   }
-  for (const Point* p : exact) d << "# exact: " << p->series << "\n" << p->ms * s.timeScale << " " << floorAt << "\n\n\n";
+  for (const Point* p : exact)
+    d << "# error 0: " << p->series << " " << p->setting << "\n" << p->ms * s.timeScale << " " << floorAt << "\n\n\n";
   d.close();
   std::ofstream g(script);
   const size_t curves = series.size() + exact.size();
-  // Many curves: the key goes below the plot in three columns and the picture grows to hold it.
-  const bool many = curves > 16;
+  // Many curves or long names: the key goes below the plot in three columns and the picture
+  // grows to hold it.
+  size_t longest = 0;
+  for (const auto& [name, pts] : series) longest = std::max(longest, name.size());
+  for (const Point* p : exact) longest = std::max(longest, p->series.size() + p->setting.size() + 24);
+  const bool many = curves > 10 || longest > 32;
   const int height = many ? 560 + 15 * int((curves + 2) / 3) : 520;
   g << "set terminal pngcairo noenhanced size " << (many ? 1000 : 800) << "," << height << " font 'sans,10'\n"
     << "set output '" << (dir / (s.id + ".png")).string() << "'\n"
@@ -783,8 +804,8 @@ void plot(const Section& s, const fs::path& dir) {
     << "set logscale xy\nset grid\n"
     << (many ? "set key outside below maxcols 3 maxrows " + std::to_string((curves + 2) / 3) + "\n"
              : std::string("set key outside right top\n"))
-    << "set xlabel \"" << s.timeName << ", log scale\"\nset ylabel \"" << s.errorName
-    << ", log scale" << (exact.empty() ? "" : " (error 0 drawn at the floor, open diamonds)") << "\"\n"
+    << "set xlabel \"" << s.timeName << ", log scale\"\nset ylabel \"" << wrapped(s.errorName + ", log scale", 40)
+    << "\"\n"
     << "set format y '%.0e'\n";
   if (!exact.empty()) g << "set arrow from graph 0, first " << floorAt << " to graph 1, first " << floorAt << " nohead dt 3 lc rgb 'gray'\n";
   g << "plot ";
@@ -798,7 +819,7 @@ void plot(const Section& s, const fs::path& dir) {
   }
   for (size_t k = 0; k < exact.size(); ++k, ++i)
     g << (i ? ", " : "") << "'" << data.string() << "' index " << i << " with points lc " << (i % 8 + 1)
-      << " pt 12 ps 2 title '" << exact[k]->series << " (error 0)'";
+      << " pt 12 ps 2 title '" << exact[k]->series << " " << exact[k]->setting << " (error 0, at the floor)'";
   g << "\n";
   g.close();
   const std::string cmd = "gnuplot '" + script.string() + "'";
