@@ -202,6 +202,24 @@ def per_row(lengths_seeds, tol=0.12, filled=None):
     return check
 
 
+def same_fill(runs):
+    """Cells per row at eta 1e-6 against eta 0, per length."""
+    def check(answers):
+        if not ok_status(200, answers):
+            return False, "statuses " + ", ".join(str(s) for s, _ in answers)
+        sums = {}
+        for (length, eta, _), (_, a) in zip(runs, answers):
+            sums.setdefault((length, eta), []).append(a["stats"]["counters"]["cells"] / length)
+        seen, ok = [], True
+        for length in sorted({L for L, _, _ in runs}):
+            zero = sum(sums[(length, 0)]) / len(sums[(length, 0)])
+            tiny = sum(sums[(length, 1e-6)]) / len(sums[(length, 1e-6)])
+            ok = ok and abs(tiny / zero - 1) <= 0.05
+            seen.append(f"length {length}: {zero:.3f} at η 0, {tiny:.3f} at η 1e-6")
+        return ok, "; ".join(seen)
+    return check
+
+
 def tangents_equal_at_scales(scales):
     def check(answers):
         if not ok_status(200, answers):
@@ -392,13 +410,18 @@ def cases(quick):
                                                        f"power {a['stats']['counters']['chargesEta']:.4f}")),) + c[5:]
         elif c[4] is None:
             out[i] = c[:4] + (bolt_ok(c[3]),) + c[5:]
-    for width in (3, 5, 7):
+    for width in (3, 5, 7, 9):
         runs = [(64, s) for s in range(1, 5)] + [(channel_long, s) for s in range(1, seeds_long + 1)]
         out.append(("lightning", f"dbm in a {width}-wide channel, length 64 and {channel_long}", "lightning",
                     [channel(width, L, s) for L, s in runs], per_row(runs, filled=0.5 * width),
                     "cells per row independent of the length (±12 %), the channel not filled: the field ahead of "
                     "the bolt (down to 1e-" + str(int(math.pi * channel_long / (width + 1) / math.log(10))) +
                     ") resolved by DeepField"))
+    eden = [(length, eta, s) for length in (64, 600) for eta in (0, 1e-6) for s in (1, 2, 3)]
+    out.append(("lightning", "dbm at η = 1e-6 against η = 0 in a 3-wide channel, length 64 and 600", "lightning",
+                [channel(3, L, s, eta=eta) for L, eta, s in eden], same_fill(eden),
+                "η → 0 is uniform growth: the same cells per row as η 0 (±5 %), every candidate weighed, even "
+                "where its potential underflows"))
     tube_runs = [(48, s) for s in range(1, 5)] + [(240 if quick else 960, s) for s in range(1, 3)]
     out.append(("lightning", f"3-D dbm in a 3 × 3 tube, length 48 and {tube_runs[-1][0]}", "lightning",
                 [tube(L, s) for L, s in tube_runs], per_row(tube_runs, filled=3.0),
