@@ -6,5 +6,5 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 command -v node >/dev/null || { echo "node is required: run scripts/setup.sh"; exit 1; }
 command -v chromium >/dev/null || { echo "chromium is required: run scripts/setup.sh"; exit 1; }
-[ -d "$here/node_modules/puppeteer-core" ] || (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
+[ -d "$here/node_modules/puppeteer-core" ] && [ -d "$here/node_modules/three" ] || (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
 node "$here/${2:-cors.mjs}" "$1" "$(command -v chromium)"
