@@ -1,5 +1,7 @@
-// The bubble's GLB judged by an engine that consumes it: three.js (npm `three`, its own
-// GLTFLoader and MeshPhysicalMaterial's KHR_materials_iridescence) in headless chromium (WebGL2
+// The bubble's GLB judged by the engines that consume it: three.js (npm `three`, its own
+// GLTFLoader and MeshPhysicalMaterial's KHR_materials_iridescence) and Babylon.js (npm
+// `@babylonjs/core` + `@babylonjs/loaders`, its glTF loader and PBRMaterial iridescence, under a
+// cube map of effectd's sky) in headless chromium (WebGL2
 // on SwiftShader) draws /v1/bubble's `format: "glb"` under an environment map over a neutral
 // grey backdrop, and the film's part of the frame is measured: how much the iridescence changes
 // the bubble's disc (on against off, mean per channel) and how much of the disc it colours
@@ -7,7 +9,8 @@
 // film's (the old material, which three drew almost clear) is measured beside it.
 // effectd's /v1/render preview of the same bubble and camera (under effectd's sky, not three's
 // RoomEnvironment) is measured the same way: three must colour at least half the share of the
-// disc the preview colours (seen: 36.6 % against 39.2 %; the old GLB 5.6 %).
+// disc the preview colours (seen: three 36.6 %, Babylon 34.8 %, the preview 39.2 %; the old GLB
+// 5.6 % and 3.1 %).
 // Usage: node bubble_gltf.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
 import http from 'node:http';
@@ -18,20 +21,22 @@ import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
 const here = path.dirname(fileURLToPath(import.meta.url));
-const threeRoot = path.join(here, 'node_modules', 'three');
+const modules = path.join(here, 'node_modules');
 
 const pages = http.createServer((req, res) => {
   const url = new URL(req.url, 'http://x');
-  if (url.pathname.startsWith('/three/')) {  // three's ES modules, as a page would load them
-    const file = path.normalize(path.join(threeRoot, url.pathname.slice('/three/'.length)));
-    if (!file.startsWith(threeRoot) || !fs.existsSync(file)) return res.writeHead(404).end();
+  if (url.pathname.startsWith('/nm/')) {  // the engines' ES modules, as a page would load them
+    const file = path.normalize(path.join(modules, decodeURIComponent(url.pathname.slice('/nm/'.length))));
+    if (!file.startsWith(modules) || !fs.existsSync(file) || !fs.statSync(file).isFile()) return res.writeHead(404).end();
     res.writeHead(200, { 'Content-Type': 'text/javascript' });
     return res.end(fs.readFileSync(file));
   }
   res.writeHead(200, { 'Content-Type': 'text/html' });
-  res.end('<!doctype html><title>effectd bubble GLB in three.js</title>' +
-          '<script type="importmap">{"imports":{"three":"/three/build/three.module.js",' +
-          '"three/addons/":"/three/examples/jsm/"}}</script><canvas id="gl"></canvas><canvas id="png"></canvas>');
+  res.end('<!doctype html><title>effectd bubble GLB in three.js and Babylon.js</title>' +
+          '<script type="importmap">{"imports":{"three":"/nm/three/build/three.module.js",' +
+          '"three/addons/":"/nm/three/examples/jsm/","@babylonjs/core/":"/nm/@babylonjs/core/",' +
+          '"@babylonjs/loaders/":"/nm/@babylonjs/loaders/"}}</script>' +
+          '<canvas id="gl"></canvas><canvas id="png"></canvas><canvas id="bjs" width="160" height="160"></canvas>');
 });
 await new Promise((r) => pages.listen(0, '127.0.0.1', r));
 const origin = `http://localhost:${pages.address().port}`;
@@ -153,6 +158,104 @@ try {
         { three: r.three.on.share, preview: r.preview.share });
   check(r.three.change >= 3 * r.oldIor.change, `with the base ior at the film's (the old GLB) the film changed the disc by ` +
         `${r.oldIor.change.toFixed(2)}/255: the base ior of 1 shows it at least 3 times as strongly`, r.oldIor);
+
+  // Babylon.js: its own glTF loader and PBRMaterial iridescence, under a cube map of effectd's sky.
+  const page2 = await browser.newPage();
+  page2.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
+  await page2.goto(`${origin}/`);
+  const b = await page2.evaluate(async (api) => {
+    const out = {};
+    const size = 160, eye = [0, 0.3, 4], fovY = 45, backdrop = [0.5, 0.5, 0.5];
+    const { Engine } = await import('@babylonjs/core/Engines/engine.js');
+    const { Scene } = await import('@babylonjs/core/scene.js');
+    const { FreeCamera } = await import('@babylonjs/core/Cameras/freeCamera.js');
+    const { Vector3 } = await import('@babylonjs/core/Maths/math.vector.js');
+    const { Color4 } = await import('@babylonjs/core/Maths/math.color.js');
+    const { RawCubeTexture } = await import('@babylonjs/core/Materials/Textures/rawCubeTexture.js');
+    const { LoadAssetContainerAsync } = await import('@babylonjs/core/Loading/sceneLoader.js');
+    await import('@babylonjs/loaders/glTF/index.js');  // registers the .glb loader and its extensions
+    const canvas = document.getElementById('bjs');
+    const engine = new Engine(canvas, false, { preserveDrawingBuffer: true });
+    const scene = new Scene(engine);
+    scene.clearColor = new Color4(...backdrop, 1);
+    scene.useRightHandedSystem = true;  // glTF's
+    const camera = new FreeCamera('camera', new Vector3(...eye), scene);
+    camera.fov = fovY * Math.PI / 180;
+    camera.fovMode = 0;  // vertical
+    camera.setTarget(Vector3.Zero());
+    // effectd's sky (scene.json's environment) as the environment cube.
+    const n = 32, sky = { zenith: [0.35, 0.6, 1.0], horizon: [1.0, 0.98, 0.95], ground: [0.16, 0.18, 0.12] };
+    const skyAt = (y) => y >= 0 ? sky.horizon.map((h, k) => h + (sky.zenith[k] - h) * Math.sqrt(y))
+                                : sky.horizon.map((h, k) => h + (sky.ground[k] - h) * Math.sqrt(-y));
+    const faces = [];
+    for (let face = 0; face < 6; ++face) {
+      const px = new Float32Array(n * n * 4);
+      for (let j = 0; j < n; ++j)
+        for (let i = 0; i < n; ++i) {
+          const s1 = (2 * (i + 0.5)) / n - 1, t1 = (2 * (j + 0.5)) / n - 1;
+          const d = [[1, -t1, -s1], [-1, -t1, s1], [s1, 1, t1], [s1, -1, -t1], [s1, -t1, 1], [-s1, -t1, -1]][face];
+          px.set([...skyAt(d[1] / Math.hypot(...d)), 1], (j * n + i) * 4);
+        }
+      faces.push(px);
+    }
+    scene.environmentTexture = new RawCubeTexture(scene, faces, n, 5, 1);  // RGBA, float
+    const res = await fetch(`${api}/v1/bubble`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                                  body: JSON.stringify({ mesh: { level: 4 }, features: { wobble: false }, format: 'glb' }) });
+    const container = await LoadAssetContainerAsync(new Uint8Array(await res.arrayBuffer()), scene, { pluginExtension: '.glb' });
+    container.addAllToScene();
+    const material = container.materials.find((m) => m.iridescence);
+    out.material = { type: material.getClassName(), ior: material.indexOfRefraction, iridescence: material.iridescence.isEnabled,
+                     iridescenceIor: material.iridescence.indexOfRefraction };
+    const rPx = (size / 2) / (Math.hypot(...eye) * Math.tan((fovY / 2) * Math.PI / 180)) * 0.85;
+    const frame = async () => {
+      await scene.whenReadyAsync();
+      scene.render();
+      return await engine.readPixels(0, 0, size, size);
+    };
+    const measure = (px) => {
+      let n2 = 0, coloured = 0;
+      for (let y = 0; y < size; ++y)
+        for (let x = 0; x < size; ++x) {
+          if (Math.hypot(x + 0.5 - size / 2, y + 0.5 - size / 2) > rPx) continue;
+          const i = (y * size + x) * 4;
+          ++n2, coloured += Math.max(px[i], px[i + 1], px[i + 2]) - Math.min(px[i], px[i + 1], px[i + 2]) > 8;
+        }
+      return coloured / n2;
+    };
+    const filmPart = async () => {
+      material.iridescence.isEnabled = true;
+      const on = new Uint8Array(await frame());
+      material.iridescence.isEnabled = false;
+      const off = new Uint8Array(await frame());
+      let diff = 0, m = 0;
+      for (let y = 0; y < size; ++y)
+        for (let x = 0; x < size; ++x) {
+          if (Math.hypot(x + 0.5 - size / 2, y + 0.5 - size / 2) > rPx) continue;
+          const i = (y * size + x) * 4;
+          for (let k = 0; k < 3; ++k) diff += Math.abs(on[i + k] - off[i + k]);
+          m += 3;
+        }
+      return { change: diff / m, on: measure(on), off: measure(off) };
+    };
+    out.babylon = await filmPart();
+    material.iridescence.isEnabled = true;
+    await frame();
+    out.picture = canvas.toDataURL('image/png');
+    material.indexOfRefraction = material.iridescence.indexOfRefraction;  // the old material
+    out.oldIor = await filmPart();
+    return out;
+  }, api);
+  if (process.env.EFFECTD_PICTURES)
+    fs.writeFileSync(path.join(process.env.EFFECTD_PICTURES, 'bubble-gltf-babylon.png'), Buffer.from(b.picture.split(',')[1], 'base64'));
+  delete b.picture;
+  console.log(JSON.stringify(b));
+  check(b.material.iridescence && Math.abs(b.material.ior - 1) < 1e-6 && Math.abs(b.material.iridescenceIor - 1.33) < 1e-6,
+        'Babylon loads the iridescent material: base ior 1, film ior 1.33', b.material);
+  check(b.babylon.change >= 2, `the film changes Babylon's disc by ${b.babylon.change.toFixed(2)}/255 on average (≥ 2)`, b.babylon);
+  check(b.babylon.on >= 0.5 * r.preview.share, `Babylon colours ${(100 * b.babylon.on).toFixed(1)} % of the disc, at least half ` +
+        `effectd's preview's ${(100 * r.preview.share).toFixed(1)} %`, b.babylon);
+  check(b.babylon.change >= 3 * b.oldIor.change, `with the old base ior Babylon's film changed the disc by ` +
+        `${b.oldIor.change.toFixed(2)}/255 and coloured ${(100 * b.oldIor.on).toFixed(1)} % of it`, b.oldIor);
 } finally {
   await browser.close();
   server.kill();
