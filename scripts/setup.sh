@@ -16,6 +16,7 @@ PACKAGES=(
   iproute2           # ss: tests/binary_test.sh reads the listen backlog
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
+  blender            # the second tangent oracle: Blender's own MikkTSpace (tests/mikktspace/blender_oracle.py)
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
   json-schema-test-suite  # the official JSON-Schema tests run against server/schema.cpp
   python3-jsonschema # tests/sweep_test.py checks answers against proto/schemas/*-answer.json
