@@ -53,7 +53,9 @@ Cost lightningCost(const json& body, const Config& config) {
   // ones in 3-D). 3-D fast keeps its per-voxel state in pages of the voxels the bolt and the
   // A* search touch (effects/lightning/grid.h: CellMap): at worst (a search that floods the
   // volume) A*'s cost and parent (8 bytes), the obstacle and octree charge bytes.
-  const size_t perCell = solver ? (depth ? 200 : 160) : (depth ? 12 : 24);
+  // dbm also keeps DeepField's per-cell state (effects/lightning/deep_field.h): a byte for the
+  // cells fixed at 0, and once a stage is cut its stage number and frozen value (10 bytes).
+  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (method == "dbm" ? 11 : 0);
   // dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = method == "dbm" && body.value("solver", "capacitance") == "capacitance";
   const int width = body["grid"]["width"].get<int>(), height = body["grid"]["height"].get<int>();

@@ -109,6 +109,14 @@ try {
     }
   }
 
+  // The preview and the live view sit centred in their frames (an empty note beside the
+  // preview once pushed it 28 px to the left).
+  const offsets = await page.evaluate(() => ['preview', 'live'].map((id) => {
+    const el = document.getElementById(id), frame = el.parentElement.getBoundingClientRect(), r = el.getBoundingClientRect();
+    return { id, dx: (r.left + r.right) / 2 - (frame.left + frame.right) / 2, dy: (r.top + r.bottom) / 2 - (frame.top + frame.bottom) / 2 };
+  }));
+  check(offsets.every((o) => Math.abs(o.dx) <= 1 && Math.abs(o.dy) <= 1), 'the preview and the live view are centred in their frames', offsets);
+
   // Knobs: eta re-requests and changes both pictures.
   const lightning = async (example) => {
     const before = await runs(page);
