@@ -12,4 +12,19 @@ struct FieldError {
   std::string message;
 };
 
+// Escapes a key for use in a JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1").
+inline std::string pointerEscape(const std::string& key) {
+  std::string out;
+  out.reserve(key.size());
+  for (char c : key) {
+    if (c == '~')
+      out += "~0";
+    else if (c == '/')
+      out += "~1";
+    else
+      out += c;
+  }
+  return out;
+}
+
 }  // namespace effectd

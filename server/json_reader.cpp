@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "field_error.h"
+
 namespace effectd {
 
 using nlohmann::json;
@@ -74,11 +76,7 @@ class Reader {
     std::string out;
     for (const auto& [key, index] : path_) {
       out += '/';
-      if (!key) {
-        out += std::to_string(index);
-        continue;
-      }
-      for (char c : *key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      out += key ? pointerEscape(*key) : std::to_string(index);
     }
     return out;
   }

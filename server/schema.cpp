@@ -9,20 +9,6 @@ namespace effectd {
 
 using nlohmann::json;
 
-std::string pointerEscape(const std::string& key) {
-  std::string out;
-  out.reserve(key.size());
-  for (char c : key) {
-    if (c == '~')
-      out += "~0";
-    else if (c == '/')
-      out += "~1";
-    else
-      out += c;
-  }
-  return out;
-}
-
 namespace {
 
 const std::set<std::string> kKeywords = {

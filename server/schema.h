@@ -55,7 +55,4 @@ class SchemaRegistry {
   std::map<std::string, const Node*> roots_;
 };
 
-// Escapes a key for use in a JSON pointer (RFC 6901: "~" -> "~0", "/" -> "~1").
-std::string pointerEscape(const std::string& key);
-
 }  // namespace effectd
