@@ -170,15 +170,10 @@ void fractal3d(int seeds, int n, double onlyEta) {
         const auto t0 = std::chrono::steady_clock::now();
         auto b = grow(p);
         ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        std::vector<Cell> cs;
-        std::vector<char> hasChild(b.value().nodes.size(), 0);
-        for (const auto& node : b.value().nodes) {
-          cs.push_back(node.cell);
-          if (node.parent >= 0) hasChild[size_t(node.parent)] = 1;
-        }
-        d.push_back(fractalDimension(cs, n, n, n));
-        cells.push_back(double(cs.size()));
-        tips.push_back(double(std::count(hasChild.begin(), hasChild.end(), 0)));
+        const BoltShape s = shapeOf(b.value(), n, n, n);
+        d.push_back(s.dimension);
+        cells.push_back(s.cells);
+        tips.push_back(s.tips);
       }
       double mean = 0, sd = 0;
       for (double v : d) mean += v / double(d.size());

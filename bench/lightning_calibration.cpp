@@ -47,16 +47,8 @@ Sample measure(const lt::Params& p) {
     std::fprintf(stderr, "grow failed: %s\n", r.error().message.c_str());
     std::exit(1);
   }
-  const lt::Bolt& b = r.value();
-  std::vector<char> hasChild(b.nodes.size(), 0);
-  std::vector<lt::Cell> cells;
-  for (const auto& n : b.nodes) {
-    if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
-    cells.push_back(n.cell);
-  }
-  return {p.depth ? lt::fractalDimension(cells, p.width, p.height, p.depth) : lt::fractalDimension(cells, p.width, p.height),
-          double(b.nodes.size()),
-          double(std::count(hasChild.begin(), hasChild.end(), 0)), ms};
+  const lt::BoltShape s = lt::shapeOf(r.value(), p.width, p.height, p.depth);
+  return {s.dimension, s.cells, s.tips, ms};
 }
 
 double median(std::vector<double> v) {

@@ -25,15 +25,10 @@ BoltStats statsOver(Params p, int seeds) {
     auto r = grow(p);
     EXPECT_TRUE(r.ok());
     if (!r.ok()) return {};
-    std::vector<char> hasChild(r.value().nodes.size(), 0);
-    std::vector<Cell> cs;
-    for (const Node& n : r.value().nodes) {
-      if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
-      cs.push_back(n.cell);
-    }
-    d.push_back(fractalDimension(cs, p.width, p.height));
-    cells.push_back(double(cs.size()));
-    tips.push_back(double(std::count(hasChild.begin(), hasChild.end(), 0)));
+    const BoltShape shape = shapeOf(r.value(), p.width, p.height);
+    d.push_back(shape.dimension);
+    cells.push_back(shape.cells);
+    tips.push_back(shape.tips);
   }
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
