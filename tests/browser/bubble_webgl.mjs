@@ -5,13 +5,18 @@
 // The page builds what a client builds itself: the camera matrices, the backdrop colour and
 // the sky's cube map (render::skyAt, as scene.json documents it).
 // Usage: node bubble_webgl.mjs EFFECTD_BINARY [CHROMIUM]
+import fs from 'node:fs';
 import http from 'node:http';
-import puppeteer from 'puppeteer-core';
+import { launchWebGl2Chromium } from './chromium.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
 
 const pages = http.createServer((req, res) => {
+  if (req.url === '/page_helpers.mjs') {
+    res.writeHead(200, { 'Content-Type': 'text/javascript' });
+    return res.end(fs.readFileSync(new URL('./page_helpers.mjs', import.meta.url)));
+  }
   res.writeHead(200, { 'Content-Type': 'text/html' });
   res.end('<!doctype html><title>effectd bubble in WebGL2</title><canvas id="gl"></canvas><canvas id="png"></canvas>');
 });
@@ -19,12 +24,7 @@ await new Promise((r) => pages.listen(0, '127.0.0.1', r));
 const origin = `http://localhost:${pages.address().port}`;
 const { url: api, process: server } = await startEffectd(binary, ['--cors-origins', origin]);
 
-const browser = await puppeteer.launch({
-  executablePath: chromium,
-  headless: true,
-  args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-         '--ignore-gpu-blocklist'],
-});
+const browser = await launchWebGl2Chromium(chromium);
 try {
   const page = await browser.newPage();
   page.on('console', (m) => console.log(`  page: ${m.text()}`));
@@ -138,21 +138,9 @@ try {
       // The sky's cube map, as the renderer's environment pass evaluates it (render::skyAt).
       texture(0, gl.TEXTURE_CUBE_MAP);
       const n = 256;
-      const skyAt = (d) => {
-        const y = d[1];
-        const mix = (a, c, w) => a.map((x, i) => x + (c[i] - x) * w);
-        return y >= 0 ? mix(sky.horizon, sky.zenith, Math.sqrt(y)) : mix(sky.horizon, sky.ground, Math.sqrt(Math.min(-4 * y, 1)));
-      };
-      for (let face = 0; face < 6; ++face) {
-        const px = new Float32Array(n * n * 4);
-        for (let j = 0; j < n; ++j)
-          for (let i = 0; i < n; ++i) {
-            const s1 = (2 * (i + 0.5)) / n - 1, t1 = (2 * (j + 0.5)) / n - 1;
-            const dir = norm([[1, -t1, -s1], [-1, -t1, s1], [s1, 1, t1], [s1, -1, -t1], [s1, -t1, 1], [-s1, -t1, -1]][face]);
-            px.set([...skyAt(dir), 1], (j * n + i) * 4);
-          }
-        gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, gl.RGBA16F, n, n, 0, gl.RGBA, gl.FLOAT, px);
-      }
+      const { skyCubeFaces } = await import('/page_helpers.mjs');
+      skyCubeFaces(sky, n).forEach((px, face) =>
+        gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, gl.RGBA16F, n, n, 0, gl.RGBA, gl.FLOAT, px));
       gl.uniform1i(at('uEnvironment'), 0);
       // The thin-film table (RGBA16F as sent) and the thickness texture (nm).
       texture(2, gl.TEXTURE_2D);

@@ -11,7 +11,7 @@ import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import puppeteer from 'puppeteer-core';
+import { launchWebGl2Chromium } from './chromium.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
@@ -30,12 +30,7 @@ for (const [args, expect] of [[[], 200], [['--playground', 'off'], 404], [['--ho
 }
 
 const { url: api, process: server } = await startEffectd(binary);
-const browser = await puppeteer.launch({
-  executablePath: chromium,
-  headless: true,
-  args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-         '--ignore-gpu-blocklist'],
-});
+const browser = await launchWebGl2Chromium(chromium);
 const problems = [];
 let renders = 0;
 async function open(url) {

@@ -1,0 +1,62 @@
+// Served to the test pages (bubble_webgl.mjs, bubble_gltf.mjs) as /page_helpers.mjs: what a
+// client computes the same way in each of them.
+
+// The sky as effectd's renderer evaluates it (render::skyAt, as scene.json documents it) in
+// unit direction d.
+export function skyAt(sky, d) {
+  const y = d[1];
+  const mix = (a, c, w) => a.map((x, i) => x + (c[i] - x) * w);
+  return y >= 0 ? mix(sky.horizon, sky.zenith, Math.sqrt(y)) : mix(sky.horizon, sky.ground, Math.sqrt(Math.min(-4 * y, 1)));
+}
+
+// The sky's cube map: six faces (+x, -x, +y, -y, +z, -z) of n x n RGBA floats.
+export function skyCubeFaces(sky, n) {
+  const faces = [];
+  for (let face = 0; face < 6; ++face) {
+    const px = new Float32Array(n * n * 4);
+    for (let j = 0; j < n; ++j)
+      for (let i = 0; i < n; ++i) {
+        const s1 = (2 * (i + 0.5)) / n - 1, t1 = (2 * (j + 0.5)) / n - 1;
+        const d = [[1, -t1, -s1], [-1, -t1, s1], [s1, 1, t1], [s1, -1, -t1], [s1, -t1, 1], [-s1, -t1, -1]][face];
+        const l = Math.hypot(...d);
+        px.set([...skyAt(sky, d.map((x) => x / l)), 1], (j * n + i) * 4);
+      }
+    faces.push(px);
+  }
+  return faces;
+}
+
+// The pixels of a size x size RGBA frame inside the disc of radius rPx about its centre (the
+// disc is symmetric top to bottom, so a frame read bottom-up selects the same pixels).
+function* discPixels(size, rPx) {
+  for (let y = 0; y < size; ++y)
+    for (let x = 0; x < size; ++x)
+      if (Math.hypot(x + 0.5 - size / 2, y + 0.5 - size / 2) <= rPx) yield (y * size + x) * 4;
+}
+
+// The share of the disc whose colour has chroma (max - min channel) above 8/255, and its mean.
+export function colouredShare(px, size, rPx) {
+  let n = 0, coloured = 0;
+  const sum = [0, 0, 0];
+  for (const i of discPixels(size, rPx)) {
+    const c = [px[i], px[i + 1], px[i + 2]];
+    ++n, coloured += Math.max(...c) - Math.min(...c) > 8;
+    for (let k = 0; k < 3; ++k) sum[k] += c[k];
+  }
+  return { share: coloured / n, mean: sum.map((s) => s / n) };
+}
+
+// How much a part of the picture changes the disc: the mean per channel of |on - off| over it,
+// with the share coloured either way. setOn(bool) switches the part; frame() renders and reads.
+export async function partChange(setOn, frame, size, rPx) {
+  setOn(true);
+  const on = await frame();
+  setOn(false);
+  const off = await frame();
+  let diff = 0, n = 0;
+  for (const i of discPixels(size, rPx)) {
+    for (let k = 0; k < 3; ++k) diff += Math.abs(on[i + k] - off[i + k]);
+    n += 3;
+  }
+  return { change: diff / n, on: colouredShare(on, size, rPx), off: colouredShare(off, size, rPx) };
+}
