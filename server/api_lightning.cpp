@@ -1,8 +1,12 @@
 // POST /v1/lightning — grid + obstacles + start/targets -> bolt tree, polylines, quality.
+#include <optional>
+
 #include <effects/lightning.h>
+#include <render/render.h>
 
 #include "api_common.h"
 #include "api_lightning.h"
+#include "bolt_ribbons.h"
 #include "codec.h"
 #include "costs.h"
 
@@ -231,7 +235,8 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   Includes include(body, kLightningIncludes);
   LightningRequest request = parseLightning(body, ctx.config, ctx.at);
   const lt::Params& p = request.params;
-  request.params.measureError = include.has("error");
+  const bool glbFormat = body.value("format", "json") == "glb";  // include: only timeline applies
+  request.params.measureError = include.has("error") && !glbFormat;
   const lt::Bolt bolt = growBolt(p, ctx.at);
   JsonReply reply;
   reply.method = bolt.stats.method;
@@ -245,10 +250,23 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
   out["cellCount"] = bolt.nodes.size();
   out["steps"] = bolt.nodes.back().step;
 
-  if (include.has("polylines") || include.has("timeline")) {
+  if (include.has("polylines") || include.has("timeline") || include.has("mesh") || glbFormat) {
     const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
+    std::optional<lt::Timeline> timeline;
+    if (include.has("timeline")) timeline = lt::timeline(bolt, lines, request.timeline);
+    if (glbFormat) {  // the ribbons as one file instead of JSON; the timeline's times per vertex
+      json strike = nullptr;
+      if (timeline) strike = timelineJson(*timeline), strike.erase("polylines");
+      const auto ribbons = boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr);
+      const glm::dvec3 color = effects::render::Lightning{}.color;  // the preview's
+      reply.binary = boltGlb(ribbons, {color.x, color.y, color.z}, strike);
+      reply.contentType = "model/gltf-binary";
+      return reply;
+    }
     if (include.has("polylines")) out["polylines"] = polylinesJson(lines, p.depth, request.world);
-    if (include.has("timeline")) out["timeline"] = timelineJson(lt::timeline(bolt, lines, request.timeline));
+    if (include.has("mesh"))
+      out["mesh"] = ribbonsJson(boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr));
+    if (timeline) out["timeline"] = timelineJson(*timeline);
   }
   if (include.has("cells")) out["cells"] = cellsJson(bolt);
   if (include.has("tree")) out["tree"] = treeJson(bolt);

@@ -1,8 +1,12 @@
-// Server building blocks without sockets: schema validator, codecs, configuration.
+// Server building blocks without sockets: schema validator, codecs, configuration, bolt ribbons.
+#include <cmath>
 #include <cstdlib>
 
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
+#include "bolt_ribbons.h"
 #include "codec.h"
 #include "config.h"
 #include "json_reader.h"
@@ -168,6 +172,58 @@ TEST(Config, FlagsOverrideEnvironmentOverrideDefaults) {
   EXPECT_NE(parseConfig({"--threads"}, d, help), "");
   EXPECT_EQ(parseConfig({"--help"}, d, help), "");
   EXPECT_TRUE(help);
+}
+
+}  // namespace
+}  // namespace effectd
+
+namespace effectd {
+namespace {
+
+namespace lt = effects::lightning;
+
+lt::Polyline line(bool main, float width, std::vector<std::array<float, 3>> points) {
+  lt::Polyline l;
+  l.main = main;
+  l.width = width;
+  for (const auto& p : points) l.vertices.push_back({p[0], p[1], p[2], 0, main ? 1.0f : 0.5f, 0});
+  return l;
+}
+
+glm::dvec3 at(const Ribbons& r, size_t v) { return {r.positions[3 * v], r.positions[3 * v + 1], r.positions[3 * v + 2]}; }
+
+TEST(BoltRibbons, WidthAsGivenAlongAStraightLineInGltfAxes) {
+  const auto r = boltRibbons({line(true, 2, {{1, 1, 0}, {1, 5, 0}, {1, 9, 0}}), line(false, 1, {{1, 5, 0}, {4, 5, 0}})}, 0,
+                             World{}, nullptr);
+  ASSERT_EQ(r[0].positions.size(), 3u * 6);  // two edges per polyline vertex
+  ASSERT_EQ(r[1].positions.size(), 3u * 4);
+  EXPECT_EQ(r[0].indices.size(), 12u);
+  for (size_t v = 0; v < 6; v += 2) {
+    EXPECT_NEAR(glm::length(at(r[0], v + 1) - at(r[0], v)), 2.0, 1e-6);
+    EXPECT_NEAR((at(r[0], v) + at(r[0], v + 1)).y / 2, -1.0 - 4.0 * double(v / 2), 1e-6);  // y down -> -y
+  }
+  EXPECT_EQ(r[0].uvs[4], 4.0f);  // u: distance along, v: 0 / 1 across
+  EXPECT_EQ(r[0].uvs[5], 0.0f);
+  EXPECT_EQ(r[0].uvs[7], 1.0f);
+  EXPECT_EQ(r[1].intensity[0], 0.5f);
+}
+
+TEST(BoltRibbons, CrossedRibbonsInThreeDAreSquareToEachOtherAndFiniteOnStiffPolylines) {
+  World world;
+  world.given = true;
+  world.cellSize = 0.5;
+  // A helix-like turn, a U-turn back onto itself, and a repeated point.
+  const auto r = boltRibbons({line(true, 2, {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}, {1, 1, 1}, {1, 1, 1}, {2, 2, 2}})},
+                             1, world, nullptr);
+  const Ribbons& m = r[0];
+  ASSERT_EQ(m.positions.size(), 3u * 2 * 2 * 8);  // two ribbons
+  for (float x : m.positions) ASSERT_TRUE(std::isfinite(x));
+  for (size_t v = 0; v < 16; v += 2) {
+    const glm::dvec3 a = at(m, v + 1) - at(m, v), b = at(m, 16 + v + 1) - at(m, 16 + v);
+    EXPECT_NEAR(glm::dot(a, b), 0.0, 1e-5) << v;  // crossed at right angles
+    EXPECT_GE(glm::length(a), 1.0 - 1e-6);        // the width (2 cells of 0.5), mitred up to twice
+    EXPECT_LE(glm::length(a), 2.0 + 1e-6);
+  }
 }
 
 }  // namespace

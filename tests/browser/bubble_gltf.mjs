@@ -13,37 +13,14 @@
 // 5.6 % and 3.1 %).
 // Usage: node bubble_gltf.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
-import http from 'node:http';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 import { launchWebGl2Chromium } from './chromium.mjs';
+import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
-const here = path.dirname(fileURLToPath(import.meta.url));
-const modules = path.join(here, 'node_modules');
 
-const pages = http.createServer((req, res) => {
-  const url = new URL(req.url, 'http://x');
-  if (url.pathname === '/page_helpers.mjs') {
-    res.writeHead(200, { 'Content-Type': 'text/javascript' });
-    return res.end(fs.readFileSync(path.join(here, 'page_helpers.mjs')));
-  }
-  if (url.pathname.startsWith('/nm/')) {  // the engines' ES modules, as a page would load them
-    const file = path.normalize(path.join(modules, decodeURIComponent(url.pathname.slice('/nm/'.length))));
-    if (!file.startsWith(modules) || !fs.existsSync(file) || !fs.statSync(file).isFile()) return res.writeHead(404).end();
-    res.writeHead(200, { 'Content-Type': 'text/javascript' });
-    return res.end(fs.readFileSync(file));
-  }
-  res.writeHead(200, { 'Content-Type': 'text/html' });
-  res.end('<!doctype html><title>effectd bubble GLB in three.js and Babylon.js</title>' +
-          '<script type="importmap">{"imports":{"three":"/nm/three/build/three.module.js",' +
-          '"three/addons/":"/nm/three/examples/jsm/","@babylonjs/core/":"/nm/@babylonjs/core/",' +
-          '"@babylonjs/loaders/":"/nm/@babylonjs/loaders/"}}</script>' +
-          '<canvas id="gl"></canvas><canvas id="png"></canvas><canvas id="bjs"></canvas>');
-});
-await new Promise((r) => pages.listen(0, '127.0.0.1', r));
-const origin = `http://localhost:${pages.address().port}`;
+const { origin, close: closePages } = await servePages('effectd bubble GLB in three.js and Babylon.js', ['gl', 'png', 'bjs']);
 const { url: api, process: server } = await startEffectd(binary, ['--cors-origins', origin]);
 
 // The scene both engines and the preview draw: the default bubble (wobble off) 4 units away, a
@@ -197,6 +174,6 @@ try {
 } finally {
   await browser.close();
   server.kill();
-  pages.close();
+  closePages();
 }
 process.exit(results.failures ? 1 : 0);

@@ -6,22 +6,13 @@
 // the sky's cube map (render::skyAt, as scene.json documents it).
 // Usage: node bubble_webgl.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
-import http from 'node:http';
 import { launchWebGl2Chromium } from './chromium.mjs';
+import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
 
-const pages = http.createServer((req, res) => {
-  if (req.url === '/page_helpers.mjs') {
-    res.writeHead(200, { 'Content-Type': 'text/javascript' });
-    return res.end(fs.readFileSync(new URL('./page_helpers.mjs', import.meta.url)));
-  }
-  res.writeHead(200, { 'Content-Type': 'text/html' });
-  res.end('<!doctype html><title>effectd bubble in WebGL2</title><canvas id="gl"></canvas><canvas id="png"></canvas>');
-});
-await new Promise((r) => pages.listen(0, '127.0.0.1', r));
-const origin = `http://localhost:${pages.address().port}`;
+const { origin, close: closePages } = await servePages('effectd bubble in WebGL2', ['gl', 'png']);
 const { url: api, process: server } = await startEffectd(binary, ['--cors-origins', origin]);
 
 const browser = await launchWebGl2Chromium(chromium);
@@ -235,11 +226,11 @@ try {
   check(r.p99 <= 12, `99th percentile ${r.p99}/255 (tolerance 12)`, r);
   console.log(`  browser vs preview: mean ${r.mean?.toFixed(3)}, p99 ${r.p99}, worst ${r.worst}, over 12: ${r.over} of ${r.pixels}`);
   if (process.env.EFFECTD_WEBGL_PNG && r.picture)  // the browser's frame, to look at
-    (await import('node:fs')).writeFileSync(process.env.EFFECTD_WEBGL_PNG, Buffer.from(r.picture.split(',')[1], 'base64'));
+    fs.writeFileSync(process.env.EFFECTD_WEBGL_PNG, Buffer.from(r.picture.split(',')[1], 'base64'));
 } finally {
   await browser.close();
   server.kill('SIGTERM');
-  pages.close();
+  closePages();
 }
 console.log(results.failures ? `${results.failures} check(s) failed` : 'all WebGL2 checks passed');
 process.exit(results.failures ? 1 : 0);

@@ -249,5 +249,41 @@ for (const [name, request, iridescent, texture] of [
   check(same === m.vertexCount, `bubble mesh (uvOrigin top-left): tangent w as /v1/tangents gives it on ${same}/${m.vertexCount} vertices`);
 }
 
+// The bolt as ribbons (/v1/lightning format glb): valid, and the same triangles as its JSON
+// mesh form (include mesh), attribute for attribute.
+for (const [name, request] of [
+  ['2-D with timeline', { grid: { width: 64, height: 64 }, start: [32, 1], targets: [[20, 62]], include: ['timeline'] }],
+  ['3-D in world units', { grid: { width: 24, height: 24, depth: 24 }, start: [12, 1, 12], targets: [[12, 22, 12]],
+                           world: { origin: [-3, 6, 3], cellSize: 0.25 } }],
+  ['no branches', { grid: { width: 8, height: 8 }, start: [4, 0], targets: [[4, 1]] }],
+]) {
+  const send = (body) => fetch(`${base}/v1/lightning`, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+  const res = await send({ ...request, format: 'glb' });
+  const bytes = new Uint8Array(await res.arrayBuffer());
+  if (!check(res.status === 200 && res.headers.get('Content-Type') === 'model/gltf-binary', `bolt GLB (${name}): 200 model/gltf-binary`, res.status)) continue;
+  const v = await issues(bytes);
+  check(v.errors === 0 && v.warnings === 0, `bolt GLB (${name}): validator finds 0 errors, 0 warnings`, v.messages);
+  const { doc, bin } = parseGlb(bytes);
+  const mesh = (await (await send({ ...request, include: [...(request.include || []), 'mesh'] })).json()).mesh;
+  const read = (accessor) => {
+    const a = doc.accessors[accessor], view = doc.bufferViews[a.bufferView];
+    const n = a.count * { SCALAR: 1, VEC2: 2, VEC3: 3 }[a.type];
+    const at = bin.byteOffset + (view.byteOffset || 0) + (a.byteOffset || 0);
+    const Type = { 5126: Float32Array, 5123: Uint16Array, 5125: Uint32Array }[a.componentType];
+    return Array.from(new Type(bin.buffer.slice(at, at + n * Type.BYTES_PER_ELEMENT)));
+  };
+  const same = (x, y) => x.length === y.length && x.every((e, i) => e === Math.fround(y[i]));  // JSON: shortest float32 form
+  check(doc.meshes.length === mesh.primitives.length, `bolt GLB (${name}): ${doc.meshes.length} meshes, one per JSON primitive`);
+  mesh.primitives.forEach((p, k) => {
+    const g = doc.meshes[k].primitives[0];
+    const colour = read(g.attributes.COLOR_0).filter((_, i) => i % 3 === 0);
+    check(doc.meshes[k].name === (p.channel === 'main' ? 'main' : 'branches') && same(read(g.attributes.POSITION), p.positions) &&
+          same(read(g.attributes.TEXCOORD_0), p.uvs) && same(colour, p.intensity) && same(read(g.indices), p.indices) &&
+          (!p.leader || (same(read(g.attributes._LEADER), p.leader) && same(read(g.attributes._STROKE_DELAY), p.strokeDelay))),
+          `bolt GLB (${name}): ${p.channel} is the JSON mesh's geometry (${p.positions.length / 3} vertices)`);
+  });
+  if (request.include) check(doc.scenes[0].extras.timeline.keyframes.t.length > 1, `bolt GLB (${name}): the timeline's keyframes in the scene's extras`);
+}
+
 console.log(results.failures ? `${results.failures} glTF check(s) failed` : 'glTF checks passed');
 process.exit(results.failures ? 1 : 0);
