@@ -219,36 +219,42 @@ std::string environmentFragment(Background::Kind kind, bool sky) {
          "}\n";
 }
 
-std::string waveVertex() {
+std::string waveVertex(bool world) {
   return std::string(kVertexHeader) +
-         "layout(location = 0) in vec2 aPosition;  // NDC\n"
+         (world ? "layout(location = 0) in vec3 aPosition;  // world\nuniform mat4 uViewProjection;\nout vec3 vWorld;\n"
+                : "layout(location = 0) in vec2 aPosition;  // NDC\n") +
          "layout(location = 1) in vec2 aUv;\n"
          "layout(location = 2) in vec3 aNormal;\n"
          "layout(location = 3) in vec4 aTangent;  // MikkTSpace, w = handedness\n"
          "out vec2 vUv;\nout vec3 vNormal;\nout vec4 vTangent;\n"
-         "void main() {\n  vUv = aUv;\n  vNormal = aNormal;\n  vTangent = aTangent;\n"
-         "  gl_Position = vec4(aPosition, 1.0, 1.0);\n}\n";
+         "void main() {\n  vUv = aUv;\n  vNormal = aNormal;\n  vTangent = aTangent;\n" +
+         (world ? "  vWorld = aPosition;\n  gl_Position = uViewProjection * vec4(aPosition, 1.0);\n}\n"
+                : "  gl_Position = vec4(aPosition, 1.0, 1.0);\n}\n");
 }
 
-std::string waveFragment() {
-  return std::string(kFragmentHeader) +
-         "in vec2 vUv;\nin vec3 vNormal;\nin vec4 vTangent;\nout vec4 fragColor;\n"
-         "uniform sampler2D uNormalA;\nuniform sampler2D uNormalB;\nuniform sampler2D uAlpha;\n"
-         "uniform vec2 uOffsetA;  // scroll offsets, reduced modulo 1 on the CPU\n"
-         "uniform vec2 uOffsetB;\n"
-         "uniform float uScale;\nuniform float uStrength;\nuniform vec3 uLightColor;\nuniform vec3 uLight;\n"
-         "void main() {\n"
-         "  vec3 a = texture(uNormalA, vUv * uScale + uOffsetA).xyz * 2.0 - 1.0;\n"
-         "  vec3 b = texture(uNormalB, vUv * uScale * 0.73 + uOffsetB).xyz * 2.0 - 1.0;\n"
-         "  vec3 nt = normalize(vec3(a.xy + b.xy, a.z * b.z));  // the two maps combined (whiteout)\n"
-         "  vec3 N = normalize(vNormal);\n"
-         "  vec3 T = normalize(vTangent.xyz - N * dot(N, vTangent.xyz));\n"
-         "  vec3 B = vTangent.w * cross(N, T);\n"
-         "  vec3 n = normalize(mat3(T, B, N) * nt);  // seed 004: [r g b] [T; B; N]\n"
-         "  float light = pow(max(dot(n, normalize(uLight)), 0.0), 24.0);\n"
-         "  float alpha = texture(uAlpha, vUv * 0.5 + 0.5 * uOffsetB).r;\n"
-         "  fragColor = vec4(uLightColor * (uStrength * light * alpha), 0.0);  // added to the backdrop\n"
-         "}\n";
+std::string waveFragment(bool world, const FogVariant* fog) {
+  std::string s = std::string(kFragmentHeader) +
+                  "in vec2 vUv;\nin vec3 vNormal;\nin vec4 vTangent;\nout vec4 fragColor;\n" +
+                  (world ? "in vec3 vWorld;\n" : "") +
+                  "uniform sampler2D uNormalA;\nuniform sampler2D uNormalB;\nuniform sampler2D uAlpha;\n"
+                  "uniform vec2 uOffsetA;  // scroll offsets, reduced modulo 1 on the CPU\n"
+                  "uniform vec2 uOffsetB;\n"
+                  "uniform float uScale;\nuniform float uStrength;\nuniform vec3 uLightColor;\nuniform vec3 uLight;\n";
+  if (world && fog) s += fogGlsl(*fog);
+  s += "void main() {\n"
+       "  vec3 a = texture(uNormalA, vUv * uScale + uOffsetA).xyz * 2.0 - 1.0;\n"
+       "  vec3 b = texture(uNormalB, vUv * uScale * 0.73 + uOffsetB).xyz * 2.0 - 1.0;\n"
+       "  vec3 nt = normalize(vec3(a.xy + b.xy, a.z * b.z));  // the two maps combined (whiteout)\n"
+       "  vec3 N = normalize(vNormal);\n"
+       "  vec3 T = normalize(vTangent.xyz - N * dot(N, vTangent.xyz));\n"
+       "  vec3 B = vTangent.w * cross(N, T);\n"
+       "  vec3 n = normalize(mat3(T, B, N) * nt);  // seed 004: [r g b] [T; B; N]\n"
+       "  float light = pow(max(dot(n, normalize(uLight)), 0.0), 24.0);\n"
+       "  float alpha = texture(uAlpha, vUv * 0.5 + 0.5 * uOffsetB).r;\n"
+       "  vec3 added = uLightColor * (uStrength * light * alpha);\n";
+  // Light added on a fogged surface reaches the eye attenuated as the surface's own: f * added.
+  if (world && fog) s += "  added = applyFog(added, vWorld) - applyFog(vec3(0.0), vWorld);\n";
+  return s + "  fragColor = vec4(added, 0.0);  // added to what is behind\n}\n";
 }
 
 std::string quadVertex() {

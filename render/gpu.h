@@ -4,6 +4,8 @@
 // returns an Error when the GPU refuses; renderer.cpp decides which passes a scene needs.
 #pragma once
 
+#include <array>
+
 #include <deque>
 #include <memory>
 #include <optional>
@@ -104,6 +106,10 @@ struct FrameState {
 void setBackground(Program& p, const Background& b, const Texture* image);
 // Fog uniforms of a program built with fogGlsl (passes/quads.cpp).
 void setFog(Program& p, const Fog& f, const glm::vec3& eye);
+
+// A quad's corners as it is drawn: centre -/+ right -/+ up, counter-clockwise seen from its
+// normal's side (passes/quads.cpp).
+std::array<glm::dvec3, 4> quadCorners(const Quad& q);
 
 std::optional<Error> backgroundPass(Gpu& gpu, FrameState& f);   // passes/background.cpp
 std::optional<Error> surfaceWavePass(Gpu& gpu, FrameState& f);  // passes/surface_wave.cpp

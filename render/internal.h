@@ -41,8 +41,10 @@ std::string screenVertex();                         // full-screen triangle, no 
 std::string backgroundFragment(Background::Kind kind);
 // One cube face: direction -> the backdrop, or the sky (render::skyAt) when `sky`.
 std::string environmentFragment(Background::Kind kind, bool sky);
-std::string waveVertex();
-std::string waveFragment();
+// The surface wave over the frame (NDC positions), or on a quad in the world (`world`: world
+// positions through uViewProjection, fogged as the quad when `fog`).
+std::string waveVertex(bool world);
+std::string waveFragment(bool world, const FogVariant* fog);
 std::string quadVertex();
 std::string quadFragment(const FogVariant* fog);
 std::string boltVertex(bool world);

@@ -112,8 +112,9 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   // The passes this scene needs, back to front.
   using Pass = std::optional<Error> (*)(Gpu&, FrameState&);
   std::vector<Pass> passes = {backgroundPass};
-  if (scene.wave) passes.push_back(surfaceWavePass);
+  if (scene.wave && !scene.wave->onQuad) passes.push_back(surfaceWavePass);  // over the backdrop
   if (!scene.quads.empty()) passes.push_back(quadsPass);
+  if (scene.wave && scene.wave->onQuad) passes.push_back(surfaceWavePass);  // on its quad
   if (!scene.bubbles.empty()) passes.push_back(bubblePass);
   if (scene.lightning && !scene.lightning->polylines.empty()) passes.push_back(lightningPass);
   if (scene.blend && scene.blend->amount > 0) passes.push_back(cameraBlendPass);

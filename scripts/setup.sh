@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   glslang-tools spirv-tools  # every shader variant compiled and validated by each language's own tools
   glslang-dev libspirv-cross-c-shared-dev  # GLSL -> SPIR-V -> HLSL / MSL (server/shader_targets.cpp)
+  mesa-vulkan-drivers libvulkan-dev  # lavapipe: the SPIR-V drawn by Vulkan on the CPU (tests/vulkan/)
   gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
   iproute2           # ss: tests/binary_test.sh reads the listen backlog

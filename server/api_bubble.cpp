@@ -136,6 +136,8 @@ json uniforms(const bb::Params& p, const bb::ThicknessOptions& film, const std::
               {"uThicknessRange", thicknessRange},
               {"uThicknessNm", bb::equatorThickness(p, film, t)},
               {"uPass", 0}};
+  const glm::dvec4 base = rd::Bubble{}.baseColor;  // the preview's (scene bubbleStyle.baseColor)
+  all["uBaseColor"] = {base.r, base.g, base.b, base.a};
   json directions = json::array(), radiances = json::array(), sharpness = json::array();
   for (size_t i = 0; i < lights.size() && i < size_t(bb::kMaxLights); ++i) {
     const glm::dvec3 d = glm::normalize(lights[i].direction), r = lights[i].color * lights[i].intensity;

@@ -115,8 +115,14 @@ void parseBackground(const json& b, const Config& config, rd::Scene& s) {
   }
 }
 
-rd::SurfaceWave parseSurfaceWave(const json& w) {
+rd::SurfaceWave parseSurfaceWave(const json& w, size_t quads) {
   rd::SurfaceWave wave;
+  if (w.contains("quad")) {
+    wave.onQuad = w["quad"].get<size_t>();
+    if (*wave.onQuad >= quads)
+      throw fieldError(422, "/surfaceWave/quad",
+                       "names quad " + std::to_string(*wave.onQuad) + " but the scene has " + std::to_string(quads));
+  }
   wave.strength = w.value("strength", wave.strength);
   wave.scale = w.value("scale", wave.scale);
   wave.speed = w.value("speed", wave.speed);
@@ -283,10 +289,10 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
     if (e.contains("ground")) env.ground = toVec3(e["ground"]);
     s.environment = env;
   }
-  if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"]);
   if (body.contains("cameraBlend"))
     s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
   if (body.contains("quads")) parseQuads(body["quads"], s);
+  if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"], s.quads.size());
   if (body.contains("fog")) s.fog = parseSceneFog(body["fog"]);
   if (body.contains("lightning")) s.lightning = sceneLightning(body, config, animation);
   if (body.contains("bubble"))

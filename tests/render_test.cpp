@@ -680,12 +680,46 @@ TEST(Render, BadScenesNameTheField) {
   problem({{"fog", {{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 1}}}}}}, 400, "/fog/fog/end");
   problem({{"bubble", {{"mesh", {{"level", 9}}}}}}, 400, "/bubble/mesh/level");
   problem({{"quads", {{{"center", {0, 0, 0}}, {"size", {1, 1}}, {"normal", {0, 0, 0}}}}}}, 400, "/quads/0/normal");
+  problem({{"quads", {{{"center", {0, 0, -5}}, {"size", {1, 1}}}}}, {"surfaceWave", {{"quad", 1}}}}, 422, "/surfaceWave/quad");
 
   // A PNG larger than the pixel limit is refused from its header, before decoding.
   rd::Image big{1100, 1000, std::vector<float>(size_t(1100) * 1000 * 4, 0.5f)};
   auto png = rd::encodePng(big, 8);
   ASSERT_TRUE(png.ok());
   problem({{"background", {{"image", base64Encode(png.value())}}}}, 413, "/background/image");
+}
+
+// surfaceWave.quad puts the ripples on that quad in the world (water below the horizon): every
+// pixel the waves change lies on the quad, none in the sky above it or on a wall in front of it.
+TEST(Render, SurfaceWaveOnAQuadLightsOnlyThatQuad) {
+  TestServer s;
+  const json water = {{"center", {0, -1, -10}}, {"normal", {0, 1, 0}}, {"up", {0, 0, -1}}, {"size", {40, 30}}, {"color", {0.1, 0.12, 0.18}}};
+  const json wall = {{"center", {0, -0.5, -4}}, {"size", {1, 1.5}}, {"color", {0.3, 0.3, 0.3}}};
+  json scene = {{"width", 96}, {"height", 96}, {"time", 5},
+                {"camera", {{"position", {0, 1, 6}}, {"target", {0, 0.5, 0}}, {"fovY", 50}}},
+                {"background", {{"color", {0.05, 0.05, 0.1}}}}, {"quads", {water, wall}}};
+  const rd::Image plain = decode(render(s, scene)->body);
+  scene["surfaceWave"] = {{"strength", 2}, {"scale", 4}, {"quad", 0}};
+  auto r = render(s, scene);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_NE(r->get_header_value("X-Render-Passes").find("surfaceWave:quad"), std::string::npos);
+  const rd::Image waves = decode(r->body);
+  // Which pixels show the water, the wall, the sky: the same scene with each quad recoloured.
+  json marked = scene;
+  marked.erase("surfaceWave");
+  marked["background"] = {{"color", {0, 0, 0}}};
+  marked["quads"][0]["color"] = {1, 0, 0};
+  marked["quads"][1]["color"] = {0, 1, 0};
+  const rd::Image mask = decode(render(s, marked)->body);
+  size_t onWater = 0, elsewhere = 0;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const bool changed = glm::length(glm::vec3(pixel(waves, x, y) - pixel(plain, x, y))) > 2.0f / 255;
+      const glm::vec4 m = pixel(mask, x, y);
+      if (changed) (m.r > 0.5f && m.g < 0.5f ? onWater : elsewhere)++;
+    }
+  EXPECT_GT(onWater, 300u);
+  EXPECT_EQ(elsewhere, 0u) << "waves outside the water quad";
 }
 
 json strikeScene(int frames, const char* format) {

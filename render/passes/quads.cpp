@@ -1,6 +1,7 @@
 // Opaque quads (walls, floors, props) with the depth test, fogged per fragment when the
 // scene has fog.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -108,20 +109,22 @@ void setFog(Program& p, const Fog& f, const glm::vec3& eye) {
   }
 }
 
+std::array<glm::dvec3, 4> quadCorners(const Quad& q) {
+  glm::dvec3 n = glm::normalize(q.normal), up = q.up - n * glm::dot(q.up, n);
+  if (glm::length(up) < 1e-9) up = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) - n * n.y : glm::dvec3(1, 0, 0) - n * n.x;
+  up = glm::normalize(up) * (0.5 * q.size.y);
+  const glm::dvec3 right = glm::normalize(glm::cross(up, n)) * (0.5 * q.size.x);
+  return {q.center - right - up, q.center + right - up, q.center + right + up, q.center - right + up};
+}
+
 std::optional<Error> quadsPass(Gpu& gpu, FrameState& f) {
   const Scene& scene = f.scene;
   std::vector<float> data;
   for (const Quad& q : scene.quads) {
-    glm::dvec3 n = glm::normalize(q.normal), up = q.up - n * glm::dot(q.up, n);
-    if (glm::length(up) < 1e-9)
-      up = std::abs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) - n * n.y : glm::dvec3(1, 0, 0) - n * n.x;
-    up = glm::normalize(up) * (0.5 * q.size.y);
-    glm::dvec3 right = glm::normalize(glm::cross(up, n)) * (0.5 * q.size.x);
-    const glm::dvec3 corners[6] = {q.center - right - up, q.center + right - up, q.center + right + up,
-                                   q.center - right - up, q.center + right + up, q.center - right + up};
-    for (const auto& c : corners)
+    const std::array<glm::dvec3, 4> c = quadCorners(q);
+    for (int k : {0, 1, 2, 0, 2, 3})
       data.insert(data.end(),
-                  {float(c.x), float(c.y), float(c.z), float(q.color.r), float(q.color.g), float(q.color.b)});
+                  {float(c[k].x), float(c[k].y), float(c[k].z), float(q.color.r), float(q.color.g), float(q.color.b)});
   }
   auto program = gpu.program("quad" + f.fogKey,
                              [&] { return std::pair{quadVertex(), quadFragment(f.fog ? &*f.fog : nullptr)}; });

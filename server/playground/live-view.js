@@ -2,7 +2,8 @@
 // way a game client would draw it.
 //   lightning  the polylines as glowing ribbons; with a timeline, the strike played as
 //              docs/effects.md §1 says a client plays it (leader, return stroke, re-strikes)
-//   fog        a small scene (ground, blocks, sky) fogged per pixel from the answer's table
+//   fog        the preview's scene (its quads, camera and backdrop) fogged per pixel from the
+//              answer's table
 //   bubble     the answer's mesh with its own GLSL ES 3.00, uniforms, thin-film table and
 //              thickness texture, in the draw order and blend the answer names
 //   tangents   the mesh with each vertex's tangent (red), bitangent (green) and normal (blue)
@@ -68,63 +69,50 @@ void main() {
   color = vec4(mix(uColor, vec3(1.0), clamp(a - 0.6, 0.0, 1.0)) * a, 1.0);
 }`;
 
-const FULL_VS = `#version 300 es
-out vec2 vNdc;
-void main() {
-  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-  vNdc = p * 2.0 - 1.0;
-  gl_Position = vec4(vNdc, 0.0, 1.0);
-}`;
-// The fog scene: ground at y = 0, four blocks, the sky; the table gives (S, f) per distance
-// (and per ray direction y for HEIGHT), composed as the renderer does: colour * f + S.
+// The fog scene is the preview's (its quads, camera and backdrop), each fragment fogged from the
+// answer's table by its distance (and, with elevations, its ray's direction y), composed as the
+// renderer does: colour * f + S.
+const FOG_VS = `#version 300 es
+in vec3 aPosition; in vec3 aColor; uniform mat4 uViewProjection; out vec3 vWorld; out vec3 vColor;
+void main() { vWorld = aPosition; vColor = aColor; gl_Position = uViewProjection * vec4(aPosition, 1.0); }`;
 const FOG_FS = `#version 300 es
 precision highp float;
-in vec2 vNdc;
+in vec3 vWorld; in vec3 vColor;
 uniform sampler2D uTable; uniform vec2 uRange; uniform vec2 uTexels; uniform float uRows;
-uniform float uCutoff; uniform float uCameraHeight; uniform float uYaw;
+uniform float uCutoff; uniform vec3 uEye;
 out vec4 color;
-const float kFar = 1e30;
-float box(vec3 o, vec3 d, vec3 lo, vec3 hi, out vec3 n) {
-  vec3 t0 = (lo - o) / d, t1 = (hi - o) / d, a = min(t0, t1), b = max(t0, t1);
-  float tn = max(max(a.x, a.y), a.z), tf = min(min(b.x, b.y), b.z);
-  if (tf < max(tn, 0.0)) return kFar;
-  n = -sign(d) * step(a.yzx, a.xyz) * step(a.zxy, a.xyz);
-  return tn;
-}
 void main() {
-  float R = uRange.y;
-  float c = cos(uYaw), s = sin(uYaw);
-  vec3 dir = normalize(vec3(vNdc.x * 0.577, vNdc.y * 0.577 - 0.12, -1.0));
-  dir = vec3(c * dir.x - s * dir.z, dir.y, s * dir.x + c * dir.z);
-  vec3 eye = vec3(0.0, uCameraHeight, 0.0);
-  float d = kFar; vec3 base; vec3 n = vec3(0.0, 1.0, 0.0);
-  // sky
-  base = dir.y >= 0.0 ? mix(vec3(1.0, 0.98, 0.95), vec3(0.35, 0.6, 1.0), sqrt(dir.y)) : vec3(0.3);
-  if (dir.y < 0.0) {
-    float t = -eye.y / dir.y;
-    if (t > 0.0) {
-      d = t;
-      vec2 p = floor((eye + dir * t).xz / (R / 40.0));
-      base = mod(p.x + p.y, 2.0) < 1.0 ? vec3(0.42, 0.4, 0.36) : vec3(0.25, 0.24, 0.22);
-    }
-  }
-  vec3 colors[4] = vec3[4](vec3(0.8, 0.3, 0.2), vec3(0.2, 0.5, 0.8), vec3(0.85, 0.75, 0.2), vec3(0.3, 0.7, 0.35));
-  for (int i = 0; i < 4; ++i) {
-    float z = R * (0.06 + 0.18 * float(i) * float(i) / 3.0 + 0.04 * float(i));
-    float x = (i % 2 == 0 ? -1.0 : 1.0) * z * 0.25, w = z * 0.08;
-    vec3 bn;
-    float t = box(eye, dir, vec3(x - w, 0.0, -z - w), vec3(x + w, 3.0 * w, -z + w), bn);
-    if (t < d) { d = t; n = bn; base = colors[i] * (0.55 + 0.45 * max(dot(bn, normalize(vec3(0.4, 0.8, 0.3))), 0.0)); }
-  }
+  vec3 ray = vWorld - uEye;
+  float d = length(ray);
   vec4 fog = vec4(0.0, 0.0, 0.0, 1.0);
   if (d < uCutoff) {
+    float R = uRange.y;
     float u = clamp((min(d, R) - uRange.x) / (R - uRange.x), 0.0, 1.0);
-    float v = uRows > 1.0 ? (dir.y + 1.0) * 0.5 : 0.5;
+    float v = uRows > 1.0 ? (ray.y / max(d, 1e-6) + 1.0) * 0.5 : 0.5;
     fog = texture(uTable, vec2((u * (uTexels.x - 1.0) + 0.5) / uTexels.x, (v * (uTexels.y - 1.0) + 0.5) / uTexels.y));
   }
-  vec3 linear = base * fog.a + fog.rgb;
-  color = vec4(pow(clamp(linear, 0.0, 1.0), vec3(1.0 / 2.2)), 1.0);
+  color = vec4(vColor * fog.a + fog.rgb, 1.0);
 }`;
+
+// Two triangles per quad, its corners as the renderer places them (scene.json's quads: normal
+// towards the viewer, up, size, colour).
+function quadTriangles(quads) {
+  const position = [], colour = [];
+  for (const q of quads) {
+    const n = normalize(q.normal || [0, 0, 1]);
+    let up = q.up || [0, 1, 0];
+    up = sub(up, n.map((x) => x * dot(up, n)));
+    if (Math.hypot(...up) < 1e-9) up = Math.abs(n[1]) < 0.9 ? sub([0, 1, 0], n.map((x) => x * n[1])) : sub([1, 0, 0], n.map((x) => x * n[0]));
+    up = normalize(up).map((x) => x * 0.5 * q.size[1]);
+    const right = normalize(cross(up, n)).map((x) => x * 0.5 * q.size[0]);
+    const corner = (a, b) => q.center.map((c, k) => c + a * right[k] + b * up[k]);
+    for (const [a, b] of [[-1, -1], [1, -1], [1, 1], [-1, -1], [1, 1], [-1, 1]]) {
+      position.push(...corner(a, b));
+      colour.push(...(q.color || [0.5, 0.5, 0.5]));
+    }
+  }
+  return { position: new Float32Array(position), colour: new Float32Array(colour) };
+}
 
 const MESH_VS = `#version 300 es
 in vec3 aPosition; in vec3 aColor; uniform mat4 uViewProjection; out vec3 vColor;
@@ -393,11 +381,11 @@ export class LiveView {
   }
 
   // answer: /v1/fog with an rgba16f table.
-  showFog(answer) {
+  showFog(answer, stage) {
     this.reset();
     const table = answer.table;
     if (!table || table.encoding !== 'rgba16f') throw new Error('the answer has no rgba16f table');
-    const gl = this.gl, prog = this.program(FULL_VS, FOG_FS);
+    const gl = this.gl, prog = this.program(FOG_VS, FOG_FS);
     let cols = table.size, rows = table.elevations || 1;
     let texels = new Uint16Array(bytesOf(table.data).buffer);
     const max = gl.getParameter(gl.MAX_TEXTURE_SIZE);
@@ -410,25 +398,38 @@ export class LiveView {
     }
     const vao = gl.createVertexArray();
     this.resources.push(vao);
+    gl.bindVertexArray(vao);
+    const { position, colour } = quadTriangles(stage.quads);
+    this.attribute(prog, 'aPosition', position, 3);
+    this.attribute(prog, 'aColor', colour, 3);
+    gl.bindVertexArray(null);
     this.texture(0, gl.TEXTURE_2D);
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA16F, cols, rows, 0, gl.RGBA, gl.HALF_FLOAT, texels);
+    const { position: eye, target, fovY } = stage.camera;
     this.draw = () => {
+      // The preview's camera; dragging turns it about the vertical through the eye.
+      const turn = this.yaw - 0.6, look = sub(target, eye);
+      const turned = [Math.cos(turn) * look[0] + Math.sin(turn) * look[2], look[1], -Math.sin(turn) * look[0] + Math.cos(turn) * look[2]];
+      const viewProjection = multiply(perspective(fovY, 0.05, 1000), lookAt(eye, eye.map((x, k) => x + turned[k])));
       gl.viewport(0, 0, this.canvas.width, this.canvas.height);
+      gl.clearColor(...stage.background.color.slice(0, 3), 1);
+      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+      gl.enable(gl.DEPTH_TEST);
       gl.useProgram(prog);
       gl.bindVertexArray(vao);
       gl.activeTexture(gl.TEXTURE0);
       const at = (n) => gl.getUniformLocation(prog, n);
+      gl.uniformMatrix4fv(at('uViewProjection'), false, viewProjection);
+      gl.uniform3fv(at('uEye'), eye);
       gl.uniform1i(at('uTable'), 0);
       gl.uniform2f(at('uRange'), table.range[0], table.range[1]);
       gl.uniform2f(at('uTexels'), cols, rows);
       gl.uniform1f(at('uRows'), rows);
       gl.uniform1f(at('uCutoff'), table.cutoffDistance ?? 1e38);
-      // The table depends only on distance and direction, so the scene is scaled to its range.
-      gl.uniform1f(at('uCameraHeight'), 0.05 * table.range[1]);
-      gl.uniform1f(at('uYaw'), this.yaw - 0.6);
-      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      gl.drawArrays(gl.TRIANGLES, 0, position.length / 3);
       gl.bindVertexArray(null);
+      gl.disable(gl.DEPTH_TEST);
     };
     this.dirty = true;
   }

@@ -33,6 +33,8 @@ const FOG_STAGE = [
   { center: [-1.5, 1.5, -12], size: [1.2, 1.2], color: [0.9, 0.8, 0.2] },
   { center: [1.5, 1.5, -30], size: [1.2, 1.2], color: [0.9, 0.8, 0.2] },
 ];
+// /v1/render's camera where a scene names none (scene.json's defaults).
+const DEFAULT_CAMERA = { position: [0, 1, 6], target: [0, 0.5, 0], fovY: 45 };
 const NIGHT = { gradient: { top: [0.03, 0.03, 0.08], bottom: [0.12, 0.12, 0.2] } };
 const SKY = { zenith: [0.35, 0.6, 1.0], horizon: [1.0, 0.98, 0.95], ground: [0.16, 0.18, 0.12] };
 
@@ -186,8 +188,16 @@ async function runLive(answer, signal) {
   }
   if (kind === 'lightning') view.showLightning(data);
   else if (kind === 'fog') {
-    view.showFog(data);
-    if (sub.fog && sub.fog.directional) $('live-note').textContent = '(the directional glow is in the preview only)';
+    // The preview's scene: a scene's own quads, camera and backdrop where it has them.
+    const stage = previewScene('fog', sub);
+    if (effect === 'scene') {
+      if (req.quads) stage.quads = req.quads;
+      if (req.camera) stage.camera = { ...DEFAULT_CAMERA, ...req.camera };
+      if (req.background && req.background.color) stage.background = req.background;
+    }
+    view.showFog(data, stage);
+    const onlyInPreview = [sub.fog && sub.fog.directional && 'the directional glow', sub.regions && sub.regions.length && 'the local regions'].filter(Boolean);
+    if (onlyInPreview.length) $('live-note').textContent = `(${onlyInPreview.join(' and ')}: in the preview only)`;
   }
   else view.showBubble(data);
 }

@@ -1,6 +1,7 @@
 // The test pages' origin: one page (an import map for three, its addons and Babylon.js, and the
 // canvases the script names), /page_helpers.mjs, and the engines' ES modules from node_modules
-// under /nm/, as a page would load them. Returns { origin, close }.
+// under /nm/, as a page would load them; `files` maps more paths to files (ES modules). Returns
+// { origin, close }.
 import fs from 'node:fs';
 import http from 'node:http';
 import path from 'node:path';
@@ -9,12 +10,13 @@ import { fileURLToPath } from 'node:url';
 const here = path.dirname(fileURLToPath(import.meta.url));
 const modules = path.join(here, 'node_modules');
 
-export async function servePages(title, canvases) {
+export async function servePages(title, canvases, files = {}) {
   const pages = http.createServer((req, res) => {
     const url = new URL(req.url, 'http://x');
-    if (url.pathname === '/page_helpers.mjs') {
+    const file = url.pathname === '/page_helpers.mjs' ? path.join(here, 'page_helpers.mjs') : files[url.pathname];
+    if (file) {
       res.writeHead(200, { 'Content-Type': 'text/javascript' });
-      return res.end(fs.readFileSync(path.join(here, 'page_helpers.mjs')));
+      return res.end(fs.readFileSync(file));
     }
     if (url.pathname.startsWith('/nm/')) {
       const file = path.normalize(path.join(modules, decodeURIComponent(url.pathname.slice('/nm/'.length))));

@@ -62,6 +62,20 @@ const canvasStats = (page) => page.evaluate(() => {
   }
   return { lit, fraction: lit / (d.length / 4), hash };
 });
+// The live canvas against the preview image, both drawn at 128 x 128: the mean difference per
+// channel (0-255). The same scene drawn two ways differs by the table's resolution; different
+// scenes (the fog tab once showed a corridor in one and a checkerboard in the other) by far more.
+const liveAgainstPreview = (page) => page.evaluate(() => {
+  const pixels = (el) => {
+    const g = Object.assign(document.createElement('canvas'), { width: 128, height: 128 }).getContext('2d');
+    g.drawImage(el, 0, 0, 128, 128);
+    return g.getImageData(0, 0, 128, 128).data;
+  };
+  const a = pixels(document.getElementById('live')), b = pixels(document.getElementById('preview'));
+  let sum = 0;
+  for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; ++k) sum += Math.abs(a[i + k] - b[i + k]);
+  return sum / (128 * 128 * 3);
+});
 // The preview image's size and a hash of its pixels.
 const previewBytes = (page) => page.evaluate(() => {
   const img = document.getElementById('preview');
@@ -100,6 +114,11 @@ try {
       check(last.status === 200 && !last.error && (!wantPreview || (last.preview === 200 && preview && preview.width > 0)) &&
             live.lit > 20,
             `${effect} ${name}: answer, preview and live view`, { last, preview, live });
+      const regions = effect === 'fog' && (await page.evaluate(() => (window.playground.state.request.regions || []).length));
+      if (effect === 'fog' && !regions) {  // the live view draws the global fog's table only
+        const apart = await liveAgainstPreview(page);
+        check(apart <= 12, `fog ${name}: the live view shows the preview's scene (mean difference ${apart.toFixed(1)}/255, at most 12)`);
+      }
       if (shown[effect] === name) await page.screenshot({ path: path.join(shots, `${effect}.png`) });
     }
   }

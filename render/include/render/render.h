@@ -89,6 +89,9 @@ struct SurfaceWave {
   double speed = 0.03;     // uv units per second
   glm::dvec3 lightColor{1.0, 0.97, 0.85};
   glm::dvec3 lightDirection{0.2, 0.6, 1.0};  // in the quad's tangent space, towards the light
+  // The waves on Scene::quads[*onQuad] in the world (water): its corners, depth-tested and
+  // fogged with it; without it, a quad over the whole frame on the backdrop (seed 000 §2.2).
+  std::optional<size_t> onQuad;
 };
 
 // Seed 000 eqn 12: renderTex = lerp(renderTex, blend, epsilon), last pass over the frame.

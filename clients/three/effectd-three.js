@@ -1,0 +1,297 @@
+// effectd's answers as three.js objects. An ES module that imports 'three' by its bare name, so an
+// import map or a bundler chooses the build; tested with three r187 (tests/browser/three_kit.mjs).
+//
+//   bolt      boltFromGltf(gltf) / boltFromAnswer(answer): the ribbons of /v1/lightning (format glb,
+//             or include mesh) drawn additively; with a timeline, bolt.setTime(t) plays the strike
+//   bubble    bubbleFromAnswer(answer, { environment }): /v1/bubble's own GLSL ES 3.00 as raw
+//             shader materials, its uniforms and textures, in the draws the answer names; the GLB
+//             (format glb) needs nothing: GLTFLoader reads its iridescent material
+//   fog       fogTexture(answer) and applyFog(material, answer): /v1/fog's table as a DataTexture,
+//             applied per fragment to any built-in material through onBeforeCompile
+//   tangents  /v1/tangents' GLB needs nothing: GLTFLoader reads TANGENT and normal maps use it
+//
+// Colours: effectd's shaders and tables work in the values its previews write (no sRGB encoding
+// of their own), so the raw shaders here write them unchanged, and fog is applied after three's
+// colour-space conversion, where the preview applies it.
+import * as THREE from 'three';
+
+const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
+
+// ---- lightning --------------------------------------------------------------------------------
+
+// The strike as docs/effects.md §1.6 plays it, per vertex in the vertex shader: dark before the
+// leader reaches it (or if it never does), the leader channel until its stroke arrives, then
+// the main or branches channel at t - strokeDelay; times the vertex's intensity. The keyframes
+// (t, leader, main, branches) are a 1-row float texture searched by bisection.
+const BOLT_VS = `
+attribute float _leader;
+attribute float _stroke_delay;
+uniform sampler2D uKeys;
+uniform int uKeyCount;
+uniform float uTime, uConnect;
+uniform bool uTimed, uMain;
+varying vec2 vUv;
+varying float vBrightness;
+vec4 keyAt(int i) { return texelFetch(uKeys, ivec2(i, 0), 0); }
+vec3 channels(float t) {  // (leader, main, branches) at t: linear between keyframes, 0 outside
+  if (t < keyAt(0).x || t > keyAt(uKeyCount - 1).x) return vec3(0.0);
+  int lo = 0, hi = uKeyCount - 1;
+  for (int k = 0; k < 16 && hi - lo > 1; ++k) {
+    int mid = (lo + hi) / 2;
+    if (keyAt(mid).x <= t) lo = mid; else hi = mid;
+  }
+  vec4 a = keyAt(lo), b = keyAt(hi);
+  return mix(a.yzw, b.yzw, clamp((t - a.x) / max(b.x - a.x, 1e-30), 0.0, 1.0));
+}
+void main() {
+  vUv = uv;
+  float b = color.r;  // the vertex's intensity
+  if (uTimed) {
+    if (_leader > uConnect || uTime < _leader) b = 0.0;
+    else if (uTime < uConnect + _stroke_delay) b *= channels(uTime).x;
+    else { vec3 c = channels(uTime - _stroke_delay); b *= uMain ? c.y : c.z; }
+  }
+  vBrightness = b;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}`;
+const BOLT_FS = `
+uniform sampler2D uProfile;
+uniform vec3 uColor;
+varying vec2 vUv;
+varying float vBrightness;
+void main() {
+  gl_FragColor = vec4(uColor * (vBrightness * texture2D(uProfile, vec2(0.5, vUv.y)).a), 1.0);
+}`;
+
+// The channel's cross-section over v, as the GLB embeds it (server/bolt_glb.cpp): 1 x 32 texels,
+// alpha 1 over the middle third, smoothstep to 0 at the edges, 8 bits.
+function profileTexture() {
+  const data = new Uint8Array(32 * 4).fill(255);
+  for (let y = 0; y < 32; ++y) {
+    const x = Math.min(Math.max(3 * (1 - Math.abs(2 * ((y + 0.5) / 32) - 1)), 0), 1);
+    data[4 * y + 3] = Math.round(255 * x * x * (3 - 2 * x));
+  }
+  return Object.assign(new THREE.DataTexture(data, 1, 32), { magFilter: THREE.LinearFilter, minFilter: THREE.LinearFilter, needsUpdate: true });
+}
+
+function keyTexture(timeline) {
+  const k = timeline.keyframes, n = k.t.length, data = new Float32Array(n * 4);
+  for (let i = 0; i < n; ++i) data.set([k.t[i], k.leader[i], k.main[i], k.branches[i]], 4 * i);
+  const texture = new THREE.DataTexture(data, n, 1, THREE.RGBAFormat, THREE.FloatType);
+  texture.needsUpdate = true;
+  return texture;
+}
+
+// parts: [{ main, geometry (position, uv, color; _leader and _stroke_delay with a timeline) }].
+function makeBolt(parts, timeline, { color = [0.75, 0.85, 1.0], profile = null } = {}) {
+  const group = new THREE.Group();
+  group.name = 'effectd bolt';
+  const keys = timeline ? keyTexture(timeline) : null;
+  const materials = [];
+  for (const { main, geometry } of parts) {
+    const material = new THREE.ShaderMaterial({
+      vertexShader: BOLT_VS,
+      fragmentShader: BOLT_FS,
+      vertexColors: true,
+      uniforms: {
+        uKeys: { value: keys }, uKeyCount: { value: timeline ? timeline.keyframes.t.length : 0 },
+        uTime: { value: 0 }, uConnect: { value: timeline ? timeline.connect : 0 }, uTimed: { value: Boolean(timeline) },
+        uMain: { value: main }, uProfile: { value: profile || profileTexture() },
+        uColor: { value: new THREE.Color(...color) },  // display values, as the preview's
+      },
+      blending: THREE.AdditiveBlending, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+    });
+    materials.push(material);
+    const mesh = new THREE.Mesh(geometry, material);
+    mesh.name = main ? 'main' : 'branches';
+    mesh.frustumCulled = false;
+    group.add(mesh);
+  }
+  return {
+    object: group,
+    timeline,
+    duration: timeline ? timeline.duration : 0,
+    // Game seconds since the leader set off (the answer's timeline times).
+    setTime(t) { for (const m of materials) m.uniforms.uTime.value = t; },
+    dispose() { for (const m of materials) m.dispose(); for (const c of group.children) c.geometry.dispose(); if (keys) keys.dispose(); },
+  };
+}
+
+// A /v1/lightning GLB as GLTFLoader gives it (format glb; include timeline for setTime).
+export function boltFromGltf(gltf, options = {}) {
+  const parts = [];
+  let profile = null;
+  gltf.scene.traverse((o) => {
+    if (!o.isMesh) return;
+    const g = o.geometry;
+    if (g.attributes.color && g.attributes.color.itemSize === 4) {  // three may widen COLOR_0
+      const c = g.attributes.color, rgb = new Float32Array(c.count * 3);
+      for (let i = 0; i < c.count; ++i) rgb.set([c.getX(i), c.getY(i), c.getZ(i)], 3 * i);
+      g.setAttribute('color', new THREE.BufferAttribute(rgb, 3));
+    }
+    profile = profile || o.material.map || null;
+    parts.push({ main: o.name === 'main', geometry: g });
+  });
+  return makeBolt(parts, gltf.scene.userData.timeline || null, { ...options, profile });
+}
+
+// A /v1/lightning JSON answer with include mesh (and timeline for setTime).
+export function boltFromAnswer(answer, options = {}) {
+  if (!answer.mesh) throw new Error('the answer has no mesh: ask for include ["mesh"]');
+  const timed = Boolean(answer.timeline);
+  const parts = answer.mesh.primitives.map((p) => {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(p.positions, 3));
+    g.setAttribute('uv', new THREE.Float32BufferAttribute(p.uvs, 2));
+    g.setAttribute('color', new THREE.Float32BufferAttribute(p.intensity.flatMap((i) => [i, i, i]), 3));
+    const zeros = () => new THREE.Float32BufferAttribute(new Float32Array(p.intensity.length), 1);
+    g.setAttribute('_leader', timed ? new THREE.Float32BufferAttribute(p.leader, 1) : zeros());
+    g.setAttribute('_stroke_delay', timed ? new THREE.Float32BufferAttribute(p.strokeDelay, 1) : zeros());
+    g.setIndex(p.indices);
+    return { main: p.channel === 'main', geometry: g };
+  });
+  return makeBolt(parts, answer.timeline || null, options);
+}
+
+// ---- bubble -----------------------------------------------------------------------------------
+
+// The draws /v1/bubble's shader.draw and shader.blend name: the film's far side then its near
+// side, each what passes through (multiplied) then what it reflects (added); the paper model's
+// near side, alpha-blended.
+const FILM_PASSES = [
+  { side: THREE.BackSide, pass: 0 }, { side: THREE.BackSide, pass: 1 },
+  { side: THREE.FrontSide, pass: 0 }, { side: THREE.FrontSide, pass: 1 },
+];
+function blendOf(material, film, pass) {
+  material.blending = THREE.CustomBlending;
+  material.blendEquation = material.blendEquationAlpha = THREE.AddEquation;
+  if (!film) Object.assign(material, { blendSrc: THREE.SrcAlphaFactor, blendDst: THREE.OneMinusSrcAlphaFactor,
+                                       blendSrcAlpha: THREE.OneFactor, blendDstAlpha: THREE.OneMinusSrcAlphaFactor });
+  else if (pass === 0) Object.assign(material, { blendSrc: THREE.ZeroFactor, blendDst: THREE.SrcColorFactor,
+                                                 blendSrcAlpha: THREE.ZeroFactor, blendDstAlpha: THREE.SrcAlphaFactor });
+  else Object.assign(material, { blendSrc: THREE.OneFactor, blendDst: THREE.OneFactor, blendSrcAlpha: THREE.OneFactor,
+                                 blendDstAlpha: THREE.OneFactor });
+}
+
+// A /v1/bubble JSON answer with include mesh, uniforms, shader (language glsl-es-300) and, for
+// the film, thinFilm (encoding rgba16f) and thickness (film.encoding r32f). `environment`: a
+// THREE.CubeTexture the bubble reflects and refracts (the client's sky). Returns a THREE.Group
+// whose meshes draw in the answer's order (renderOrder), and update(answer) for a new time.
+export function bubbleFromAnswer(answer, { environment = null } = {}) {
+  const { mesh, shader } = answer;
+  if (!mesh || !shader || !answer.uniforms) throw new Error('the answer needs include ["mesh", "uniforms", "shader"]');
+  if (shader.language !== 'glsl-es-300') throw new Error('the kit draws shader.language glsl-es-300');
+  const film = shader.uniforms.includes('uPass');
+  const geometry = new THREE.BufferGeometry();
+  const add = (name, data, n) => geometry.setAttribute(name, new THREE.Float32BufferAttribute(data, n));
+  add('aPosition', mesh.positions, 3), add('aNormal', mesh.normals, 3), add('aUv', mesh.uvs, 2);
+  add('position', mesh.positions, 3);  // three's bounds
+  geometry.setIndex(mesh.indices);
+  const textures = {};
+  if (answer.thinFilm) {
+    const t = answer.thinFilm;
+    textures.uThinFilm = new THREE.DataTexture(new Uint16Array(bytesOf(t.data).buffer), t.width, t.height,
+                                               THREE.RGBAFormat, THREE.HalfFloatType);
+  }
+  if (answer.thickness) {
+    const t = answer.thickness;
+    textures.uThicknessField = new THREE.DataTexture(new Float32Array(bytesOf(t.data).buffer), t.width, t.height,
+                                                     THREE.RedFormat, THREE.FloatType);
+    textures.uThicknessField.wrapS = THREE.RepeatWrapping;  // u wraps around the sphere
+  }
+  for (const t of Object.values(textures)) Object.assign(t, { magFilter: THREE.LinearFilter, minFilter: THREE.LinearFilter, needsUpdate: true });
+  const strip = (source) => source.replace(/^#version[^\n]*\n/, '');
+  const group = new THREE.Group();
+  group.name = 'effectd bubble';
+  const materials = [];
+  for (const [order, { side, pass }] of (film ? FILM_PASSES : [{ side: THREE.FrontSide, pass: 0 }]).entries()) {
+    const uniforms = {
+      uModel: { value: new THREE.Matrix4() }, uViewProjection: { value: new THREE.Matrix4() },
+      uCameraPosition: { value: new THREE.Vector3() }, uEnvironment: { value: environment },
+    };
+    for (const [name, texture] of Object.entries(textures)) uniforms[name] = { value: texture };
+    const material = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: strip(shader.vertex), fragmentShader: strip(shader.fragment), uniforms,
+      side, transparent: true, depthWrite: false, depthTest: true,
+    });
+    blendOf(material, film, pass);
+    material.userData.pass = pass;
+    materials.push(material);
+    const m = new THREE.Mesh(geometry, material);
+    m.renderOrder = order;
+    m.frustumCulled = false;
+    m.onBeforeRender = (renderer, scene, camera) => {  // the client's own uniforms
+      material.uniforms.uModel.value.copy(m.matrixWorld);
+      material.uniforms.uViewProjection.value.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
+      camera.getWorldPosition(material.uniforms.uCameraPosition.value);
+    };
+    group.add(m);
+  }
+  // A vec3 array uniform's declared length (the shader's uniform vec3 name[N]): three uploads
+  // every element, so the answer's shorter list (one light of four) is padded with zeros.
+  const declared = (name) => Number((`${shader.vertex}\n${shader.fragment}`.match(new RegExp(`uniform\\s+vec3\\s+${name}\\[(\\d+)\\]`)) || [])[1] || 0);
+  const vectors = (name, list) => {
+    const v = list.map((x) => new THREE.Vector3(...x));
+    while (v.length < declared(name)) v.push(new THREE.Vector3());
+    return v;
+  };
+  const update = (next) => {  // the answer's uniforms (a later time: new phases, film, thickness)
+    for (const material of materials)
+      for (const [name, value] of Object.entries(next.uniforms)) {
+        const v = name === 'uPass' ? material.userData.pass : value;
+        const wrapped = Array.isArray(v) && Array.isArray(v[0]) ? vectors(name, v)
+                      : Array.isArray(v) && v.length === 2 && name === 'uThicknessRange' ? new THREE.Vector2(...v)
+                      : Array.isArray(v) && v.length === 4 && name === 'uBaseColor' ? new THREE.Vector4(...v) : v;
+        material.uniforms[name] = { value: wrapped };
+      }
+  };
+  update(answer);
+  return { object: group, update, dispose() { geometry.dispose(); for (const m of materials) m.dispose(); for (const t of Object.values(textures)) t.dispose(); } };
+}
+
+// ---- fog --------------------------------------------------------------------------------------
+
+// /v1/fog's table (encoding rgba16f) as a texture: u = distance over table.range, v = the ray's
+// direction y over [-1, 1] when the table has elevations. RGB = in-scattered S, A = transmittance f.
+export function fogTexture(answer) {
+  const t = answer.table;
+  if (!t || t.encoding !== 'rgba16f') throw new Error('the answer needs table.encoding rgba16f');
+  const rows = t.elevations || 1;
+  const texture = new THREE.DataTexture(new Uint16Array(bytesOf(t.data).buffer), t.size, rows, THREE.RGBAFormat, THREE.HalfFloatType);
+  Object.assign(texture, { magFilter: THREE.LinearFilter, minFilter: THREE.LinearFilter, needsUpdate: true });
+  return texture;
+}
+
+// Fogs a built-in material (MeshBasicMaterial, MeshStandardMaterial, ...) per fragment from the
+// table: colour * f + S by the fragment's distance from the camera, as effectd's renderer does.
+// Several materials may share one texture (fogTexture(answer)).
+export function applyFog(material, answer, texture = fogTexture(answer)) {
+  const t = answer.table;
+  const uniforms = {
+    uFogTable: { value: texture }, uFogRange: { value: new THREE.Vector2(t.range[0], t.range[1]) },
+    uFogTexels: { value: new THREE.Vector2(t.size, t.elevations || 1) }, uFogCutoff: { value: t.cutoffDistance ?? 1e38 },
+  };
+  material.onBeforeCompile = (program) => {
+    Object.assign(program.uniforms, uniforms);
+    program.vertexShader = program.vertexShader
+      .replace('void main() {', 'varying vec3 vEffectdWorld;\nvoid main() {')
+      .replace('#include <project_vertex>', '#include <project_vertex>\n  vEffectdWorld = (modelMatrix * vec4(transformed, 1.0)).xyz;');
+    program.fragmentShader = program.fragmentShader
+      .replace('void main() {', `varying vec3 vEffectdWorld;
+uniform sampler2D uFogTable; uniform vec2 uFogRange; uniform vec2 uFogTexels; uniform float uFogCutoff;
+void main() {`)
+      .replace('#include <fog_fragment>', `{
+    vec3 ray = vEffectdWorld - cameraPosition;
+    float d = length(ray);
+    if (d < uFogCutoff) {
+      float u = clamp((min(d, uFogRange.y) - uFogRange.x) / (uFogRange.y - uFogRange.x), 0.0, 1.0);
+      float v = uFogTexels.y > 1.0 ? (ray.y / max(d, 1e-6) + 1.0) * 0.5 : 0.5;
+      vec4 fog = texture2D(uFogTable, vec2((u * (uFogTexels.x - 1.0) + 0.5) / uFogTexels.x, (v * (uFogTexels.y - 1.0) + 0.5) / uFogTexels.y));
+      gl_FragColor.rgb = gl_FragColor.rgb * fog.a + fog.rgb;
+    }
+  }`);
+  };
+  material.customProgramCacheKey = () => 'effectd-fog';
+  material.needsUpdate = true;
+  return material;
+}
