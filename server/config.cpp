@@ -154,6 +154,16 @@ const std::vector<Option>& options() {
          else return false;
          return true;
        }},
+      {"playground-three", "EFFECTD_PLAYGROUND_THREE",
+       "URL of three.js's ES module (three.module.js, r187) that the playground's live view imports; the browser "
+       "fetches it, so offline point it at a copy you serve (default https://unpkg.com/three@0.187.0/build/three.module.js)",
+       [](const std::string& s, Config& c) {
+         // http(s), and nothing that could leave the JavaScript string or the CSP it is put in.
+         const bool scheme = s.rfind("https://", 0) == 0 || s.rfind("http://", 0) == 0;
+         if (!scheme || s.find_first_of(" \t\r\n'\"\\<>;`") != std::string::npos) return false;
+         c.playgroundThree = s;
+         return true;
+       }},
   };
   return opts;
 }

@@ -41,6 +41,8 @@ struct Config {
   size_t responseCacheMb = 64;           // encoded answers kept for repeats; 0 = off
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
+  // three.js's ES module the playground's live view imports (it draws through clients/three/).
+  std::string playgroundThree = "https://unpkg.com/three@0.187.0/build/three.module.js";
   Limits limits;
 };
 

@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
 
   effectd::Service service(config);
   effectd::addEffectEndpoints(service);
-  if (effectd::playgroundEnabled(config)) effectd::addPlayground(service);
+  if (effectd::playgroundEnabled(config)) effectd::addPlayground(service, config.playgroundThree);
   int port = service.bind();
   if (port < 0) {
     std::fprintf(stderr, "effectd: cannot listen on %s:%d\n", config.host.c_str(), config.port);

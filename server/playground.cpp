@@ -42,12 +42,21 @@ std::string examplesIndex() {
 
 }  // namespace
 
-void addPlayground(Service& service) {
-  const std::string dir = "server/playground/";
+void addPlayground(Service& service, const std::string& threeUrl) {
+  // The origin three.js comes from (scheme://host[:port]), for the page's script-src.
+  const size_t host = threeUrl.find("//") + 2, end = threeUrl.find('/', host);
+  const std::string threeOrigin = threeUrl.substr(0, end);
   for (const auto& [key, text] : playgroundResources()) {
-    if (key.rfind(dir, 0) != 0) continue;
-    const std::string name = key.substr(dir.size());
-    service.addStatic(name == "index.html" ? "/" : "/playground/" + name, contentTypeOf(name), std::string(text));
+    std::string name;
+    if (key.rfind("server/playground/", 0) == 0) name = key.substr(std::string("server/playground/").size());
+    else if (key == "clients/three/effectd-three.js") name = "effectd-three.js";
+    else continue;
+    std::string body(text);
+    if (contentTypeOf(name).rfind("text/javascript", 0) == 0)  // the bare 'three' the page has no import map for
+      for (size_t at = body.find("from 'three'"); at != std::string::npos; at = body.find("from 'three'", at))
+        body.replace(at, 12, "from '" + threeUrl + "'"), at += threeUrl.size();
+    service.addStatic(name == "index.html" ? "/" : "/playground/" + name, contentTypeOf(name), std::move(body),
+                      threeOrigin);
   }
   service.addStatic("/playground/examples.json", "application/json", examplesIndex());
 }

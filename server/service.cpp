@@ -277,19 +277,19 @@ void Service::addBinaryAlternative(const std::string& path, const std::string& c
     if (r->path == path) r->binary[contentType] = {std::move(handler), std::move(cost)};
 }
 
-void Service::addStatic(const std::string& path, const std::string& contentType, std::string body) {
+void Service::addStatic(const std::string& path, const std::string& contentType, std::string body,
+                        const std::string& scriptOrigin) {
   auto r = std::make_unique<Route>();
   r->path = path;
   r->methods = {"GET", "HEAD"};
   routes_.push_back(std::move(r));
   const bool html = contentType.rfind("text/html", 0) == 0;
-  http_->Get(path, [contentType, html, body = std::move(body)](const httplib::Request&, httplib::Response& res) {
+  const std::string csp = "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'" +
+                          (scriptOrigin.empty() ? "" : " " + scriptOrigin) + "; connect-src 'self'; frame-ancestors 'none'";
+  http_->Get(path, [contentType, html, csp, body = std::move(body)](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Content-Type-Options", "nosniff");
-    if (html)
-      res.set_header("Content-Security-Policy",
-                     "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
-                     "connect-src 'self'; frame-ancestors 'none'");
+    if (html) res.set_header("Content-Security-Policy", csp);
     res.set_content(body, contentType);
   });
 }

@@ -103,7 +103,10 @@ class Service {
                             BinaryEstimator cost);
   // GET/HEAD `path` answers `body` as `contentType` (static files: the playground). HTML gets a
   // Content-Security-Policy that allows only this origin's scripts, styles and requests.
-  void addStatic(const std::string& path, const std::string& contentType, std::string body);
+  // An HTML page gets a Content-Security-Policy allowing scripts from itself and `scriptOrigin`
+  // ("" = itself only).
+  void addStatic(const std::string& path, const std::string& contentType, std::string body,
+                 const std::string& scriptOrigin = "");
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
   // Responses carry a strong ETag: SHA-256 of the version, the route, the canonical request

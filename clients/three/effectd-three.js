@@ -26,6 +26,8 @@ const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0)
 const BOLT_VS = `
 attribute float _leader;
 attribute float _stroke_delay;
+attribute vec3 _across;  // from the ribbon's middle to this edge (the kit adds it)
+uniform float uWiden;    // 1: the core; more: the glow around it
 uniform sampler2D uKeys;
 uniform int uKeyCount;
 uniform float uTime, uConnect;
@@ -52,16 +54,31 @@ void main() {
     else { vec3 c = channels(uTime - _stroke_delay); b *= uMain ? c.y : c.z; }
   }
   vBrightness = b;
-  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position + _across * (uWiden - 1.0), 1.0);
 }`;
+// The core: the profile across the ribbon. The glow: a Gaussian across a ribbon uWiden times as
+// wide, uGain as bright (a bloom without a post-process; the preview blurs its core instead).
 const BOLT_FS = `
 uniform sampler2D uProfile;
 uniform vec3 uColor;
+uniform bool uGlow;
+uniform float uGain;
 varying vec2 vUv;
 varying float vBrightness;
 void main() {
-  gl_FragColor = vec4(uColor * (vBrightness * texture2D(uProfile, vec2(0.5, vUv.y)).a), 1.0);
+  float v = 2.0 * vUv.y - 1.0;
+  float across = uGlow ? uGain * exp(-4.0 * v * v) : texture2D(uProfile, vec2(0.5, vUv.y)).a;
+  gl_FragColor = vec4(uColor * (vBrightness * across), 1.0);
 }`;
+
+// Each vertex's offset from its ribbon's middle: the ribbons' vertices come in pairs (2k, 2k + 1),
+// the two edges at one polyline vertex (server/bolt_ribbons.cpp).
+function acrossAttribute(geometry) {
+  const p = geometry.attributes.position, out = new Float32Array(p.count * 3);
+  for (let i = 0; i < p.count; ++i)
+    for (let k = 0; k < 3; ++k) out[3 * i + k] = 0.5 * (p.getComponent(i, k) - p.getComponent(i ^ 1, k));
+  geometry.setAttribute('_across', new THREE.BufferAttribute(out, 3));
+}
 
 // The channel's cross-section over v, as the GLB embeds it (server/bolt_glb.cpp): 1 x 32 texels,
 // alpha 1 over the middle third, smoothstep to 0 at the edges, 8 bits.
@@ -83,29 +100,35 @@ function keyTexture(timeline) {
 }
 
 // parts: [{ main, geometry (position, uv, color; _leader and _stroke_delay with a timeline) }].
-function makeBolt(parts, timeline, { color = [0.75, 0.85, 1.0], profile = null } = {}) {
+// glow: null, or {width (times the core's), strength}: a soft wider ribbon drawn under the core.
+function makeBolt(parts, timeline, { color = [0.75, 0.85, 1.0], profile = null, glow = null } = {}) {
   const group = new THREE.Group();
   group.name = 'effectd bolt';
   const keys = timeline ? keyTexture(timeline) : null;
   const materials = [];
   for (const { main, geometry } of parts) {
-    const material = new THREE.ShaderMaterial({
-      vertexShader: BOLT_VS,
-      fragmentShader: BOLT_FS,
-      vertexColors: true,
-      uniforms: {
-        uKeys: { value: keys }, uKeyCount: { value: timeline ? timeline.keyframes.t.length : 0 },
-        uTime: { value: 0 }, uConnect: { value: timeline ? timeline.connect : 0 }, uTimed: { value: Boolean(timeline) },
-        uMain: { value: main }, uProfile: { value: profile || profileTexture() },
-        uColor: { value: new THREE.Color(...color) },  // display values, as the preview's
-      },
-      blending: THREE.AdditiveBlending, transparent: true, depthWrite: false, side: THREE.DoubleSide,
-    });
-    materials.push(material);
-    const mesh = new THREE.Mesh(geometry, material);
-    mesh.name = main ? 'main' : 'branches';
-    mesh.frustumCulled = false;
-    group.add(mesh);
+    acrossAttribute(geometry);
+    for (const layer of glow ? ['glow', 'core'] : ['core']) {
+      const material = new THREE.ShaderMaterial({
+        vertexShader: BOLT_VS,
+        fragmentShader: BOLT_FS,
+        vertexColors: true,
+        uniforms: {
+          uKeys: { value: keys }, uKeyCount: { value: timeline ? timeline.keyframes.t.length : 0 },
+          uTime: { value: 0 }, uConnect: { value: timeline ? timeline.connect : 0 }, uTimed: { value: Boolean(timeline) },
+          uMain: { value: main }, uProfile: { value: profile || profileTexture() },
+          uColor: { value: new THREE.Color(...color) },  // display values, as the preview's
+          uGlow: { value: layer === 'glow' }, uWiden: { value: layer === 'glow' ? glow.width : 1 },
+          uGain: { value: layer === 'glow' ? glow.strength : 1 },
+        },
+        blending: THREE.AdditiveBlending, transparent: true, depthWrite: false, side: THREE.DoubleSide,
+      });
+      materials.push(material);
+      const mesh = new THREE.Mesh(geometry, material);
+      mesh.name = (main ? 'main' : 'branches') + (layer === 'glow' ? ' glow' : '');
+      mesh.frustumCulled = false;
+      group.add(mesh);
+    }
   }
   return {
     object: group,
@@ -130,7 +153,7 @@ export function boltFromGltf(gltf, options = {}) {
       g.setAttribute('color', new THREE.BufferAttribute(rgb, 3));
     }
     profile = profile || o.material.map || null;
-    parts.push({ main: o.name === 'main', geometry: g });
+    parts.push({ main: o.name === 'main', geometry: g });  // nodes main and branches
   });
   return makeBolt(parts, gltf.scene.userData.timeline || null, { ...options, profile });
 }
@@ -175,9 +198,11 @@ function blendOf(material, film, pass) {
 
 // A /v1/bubble JSON answer with include mesh, uniforms, shader (language glsl-es-300) and, for
 // the film, thinFilm (encoding rgba16f) and thickness (film.encoding r32f). `environment`: a
-// THREE.CubeTexture the bubble reflects and refracts (the client's sky). Returns a THREE.Group
-// whose meshes draw in the answer's order (renderOrder), and update(answer) for a new time.
-export function bubbleFromAnswer(answer, { environment = null } = {}) {
+// THREE.CubeTexture the bubble reflects and refracts (the client's sky); `flow`: the paper
+// model's flow texture (textureFlow, eqn 9; repeat wrapping), the client's own too. Returns a
+// THREE.Group whose meshes draw in the answer's order (renderOrder), and update(answer) for a
+// new time.
+export function bubbleFromAnswer(answer, { environment = null, flow = null } = {}) {
   const { mesh, shader } = answer;
   if (!mesh || !shader || !answer.uniforms) throw new Error('the answer needs include ["mesh", "uniforms", "shader"]');
   if (shader.language !== 'glsl-es-300') throw new Error('the kit draws shader.language glsl-es-300');
@@ -207,7 +232,7 @@ export function bubbleFromAnswer(answer, { environment = null } = {}) {
   for (const [order, { side, pass }] of (film ? FILM_PASSES : [{ side: THREE.FrontSide, pass: 0 }]).entries()) {
     const uniforms = {
       uModel: { value: new THREE.Matrix4() }, uViewProjection: { value: new THREE.Matrix4() },
-      uCameraPosition: { value: new THREE.Vector3() }, uEnvironment: { value: environment },
+      uCameraPosition: { value: new THREE.Vector3() }, uEnvironment: { value: environment }, uFlowTexture: { value: flow },
     };
     for (const [name, texture] of Object.entries(textures)) uniforms[name] = { value: texture };
     const material = new THREE.RawShaderMaterial({

@@ -61,14 +61,16 @@ const withInclude = (req, extra, fallback) => [...new Set([...(req.include || fa
 // The request whose answer the live view draws, or null when it cannot draw the effect.
 function liveRequest(effect, req) {
   switch (effect) {
-    case 'lightning': return { ...req, include: withInclude(req, ['polylines', 'timeline'], ['polylines']) };
+    case 'lightning': { const { format, ...bolt } = req; return { ...bolt, include: withInclude(req, ['mesh', 'timeline'], ['polylines']) }; }
     case 'fog': return { ...req, table: { ...(req.table || {}), encoding: 'rgba16f' }, include: withInclude(req, ['table'], ['table']) };
     case 'bubble': {
       const { format, ...b } = req;
       b.shader = { ...(req.shader || {}), language: 'glsl-es-300' };
-      if (req.shading === 'paper') return { ...b, include: ['mesh', 'uniforms', 'shader'] };
-      return { ...b, thinFilm: { ...(req.thinFilm || {}), encoding: 'rgba16f' }, film: { ...(req.film || {}), encoding: 'r32f' },
-               include: ['mesh', 'uniforms', 'shader', 'thinFilm', 'thickness'] };
+      const table = { ...b, thinFilm: { ...(req.thinFilm || {}), encoding: 'rgba16f' } };
+      if (req.shading === 'paper')  // the paper's iridescence reads the thin-film table too
+        return req.features && req.features.iridescence ? { ...table, include: ['mesh', 'uniforms', 'shader', 'thinFilm'] }
+                                                        : { ...b, include: ['mesh', 'uniforms', 'shader'] };
+      return { ...table, film: { ...(req.film || {}), encoding: 'r32f' }, include: ['mesh', 'uniforms', 'shader', 'thinFilm', 'thickness'] };
     }
     default: return null;
   }

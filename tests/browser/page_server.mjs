@@ -21,7 +21,7 @@ export async function servePages(title, canvases, files = {}) {
     if (url.pathname.startsWith('/nm/')) {
       const file = path.normalize(path.join(modules, decodeURIComponent(url.pathname.slice('/nm/'.length))));
       if (!file.startsWith(modules) || !fs.existsSync(file) || !fs.statSync(file).isFile()) return res.writeHead(404).end();
-      res.writeHead(200, { 'Content-Type': 'text/javascript' });
+      res.writeHead(200, { 'Content-Type': 'text/javascript', 'Access-Control-Allow-Origin': '*' });  // modules for other origins' pages too
       return res.end(fs.readFileSync(file));
     }
     res.writeHead(200, { 'Content-Type': 'text/html' });

@@ -12,6 +12,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchWebGl2Chromium } from './chromium.mjs';
+import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
@@ -29,7 +30,9 @@ for (const [args, expect] of [[[], 200], [['--playground', 'off'], 404], [['--ho
   p.kill();
 }
 
-const { url: api, process: server } = await startEffectd(binary);
+// three.js for the live view from a local origin (the default is a CDN; this machine is offline).
+const three = await servePages('three.js for the playground', []);
+const { url: api, process: server } = await startEffectd(binary, ['--playground-three', `${three.origin}/nm/three/build/three.module.js`]);
 const browser = await launchWebGl2Chromium(chromium);
 const problems = [];
 let renders = 0;
@@ -204,6 +207,7 @@ try {
 } finally {
   await browser.close();
   server.kill();
+  three.close();
 }
 console.log(`screenshots in ${shots}`);
 process.exit(results.failures ? 1 : 0);
