@@ -225,6 +225,12 @@ export function bubbleFromAnswer(answer, { environment = null, flow = null } = {
     textures.uThicknessField.wrapS = THREE.RepeatWrapping;  // u wraps around the sphere
   }
   for (const t of Object.values(textures)) Object.assign(t, { magFilter: THREE.LinearFilter, minFilter: THREE.LinearFilter, needsUpdate: true });
+  // Every texture the variant reads must be there: an unbound sampler would read another's unit.
+  const given = { ...textures, uEnvironment: environment, uFlowTexture: flow };
+  const ask = { uThinFilm: 'include "thinFilm" (thinFilm.encoding "rgba16f")', uThicknessField: 'include "thickness" (film.encoding "r32f")',
+                uEnvironment: 'the environment option (a THREE.CubeTexture)', uFlowTexture: 'the flow option (a repeating THREE.Texture)' };
+  for (const name of Object.keys(ask))
+    if (shader.uniforms.includes(name) && !given[name]) throw new Error(`the bubble's shader reads ${name}: give ${ask[name]}`);
   const strip = (source) => source.replace(/^#version[^\n]*\n/, '');
   const group = new THREE.Group();
   group.name = 'effectd bubble';
