@@ -1,16 +1,15 @@
 // The bubble's GLB judged by the engines that consume it: three.js (npm `three`, its own
 // GLTFLoader and MeshPhysicalMaterial's KHR_materials_iridescence) and Babylon.js (npm
-// `@babylonjs/core` + `@babylonjs/loaders`, its glTF loader and PBRMaterial iridescence, under a
-// cube map of effectd's sky) in headless chromium (WebGL2
-// on SwiftShader) draws /v1/bubble's `format: "glb"` under an environment map over a neutral
-// grey backdrop, and the film's part of the frame is measured: how much the iridescence changes
-// the bubble's disc (on against off, mean per channel) and how much of the disc it colours
-// (chroma, max - min channel, above 8/255). The same GLB with its base ior set back to the
-// film's (the old material, which three drew almost clear) is measured beside it.
-// effectd's /v1/render preview of the same bubble and camera (under effectd's sky, not three's
-// RoomEnvironment) is measured the same way: three must colour at least half the share of the
-// disc the preview colours (seen: three 36.6 %, Babylon 31.0 %, the preview 39.2 %; the old GLB
-// 5.6 % and 3.1 %).
+// `@babylonjs/core` + `@babylonjs/loaders`, its glTF loader and PBRMaterial iridescence) in
+// headless chromium (WebGL2 on SwiftShader) draw /v1/bubble's `format: "glb"` under a cube map
+// of effectd's sky over the preview's grey backdrop. On the bubble's disc:
+//   - how much the iridescence changes it (on against off, mean per channel);
+//   - how much of it the film colours (chroma, max - min channel, above 8/255), against
+//     effectd's /v1/render preview of the same bubble and camera: at least half its share;
+//   - the mean ΔE*ab (CIE76) from the preview, at most 8 (seen: three 4.7, Babylon 5.3 with the
+//     film; 4.0 and 4.0 without it: the bands lie elsewhere than ours);
+//   - the same GLB with its base ior set back to the film's (the old material, which three drew
+//     almost clear) shows the film at most a third as strongly.
 // Usage: node bubble_gltf.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
 import path from 'node:path';
@@ -37,7 +36,7 @@ try {
   page.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
   await page.goto(`${origin}/`);
   const r = await page.evaluate(async ({ api, view }) => {
-    const { colouredShare, partChange } = await import('/page_helpers.mjs');
+    const { colouredShare, partChange, skyCubeFaces } = await import('/page_helpers.mjs');
     const out = {};
     const { size, eye, fovY, backdrop, sky, bubble, rPx } = view;
     const json = { 'Content-Type': 'application/json' };
@@ -52,18 +51,29 @@ try {
     const ctx = c2.getContext('2d');
     ctx.drawImage(await createImageBitmap(await png.blob()), 0, 0);
     out.preview = colouredShare(ctx.getImageData(0, 0, size, size).data, size, rPx);
+    // The preview's rows bottom-up, as the engines' frames are read back.
+    const top = ctx.getImageData(0, 0, size, size).data, up = new Uint8Array(top.length);
+    for (let y = 0; y < size; ++y) up.set(top.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
+    out.previewUp = Array.from(up);
 
-    // three.js: the GLB as a glTF viewer loads it, under three's RoomEnvironment.
+    // three.js: the GLB as a glTF viewer loads it, under effectd's sky (its displayed colours,
+    // decoded to three's linear working space) over the preview's displayed grey.
     const THREE = await import('three');
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
-    const { RoomEnvironment } = await import('three/addons/environments/RoomEnvironment.js');
     const canvas = document.getElementById('gl');
     const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
     renderer.setSize(size, size, false);
     renderer.setPixelRatio(1);
     const scene = new THREE.Scene();
-    scene.background = new THREE.Color(...backdrop);
-    scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
+    scene.background = new THREE.Color().setRGB(...backdrop, THREE.SRGBColorSpace);
+    const linear = (c) => (c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4);
+    const faces = skyCubeFaces(sky, 64).map((px) => {
+      for (let i = 0; i < px.length; ++i) if (i % 4 !== 3) px[i] = linear(px[i]);
+      return Object.assign(new THREE.DataTexture(px, 64, 64, THREE.RGBAFormat, THREE.FloatType), { needsUpdate: true });
+    });
+    const cube = Object.assign(new THREE.CubeTexture(faces), { format: THREE.RGBAFormat, type: THREE.FloatType, generateMipmaps: false,
+                                                                magFilter: THREE.LinearFilter, minFilter: THREE.LinearFilter, needsUpdate: true });
+    scene.environment = new THREE.PMREMGenerator(renderer).fromCubemap(cube).texture;
     const camera = new THREE.PerspectiveCamera(fovY, 1, 0.1, 100);
     camera.position.set(...eye);
     camera.lookAt(0, 0, 0);
@@ -84,7 +94,7 @@ try {
       return px;
     };
     // The film's part: the disc with iridescence against without it.
-    const filmPart = () => partChange((on) => { material.iridescence = on ? 1 : 0; }, frame, size, rPx);
+    const filmPart = () => partChange((on) => { material.iridescence = on ? 1 : 0; }, frame, size, rPx, up);
     out.three = await filmPart();
     material.iridescence = 1;
     frame();
@@ -93,6 +103,8 @@ try {
     out.oldIor = await filmPart();
     return out;
   }, { api, view });
+  const previewUp = r.previewUp;
+  delete r.previewUp;
   if (process.env.EFFECTD_PICTURES)  // a folder to write both frames into, to look at them
     for (const [name, url] of Object.entries(r.pictures))
       fs.writeFileSync(path.join(process.env.EFFECTD_PICTURES, `bubble-gltf-${name}.png`), Buffer.from(url.split(',')[1], 'base64'));
@@ -108,6 +120,9 @@ try {
         '% more of the disc (≥ 20 points)', r.three);
   check(r.three.on.share >= 0.5 * r.preview.share, `three.js colours at least half the share of the disc effectd's preview does`,
         { three: r.three.on.share, preview: r.preview.share });
+  console.log(`  mean ΔE*ab over the disc from effectd's preview: three.js ${r.three.deltaE.on.toFixed(1)} with the film, ` +
+              `${r.three.deltaE.off.toFixed(1)} without`);
+  check(r.three.deltaE.on <= 8, `three.js's disc is within a mean ΔE*ab of 8 of the preview's (${r.three.deltaE.on.toFixed(1)})`, r.three.deltaE);
   check(r.three.change >= 3 * r.oldIor.change, `with the base ior at the film's (the old GLB) the film changed the disc by ` +
         `${r.oldIor.change.toFixed(2)}/255: the base ior of 1 shows it at least 3 times as strongly`, r.oldIor);
 
@@ -115,7 +130,7 @@ try {
   const page2 = await browser.newPage();
   page2.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
   await page2.goto(`${origin}/`);
-  const b = await page2.evaluate(async ({ api, view }) => {
+  const b = await page2.evaluate(async ({ api, view, previewUp }) => {
     const { partChange, skyCubeFaces } = await import('/page_helpers.mjs');
     const out = {};
     const { size, eye, fovY, backdrop, sky, bubble, rPx } = view;
@@ -151,7 +166,7 @@ try {
       scene.render();
       return new Uint8Array(await engine.readPixels(0, 0, size, size));
     };
-    const filmPart = () => partChange((on) => { material.iridescence.isEnabled = on; }, frame, size, rPx);
+    const filmPart = () => partChange((on) => { material.iridescence.isEnabled = on; }, frame, size, rPx, previewUp);
     out.babylon = await filmPart();
     material.iridescence.isEnabled = true;
     await frame();
@@ -159,7 +174,7 @@ try {
     material.indexOfRefraction = material.iridescence.indexOfRefraction;  // the old material
     out.oldIor = await filmPart();
     return out;
-  }, { api, view });
+  }, { api, view, previewUp });
   if (process.env.EFFECTD_PICTURES)
     fs.writeFileSync(path.join(process.env.EFFECTD_PICTURES, 'bubble-gltf-babylon.png'), Buffer.from(b.picture.split(',')[1], 'base64'));
   delete b.picture;
@@ -169,6 +184,9 @@ try {
   check(b.babylon.change >= 2, `the film changes Babylon's disc by ${b.babylon.change.toFixed(2)}/255 on average (≥ 2)`, b.babylon);
   check(b.babylon.on.share >= 0.5 * r.preview.share, `Babylon colours ${(100 * b.babylon.on.share).toFixed(1)} % of the disc, at least half ` +
         `effectd's preview's ${(100 * r.preview.share).toFixed(1)} %`, b.babylon);
+  console.log(`  mean ΔE*ab over the disc from effectd's preview: Babylon.js ${b.babylon.deltaE.on.toFixed(1)} with the film, ` +
+              `${b.babylon.deltaE.off.toFixed(1)} without`);
+  check(b.babylon.deltaE.on <= 8, `Babylon.js's disc is within a mean ΔE*ab of 8 of the preview's (${b.babylon.deltaE.on.toFixed(1)})`, b.babylon.deltaE);
   check(b.babylon.change >= 3 * b.oldIor.change, `with the old base ior Babylon's film changed the disc by ` +
         `${b.oldIor.change.toFixed(2)}/255 and coloured ${(100 * b.oldIor.on.share).toFixed(1)} % of it`, b.oldIor);
 } finally {

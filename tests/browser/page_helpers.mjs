@@ -46,9 +46,30 @@ export function colouredShare(px, size, rPx) {
   return { share: coloured / n, mean: sum.map((s) => s / n) };
 }
 
+// CIE L*a*b* (D65) of an 8-bit sRGB colour.
+function lab(r8, g8, b8) {
+  const lin = (c) => (c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4);
+  const [r, g, b] = [r8, g8, b8].map((c) => lin(c / 255));
+  const xyz = [(0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047, 0.2126 * r + 0.7152 * g + 0.0722 * b,
+               (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883];
+  const f = xyz.map((t) => (t > 216 / 24389 ? Math.cbrt(t) : (24389 / 27 * t + 16) / 116));
+  return [116 * f[1] - 16, 500 * (f[0] - f[1]), 200 * (f[1] - f[2])];
+}
+
+// The mean ΔE*ab (CIE76) over the disc between two frames with their rows in the same order.
+export function meanDeltaE(px, reference, size, rPx) {
+  let sum = 0, n = 0;
+  for (const i of discPixels(size, rPx)) {
+    const a = lab(px[i], px[i + 1], px[i + 2]), b = lab(reference[i], reference[i + 1], reference[i + 2]);
+    sum += Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]), ++n;
+  }
+  return sum / n;
+}
+
 // How much a part of the picture changes the disc: the mean per channel of |on - off| over it,
-// with the share coloured either way. setOn(bool) switches the part; frame() renders and reads.
-export async function partChange(setOn, frame, size, rPx) {
+// with the share coloured either way, and with a `reference` frame (rows in the frames' order)
+// the mean ΔE*ab from it either way. setOn(bool) switches the part; frame() renders and reads.
+export async function partChange(setOn, frame, size, rPx, reference = null) {
   setOn(true);
   const on = await frame();
   setOn(false);
@@ -58,5 +79,7 @@ export async function partChange(setOn, frame, size, rPx) {
     for (let k = 0; k < 3; ++k) diff += Math.abs(on[i + k] - off[i + k]);
     n += 3;
   }
-  return { change: diff / n, on: colouredShare(on, size, rPx), off: colouredShare(off, size, rPx) };
+  const out = { change: diff / n, on: colouredShare(on, size, rPx), off: colouredShare(off, size, rPx) };
+  if (reference) out.deltaE = { on: meanDeltaE(on, reference, size, rPx), off: meanDeltaE(off, reference, size, rPx) };
+  return out;
 }
