@@ -104,8 +104,6 @@ struct FrameState {
 
 // Backdrop uniforms of a background or environment program (passes/background.cpp).
 void setBackground(Program& p, const Background& b, const Texture* image);
-// Fog uniforms of a program built with fogGlsl (passes/quads.cpp).
-void setFog(Program& p, const Fog& f, const glm::vec3& eye);
 
 // A quad's corners as it is drawn: centre -/+ right -/+ up, counter-clockwise seen from its
 // normal's side (passes/quads.cpp).

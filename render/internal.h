@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "fog.h"
 #include "render/render.h"
 
 namespace effects::render::detail {
@@ -21,20 +22,6 @@ void destroyContext(EglContext& c);
 // ---- GLSL (OpenGL ES 3.00) ---------------------------------------------------------------
 inline constexpr const char* kFragmentHeader = "#version 300 es\nprecision highp float;\nprecision highp int;\n";
 inline constexpr const char* kVertexHeader = "#version 300 es\n";
-
-// Fog: the same formulas as effects::fog::factor, per fragment, for the fog types the scene
-// uses (slot 0 = global fog, slots 1..R = regions sorted by volume so that the first one
-// containing a point is the one regionAt() picks). Defines vec3 applyFog(vec3 rgb, vec3 world).
-struct FogVariant {
-  std::vector<fog::FogType> types;  // distinct, sorted
-  size_t regions = 0;
-  // The engine terms some slot uses (fog.h): only those are compiled in.
-  bool start = false, cutoff = false, opacity = false, secondLayer = false, directional = false;
-  bool engine() const { return start || cutoff || opacity || directional; }
-  std::string key() const;
-};
-FogVariant fogVariant(const Fog& fog);
-std::string fogGlsl(const FogVariant& v);
 
 std::string backgroundGlsl(Background::Kind kind);  // vec4 backgroundAt(vec2 uv) (premultiplied)
 std::string screenVertex();                         // full-screen triangle, no attributes

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "service.h"
+#include "problem.h"
 
 namespace effectd {
 

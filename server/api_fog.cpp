@@ -240,6 +240,13 @@ JsonReply handleFog(const json& body, const RequestContext& ctx) {
     auto t = fog::buildTable(f, tableOptions(tableOpts, ctx.config));
     if (!t.ok()) {
       effects::Error e = t.error();
+      // X3D fog with visibilityRange 0 is off (the spec's rule): no distance completes it. Say
+      // that, at the field, rather than the range no distance reaches.
+      const bool x3d = f.type == fog::FogType::kX3dLinear || f.type == fog::FogType::kX3dExponential;
+      if (e.field == "/range" && x3d && f.visibilityRange <= 0)
+        throw fieldError(422, pointer + "/visibilityRange",
+                         "is 0, which turns X3D fog off (fogType " + std::string(fog::toString(f.type)) +
+                             "; LINEAR is the default): give visibilityRange > 0, another fogType, or table.range");
       throwError(e,
                  e.field == "/range" || e.field.rfind("/range/", 0) == 0 || e.field == "/size" || e.field == "/maxError"
                      ? ctx.at + "/table"

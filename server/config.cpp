@@ -175,7 +175,7 @@ std::string usage() {
   os << "usage: effectd [serve] [--flag=value ...]          serve HTTP until SIGTERM/SIGINT\n"
         "       effectd render SCENE.json -o OUT.png [--egl-platform=...] [--max-*=N]\n"
         "                                                   render a /v1/render scene to a PNG, no server\n"
-        "       effectd --help\n\n"
+        "       effectd --help | --version\n\n"
         "Flags (environment variable in brackets; flags win over the environment):\n";
   for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";
   return os.str();
@@ -221,5 +221,7 @@ std::string parseConfig(const std::vector<std::string>& args, Config& config, bo
   }
   return "";
 }
+
+std::string buildVersion() { return EFFECTD_VERSION; }
 
 }  // namespace effectd

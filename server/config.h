@@ -58,4 +58,8 @@ std::string usage();
 // that lets anyone who can reach the port start renders is the operator's decision to make.
 bool playgroundEnabled(const Config& config);
 
+// This build: the project version and the hash of the sources it was built from (effectd
+// --version; part of every ETag, since a new build may answer differently).
+std::string buildVersion();
+
 }  // namespace effectd

@@ -1,6 +1,7 @@
 #include "etag.h"
 
 #include "codec.h"
+#include "config.h"
 
 namespace effectd {
 
@@ -38,7 +39,7 @@ bool etagMatches(const std::string& ifNoneMatch, const std::string& etag) {
 }
 
 std::string etagFor(const std::string& path, const std::string& salt, const std::string& canonical, Coding coding) {
-  std::string identity = EFFECTD_VERSION;
+  std::string identity = buildVersion();
   for (const std::string* part : {&path, &salt, &canonical}) identity.append("\n").append(*part);
   std::string tag = "\"";
   tag.append(sha256Hex(identity), 0, 32);

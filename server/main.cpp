@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -16,8 +17,8 @@
 #include "endpoints.h"
 #include "idle_trim.h"
 #include "json_reader.h"
+#include "movie.h"
 #include "playground.h"
-#include "scene.h"
 #include "service.h"
 
 namespace {
@@ -56,43 +57,47 @@ bool readScene(const std::string& scenePath, nlohmann::json& body) {
 
 // Renders a schema-valid scene into `outPath` (a PNG; with "frames" a GIF or a flipbook PNG);
 // returns the exit status. What it rendered goes to stderr as one JSON line.
-int renderScene(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
+int renderToFile(const nlohmann::json& body, const effectd::Config& config, const std::string& outPath) {
   try {
     effectd::Animation animation;
     effects::ThreadPool pool(effects::ThreadPool::besideCaller());  // as the server's
     effects::render::Scene scene =
         effectd::buildScene(body, effectd::RequestContext{"render", config, &pool}, nullptr, &animation);
+    // The file's name says what it holds: a .gif only for an animated GIF, a .png for the rest.
+    const bool gif = animation.frames.count > 0 && !animation.frames.flipbook;
+    auto ends = [&](const char* ext) {
+      const std::string e(ext);
+      if (outPath.size() < e.size()) return false;
+      std::string tail = outPath.substr(outPath.size() - e.size());
+      for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+      return tail == e;
+    };
+    if (ends(".gif") != gif && (ends(".gif") || ends(".png"))) {
+      std::fprintf(stderr, "effectd render: %s: this scene renders %s; name the file .%s%s\n", outPath.c_str(),
+                   gif ? "an animated GIF" : "a PNG", gif ? "gif" : "png",
+                   gif ? "" : " (an animated GIF needs \"frames\", without \"format\": \"flipbook\")");
+      return 2;
+    }
     auto renderer = effects::render::Renderer::create(config.eglPlatform);
     if (!renderer.ok()) throw effectd::toApiError(renderer.error());
-    nlohmann::json said = {{"renderer", renderer.value()->description()}};
-    std::string bytes;
-    if (animation.frames.count > 0) {
-      effectd::MovieWriter writer(animation, scene.width, scene.height, scene.bitDepth, &pool);
-      auto frames = renderer.value()->render(scene, writer.sequence());
-      if (!frames.ok()) throw effectd::toApiError(frames.error());
-      auto movie = writer.finish();
-      if (!movie.ok()) throw effectd::toApiError(movie.error());
-      bytes = std::move(movie.value().bytes);
-      said["passes"] = frames.value().passList();
-      said["renderMs"] = frames.value().ms;
-      said["contentType"] = movie.value().contentType;
-      for (const auto& [name, value] : movie.value().headers) said[name] = value;
-    } else {
-      auto frame = renderer.value()->render(scene);
-      if (!frame.ok()) throw effectd::toApiError(frame.error());
-      auto png = effects::render::encodePng(frame.value().image, scene.bitDepth, &pool);
-      if (!png.ok()) throw effectd::toApiError(png.error());
-      bytes = std::move(png.value());
-      said["passes"] = frame.value().passList();
-      said["renderMs"] = frame.value().ms;
-    }
+    auto drawn = effectd::renderScene(std::move(scene), animation, &pool,
+                                      [&](effects::render::Scene s, const effects::render::Sequence* sequence) {
+                                        return sequence ? renderer.value()->render(s, *sequence) : renderer.value()->render(s);
+                                      });
+    if (!drawn.ok()) throw effectd::toApiError(drawn.error());
+    const effectd::Rendered& r = drawn.value();
+    nlohmann::json said = {{"renderer", renderer.value()->description()},
+                           {"passes", r.frame.passList()},
+                           {"renderMs", r.frame.ms},
+                           {"contentType", r.output.contentType}};
+    for (const auto& [name, value] : r.output.headers) said[name] = value;
     std::ofstream out(outPath, std::ios::binary);
-    out << bytes;
+    out << r.output.bytes;
     if (!out.flush()) {
       std::fprintf(stderr, "effectd render: cannot write %s\n", outPath.c_str());
       return 1;
     }
-    said["bytes"] = bytes.size();
+    said["bytes"] = r.output.bytes.size();
     std::fprintf(stderr, "%s\n", said.dump().c_str());
     return 0;
   } catch (const effectd::ApiError& e) {
@@ -127,7 +132,7 @@ int renderCommand(std::vector<std::string> args) {
       std::fprintf(stderr, "effectd render: %s: %s\n", v.pointer.c_str(), v.message.c_str());
     return 2;
   }
-  return renderScene(body, config, outPath);
+  return renderToFile(body, config, outPath);
 }
 
 }  // namespace
@@ -135,6 +140,10 @@ int renderCommand(std::vector<std::string> args) {
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (!args.empty() && args.front() == "render") return renderCommand({args.begin() + 1, args.end()});
+  if (args.size() == 1 && args.front() == "--version") {
+    std::printf("effectd %s\n", effectd::buildVersion().c_str());
+    return 0;
+  }
   if (!args.empty() && args.front() == "serve") args.erase(args.begin());
 
   effectd::Config config;

@@ -1,5 +1,6 @@
-// Animated renders: each frame's scene from the animation, frames into a GIF or a flipbook.
-#include "scene.h"
+// A scene into bytes: a still into a PNG; an animation, each frame's scene from the animation,
+// into a GIF or a flipbook.
+#include "movie.h"
 
 namespace effectd {
 
@@ -74,6 +75,34 @@ effects::Result<Movie> MovieWriter::write() {
   m.bytes = std::move(gif.value());
   m.contentType = "image/gif";
   return m;
+}
+
+effects::Result<Rendered> renderScene(rd::Scene scene, const Animation& animation, effects::Parallel* parallel,
+                                      const DrawScene& draw) {
+  Rendered r;
+  const int bitDepth = scene.bitDepth;
+  if (animation.frames.count > 0) {
+    MovieWriter writer(animation, scene.width, scene.height, bitDepth, parallel);
+    const rd::Sequence sequence = writer.sequence();
+    auto frames = draw(std::move(scene), &sequence);
+    if (!frames.ok()) return frames.error();
+    r.frame = std::move(frames.value());
+    auto movie = writer.finish();
+    if (!movie.ok()) return movie.error();
+    r.output = std::move(movie.value());
+    r.encodeMs = writer.encodeMs();
+    return r;
+  }
+  auto frame = draw(std::move(scene), nullptr);
+  if (!frame.ok()) return frame.error();
+  r.frame = std::move(frame.value());
+  effects::Stopwatch encode;
+  auto png = rd::encodePng(r.frame.image, bitDepth, parallel);
+  if (!png.ok()) return png.error();
+  r.output.bytes = std::move(png.value());
+  r.output.contentType = "image/png";
+  r.encodeMs = encode.ms();
+  return r;
 }
 
 }  // namespace effectd

@@ -1,5 +1,5 @@
 // JSON scenes (proto/schemas/scene.json) -> render::Scene, shared by POST /v1/render and
-// the command line (`effectd render scene.json -o out.png`).
+// the command line (`effectd render scene.json -o out.png`); movie.h turns them into bytes.
 #pragma once
 
 #include <render/render.h>
@@ -33,31 +33,5 @@ struct Animation {
 // `animation`, also what an animated render ("frames") needs.
 effects::render::Scene buildScene(const nlohmann::json& body, const RequestContext& ctx, double* computeMs = nullptr,
                                   Animation* animation = nullptr);
-
-// An animated render's bytes: a looping GIF or a flipbook PNG, and the headers that describe it.
-struct Movie {
-  std::string bytes, contentType;
-  std::vector<std::pair<std::string, std::string>> headers;
-};
-
-// Renders `animation`'s frames into a Movie: hand sequence() to a renderer, then finish().
-class MovieWriter {
- public:
-  // `parallel` writes a flipbook's PNG (null: the calling thread only).
-  MovieWriter(const Animation& animation, int width, int height, int bitDepth, effects::Parallel* parallel);
-  effects::render::Sequence sequence();
-  effects::Result<Movie> finish();
-  // Time spent encoding: each frame into the GIF or the sheet (on the render thread), and finish.
-  double encodeMs() const { return encodeMs_; }
-
- private:
-  const Animation& animation_;
-  int bitDepth_;
-  effects::Parallel* parallel_;
-  double encodeMs_ = 0;
-  effects::Result<Movie> write();  // finish() without the stopwatch
-  std::optional<effects::render::GifEncoder> gif_;
-  std::optional<effects::render::Flipbook> book_;
-};
 
 }  // namespace effectd

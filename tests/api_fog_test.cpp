@@ -139,6 +139,13 @@ TEST(FogApi, BadFieldsAre400WithPointers) {
   p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"range", {3, 1}}}}}),
                     400);
   EXPECT_TRUE(hasPointer(p, "/table/range/1")) << p;
+  // No fogType means X3D LINEAR, which visibilityRange 0 (its default) turns off: the problem
+  // names that field, not the table's range that no distance completes.
+  p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"density", 0.1}}}}), 422);
+  EXPECT_TRUE(hasPointer(p, "/fog/visibilityRange")) << p;
+  // With a range the table of an off fog is all clear, as X3D says.
+  auto r = s.postJson("/v1/fog", json{{"fog", json::object()}, {"table", {{"range", {0, 10}}, {"size", 4}}}});
+  EXPECT_EQ(r->status, 200) << r->body;
 }
 
 TEST(FogApi, EngineTermsInTablesAndErrors) {

@@ -72,4 +72,13 @@ set -e
 rm -f /tmp/effectd_bad.$$.json
 [ "$rc" -eq 2 ] && grep -q '/width' "$log" || { echo "bad scene: exit $rc"; cat "$log"; exit 1; }
 [ ! -e "$png" ] || { echo "wrote a PNG for a bad scene"; exit 1; }
+# A still scene is a PNG: a .gif name is refused, not filled with PNG bytes.
+gif=/tmp/effectd_render.$$.gif
+set +e
+"$bin" render "$scene" -o "$gif" 2>"$log"
+rc=$?
+set -e
+[ "$rc" -eq 2 ] && grep -q 'renders a PNG' "$log" && [ ! -e "$gif" ] || { echo "still as .gif: exit $rc"; cat "$log"; exit 1; }
+# --version names the build ETags are made from.
+"$bin" --version | grep -Eq '^effectd [0-9]+\.[0-9]+\.[0-9]+\+[0-9a-f]+$' || { echo "--version: $("$bin" --version)"; exit 1; }
 echo "binary test ok (port $port)"

@@ -11,7 +11,7 @@
 // Usage: node bolt_gltf.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchWebGl2Chromium } from './chromium.mjs';
+import { launchWebGl2Chromium, openLoggedPage } from './chromium.mjs';
 import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
@@ -25,10 +25,7 @@ const view = { size: 192, grid: 96, dark: [0.02, 0.02, 0.03],
 
 const browser = await launchWebGl2Chromium(chromium);
 try {
-  const page = await browser.newPage();
-  page.on('console', (m) => console.log(`  page: ${m.text()}`));
-  page.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
-  await page.goto(`${origin}/`);
+  const page = await openLoggedPage(browser, `${origin}/`);
   const r = await page.evaluate(async ({ api, view }) => {
     const { size, grid, dark, bolt, volume } = view;
     const out = {};

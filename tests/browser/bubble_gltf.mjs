@@ -13,7 +13,7 @@
 // Usage: node bubble_gltf.mjs EFFECTD_BINARY [CHROMIUM]
 import fs from 'node:fs';
 import path from 'node:path';
-import { launchWebGl2Chromium } from './chromium.mjs';
+import { launchWebGl2Chromium, openLoggedPage } from './chromium.mjs';
 import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
@@ -31,10 +31,7 @@ view.rPx = (view.size / 2) / (Math.hypot(...view.eye) * Math.tan((view.fovY / 2)
 
 const browser = await launchWebGl2Chromium(chromium);
 try {
-  const page = await browser.newPage();
-  page.on('console', (m) => console.log(`  page: ${m.text()}`));
-  page.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
-  await page.goto(`${origin}/`);
+  const page = await openLoggedPage(browser, `${origin}/`);
   const r = await page.evaluate(async ({ api, view }) => {
     const { colouredShare, partChange, skyCubeFaces } = await import('/page_helpers.mjs');
     const out = {};

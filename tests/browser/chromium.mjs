@@ -10,3 +10,12 @@ export function launchWebGl2Chromium(executablePath) {
            '--ignore-gpu-blocklist'],
   });
 }
+
+// A new page that prints the page's console and errors, at `url`.
+export async function openLoggedPage(browser, url) {
+  const page = await browser.newPage();
+  page.on('console', (m) => console.log(`  page: ${m.text()}`));
+  page.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
+  await page.goto(url);
+  return page;
+}

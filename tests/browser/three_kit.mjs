@@ -15,7 +15,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { launchWebGl2Chromium } from './chromium.mjs';
+import { launchWebGl2Chromium, openLoggedPage } from './chromium.mjs';
 import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
@@ -26,10 +26,7 @@ const { url: api, process: server } = await startEffectd(binary, ['--cors-origin
 
 const browser = await launchWebGl2Chromium(chromium);
 try {
-  const page = await browser.newPage();
-  page.on('console', (m) => console.log(`  page: ${m.text()}`));
-  page.on('pageerror', (e) => console.log(`  page error: ${e.message}`));
-  await page.goto(`${origin}/`);
+  const page = await openLoggedPage(browser, `${origin}/`);
   const r = await page.evaluate(async (api) => {
     const THREE = await import('three');
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');

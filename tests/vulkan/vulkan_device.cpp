@@ -136,14 +136,7 @@ Device::Device(int width, int height) : width_(width), height_(height) {
   ii.tiling = VK_IMAGE_TILING_OPTIMAL;
   ii.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   check(vkCreateImage(device_, &ii, nullptr, &target_.image), "vkCreateImage (target)");
-  VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(device_, target_.image, &req);
-  VkMemoryAllocateInfo mai{};
-  mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  mai.allocationSize = req.size;
-  mai.memoryTypeIndex = memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(vkAllocateMemory(device_, &mai, nullptr, &target_.memory), "vkAllocateMemory (target)");
-  vkBindImageMemory(device_, target_.image, target_.memory, 0);
+  target_.memory = deviceMemory(target_.image);
   VkImageViewCreateInfo vi{};
   vi.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
   vi.image = target_.image;
@@ -196,6 +189,19 @@ uint32_t Device::memoryType(uint32_t bits, VkMemoryPropertyFlags want) const {
   for (uint32_t i = 0; i < p.memoryTypeCount; ++i)
     if ((bits & (1u << i)) && (p.memoryTypes[i].propertyFlags & want) == want) return i;
   throw std::runtime_error("no suitable memory type");
+}
+
+VkDeviceMemory Device::deviceMemory(VkImage image) {
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(device_, image, &req);
+  VkMemoryAllocateInfo mai{};
+  mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  VkDeviceMemory memory;
+  check(vkAllocateMemory(device_, &mai, nullptr, &memory), "vkAllocateMemory (image)");
+  vkBindImageMemory(device_, image, memory, 0);
+  return memory;
 }
 
 VkCommandBuffer Device::begin() {
@@ -267,14 +273,7 @@ Texture Device::texture(const TextureData& d) {
   ii.tiling = VK_IMAGE_TILING_OPTIMAL;
   ii.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   check(vkCreateImage(device_, &ii, nullptr, &t.image), "vkCreateImage");
-  VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(device_, t.image, &req);
-  VkMemoryAllocateInfo mai{};
-  mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  mai.allocationSize = req.size;
-  mai.memoryTypeIndex = memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(vkAllocateMemory(device_, &mai, nullptr, &t.memory), "vkAllocateMemory (texture)");
-  vkBindImageMemory(device_, t.image, t.memory, 0);
+  t.memory = deviceMemory(t.image);
   const size_t expected = size_t(d.width) * size_t(d.height) * size_t(d.layers) * texelBytes(d.format);
   if (d.bytes.size() != expected) throw std::runtime_error("texture data has the wrong size");
   Buffer staging = buffer(d.bytes.data(), d.bytes.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);

@@ -85,6 +85,7 @@ class Device {
 
  private:
   uint32_t memoryType(uint32_t bits, VkMemoryPropertyFlags want) const;
+  VkDeviceMemory deviceMemory(VkImage image);  // allocated for and bound to `image`
   VkCommandBuffer begin();
   void submit(VkCommandBuffer cb);
   VkShaderModule module(const std::vector<uint32_t>& words);
