@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The render figures on a GPU machine that lacks Debian's packages, from a bundle of this build
-# made here with ../shared/tools/bundle-build.sh (effectd, render_bench, render_test, and the
+# made here with scripts/bundle.sh (effectd, render_bench, render_test, and the
 # baseline's effectd-base, render_bench-base and render_test-base, built from the commit
 # compared against; any of the baseline's may be left out):
 #   scripts/gpu-bench.sh BUNDLE_DIR [OUT_DIR]
