@@ -139,6 +139,8 @@ FogVariant fogVariant(const Fog& f) {
   return v;
 }
 
+// Long because it is one GLSL program read top to bottom: uniforms, each fog type's function,
+// the engine terms, then applyFog; each piece is emitted only for the variant that uses it.
 std::string fogGlsl(const FogVariant& v) {
   using T = fog::FogType;
   auto has = [&](T t) { return std::find(v.types.begin(), v.types.end(), t) != v.types.end(); };

@@ -74,6 +74,8 @@ std::vector<uint8_t> samples(const Image& image, int bitDepth) {
 
 }  // namespace
 
+// Long because it is one PNG written in order (signature, IHDR, the strips filtered and deflated
+// on `parallel` and joined into one zlib stream, IEND), each chunk with its CRC.
 Result<std::string> encodePng(const Image& image, int bitDepth, Parallel* parallel) {
   if (bitDepth != 8 && bitDepth != 16) return invalid("/bitDepth", "must be 8 or 16");
   if (image.width <= 0 || image.height <= 0 || image.values() != size_t(image.width) * image.height * 4)

@@ -344,6 +344,8 @@ bb::ThicknessField thicknessField(const bb::Params& params, const bb::ThicknessO
 
 }  // namespace
 
+// Long because it is the list of what /v1/bubble can include (glb, motion, shader parts, mesh,
+// thin-film table, thickness), each computed only when asked for, in the answer's order.
 JsonReply handleBubble(const json& body, const RequestContext& ctx) {
   Includes include(body, kBubbleIncludes);
   const bb::Params params = parseBubbleParams(body.value("params", json::object()), ctx.at + "/params");

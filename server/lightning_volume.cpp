@@ -144,6 +144,8 @@ World parseWorld(const json& body) {
   return w;
 }
 
+// Long because it is the list of obstacle forms a 3-D grid takes (boxes, spheres, rows, bitmap,
+// mesh, glb), each a few lines into the same voxel grid, in the schema's order.
 std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, const World& world, const Config& config,
                                           const std::string& at) {
   if (o.contains("rects"))

@@ -4,7 +4,7 @@
 #include <cfloat>
 #include <cmath>
 
-#include "laplace3.h"
+#include "potential.h"
 
 namespace effects::lightning::detail {
 
@@ -36,11 +36,8 @@ void DeepField::fix(Cell c, double value) {
 }
 
 std::unique_ptr<Potential> DeepField::build(int stage) const {
-  std::unique_ptr<Potential> lap;
-  if (d_)
-    lap = std::make_unique<Laplace3>(w_, h_, d_);
-  else
-    lap = std::make_unique<Laplace>(w_, h_);
+  // A rebuilt stage is solved iteratively (potential.h's rule for any solver but capacitance).
+  std::unique_ptr<Potential> lap = potentialFor(w_, h_, d_, Solver::kMgpcg, 0, 0);
   for (size_t i = 0; i < cells_; ++i) {
     if (zero_[i]) {
       lap->fix(cellAt(i), 0.0);

@@ -8,11 +8,10 @@
 #include <cmath>
 #include <limits>
 
-#include "capacitance.h"
 #include "deep_field.h"
 #include "grid.h"
 #include "laplace.h"
-#include "laplace3.h"
+#include "potential.h"
 #include "weight_tree.h"
 
 namespace effects::lightning {
@@ -637,20 +636,13 @@ std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
   return path;
 }
 
-// The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1.
-// The capacitance solver takes 2-D problems whose fixed cells (obstacles, bolt, target) leave
-// room for the bolt to grow within its direct limit; the rest go to the iterative solvers.
+// The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1, on the
+// solver potential.h chooses.
 std::unique_ptr<detail::DeepField> Grower::dbmProblem(Cell target, Solver solver) const {
-  std::unique_ptr<detail::Potential> lap;
   size_t fixedCells = bolt_.nodes.size() + 1;
   for (uint8_t o : p_.obstacles) fixedCells += o != 0;
-  if (solver == Solver::kCapacitance && detail::Capacitance::fits(p_.width, p_.height, p_.depth) &&
-      fixedCells <= detail::Capacitance::maxFixed(p_.width, p_.height, p_.depth) / 2)
-    lap = std::make_unique<detail::Capacitance>(p_.width, p_.height, p_.depth);
-  else if (p_.depth)
-    lap = std::make_unique<detail::Laplace3>(p_.width, p_.height, p_.depth);
-  else
-    lap = std::make_unique<detail::Laplace>(p_.width, p_.height);
+  std::unique_ptr<detail::Potential> lap =
+      detail::potentialFor(p_.width, p_.height, p_.depth, solver, fixedCells, fixedCells);  // room to grow
   auto field = std::make_unique<detail::DeepField>(std::move(lap), p_.width, p_.height, p_.depth);
   for (size_t i = 0; i < g_.cells(); ++i)
     if (!p_.obstacles.empty() && p_.obstacles[i]) field->fix(g_.cellAt(i), 0.0);

@@ -4,9 +4,7 @@
 #include <cmath>
 #include <memory>
 
-#include "capacitance.h"
 #include "grid.h"
-#include "laplace3.h"
 
 namespace effects::lightning::detail {
 
@@ -272,36 +270,3 @@ int Laplace::solve(Solver solver, double tolerance) {
 }
 
 }  // namespace effects::lightning::detail
-
-namespace effects::lightning {
-
-std::vector<double> solveLaplace(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
-                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
-                                 int* iterations, double* residual) {
-  std::unique_ptr<detail::Potential> lap;
-  if (solver == Solver::kCapacitance && detail::Capacitance::fits(width, height, depth))
-    lap = std::make_unique<detail::Capacitance>(width, height, depth);
-  else if (depth > 0)
-    lap = std::make_unique<detail::Laplace3>(width, height, depth);
-  else
-    lap = std::make_unique<detail::Laplace>(width, height);
-  const detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
-  for (size_t i = 0; i < g.cells(); ++i)
-    if (!obstacles.empty() && obstacles[i]) lap->fix(g.cellAt(i), 0.0);
-  for (const Cell& c : bolt) lap->fix(c, 0.0);
-  lap->fix(target, 1.0);
-  int it = lap->solve(solver, tolerance);
-  if (iterations) *iterations = it;
-  if (residual) *residual = lap->residual();
-  std::vector<double> out(g.cells());
-  for (size_t i = 0; i < out.size(); ++i) out[i] = lap->phi(g.cellAt(i));
-  return out;
-}
-
-std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
-                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
-                                 int* iterations, double* residual) {
-  return solveLaplace(width, height, 0, obstacles, bolt, target, solver, tolerance, iterations, residual);
-}
-
-}  // namespace effects::lightning

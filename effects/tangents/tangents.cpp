@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "effects/check.h"
+#include "../util/check.h"
 #include "steps.h"
 
 namespace effects::tangents {

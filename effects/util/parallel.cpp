@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <atomic>
 
-#include "effects/check.h"
+#include "check.h"
 
 namespace effects {
 

@@ -3,7 +3,8 @@
 // Contract for every effect module:
 //  * Bad input is reported as an `Error` value naming the field (a JSON-pointer-like path
 //    relative to the params struct, e.g. "/visibilityRange") and the rule broken. No
-//    exception crosses the library boundary; programming errors are CHECKs (effects/check.h).
+//    exception crosses the library boundary; programming errors are CHECKs (effects/util/
+//    check.h, internal to the library).
 //  * Every result carries `Stats`: which method ran, how long it took, work counters, and
 //    an error estimate against the effect's reference method with the metric's name.
 //  * Deterministic: same params + seed -> same output, bit for bit. Randomness comes from

@@ -1,5 +1,6 @@
-// effects/check.h — CHECK macros for programming errors (broken invariants, not bad input:
-// bad input is an `Error` value, see common.h). A failed CHECK prints the expression, both
+// CHECK macros for programming errors (broken invariants, not bad input: bad input is an
+// `Error` value, see common.h). Internal to the library: its bare CHECK names stay out of the
+// headers an engine includes. A failed CHECK prints the expression, both
 // operands where there are two, and the place, then aborts; CHECKs stay on in Release because
 // a wrong answer served is worse than a crash that names its cause. DCHECK is for checks on
 // hot paths and compiles to nothing with NDEBUG. After pbrt-v4's src/pbrt/util/check.h.
