@@ -1,6 +1,6 @@
 // The bolt as engine geometry: ribbons a game draws with an additive material, as JSON
 // ("mesh" in /v1/lightning's answer) or as one binary glTF file (format "glb"). Both are the
-// same triangles. docs/effects.md §1.6 describes the layout.
+// same triangles. docs/effects.md §1.8 describes the layout.
 #pragma once
 
 #include <array>
