@@ -119,10 +119,8 @@ json guideJson(const lt::Bolt& bolt) {
   return g;
 }
 
-// "timeline": when each polyline vertex lights, the strokes, and the channels' keyframes.
-json timelineJson(const lt::Timeline& tl) {
-  json lines = json::array();
-  for (size_t i = 0; i < tl.leader.size(); ++i) lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
+// The strike without its per-vertex times: connect, duration, strokes and the channels' keyframes.
+json strikeJson(const lt::Timeline& tl) {
   json strokes = json::array();
   for (const auto& s : tl.strokes) strokes.push_back({{"t", s.t}, {"peak", s.peak}});
   json t = json::array(), leader = json::array(), main = json::array(), branches = json::array();
@@ -135,8 +133,16 @@ json timelineJson(const lt::Timeline& tl) {
   return {{"connect", tl.connect},
           {"duration", tl.duration},
           {"strokes", std::move(strokes)},
-          {"keyframes", {{"t", std::move(t)}, {"leader", std::move(leader)}, {"main", std::move(main)}, {"branches", std::move(branches)}}},
-          {"polylines", std::move(lines)}};
+          {"keyframes", {{"t", std::move(t)}, {"leader", std::move(leader)}, {"main", std::move(main)}, {"branches", std::move(branches)}}}};
+}
+
+// "timeline": the strike and, per polyline, when each vertex lights.
+json timelineJson(const lt::Timeline& tl) {
+  json lines = json::array();
+  for (size_t i = 0; i < tl.leader.size(); ++i) lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
+  json out = strikeJson(tl);
+  out["polylines"] = std::move(lines);
+  return out;
 }
 
 // The strike's physics: top-level animationSeed (default: seed) and timeScale, "timeline".
@@ -255,8 +261,7 @@ JsonReply handleLightning(const json& body, const RequestContext& ctx) {
     std::optional<lt::Timeline> timeline;
     if (include.has("timeline")) timeline = lt::timeline(bolt, lines, request.timeline);
     if (glbFormat) {  // the ribbons as one file instead of JSON; the timeline's times per vertex
-      json strike = nullptr;
-      if (timeline) strike = timelineJson(*timeline), strike.erase("polylines");
+      const json strike = timeline ? strikeJson(*timeline) : json(nullptr);
       const auto ribbons = boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr);
       const glm::dvec3 color = effects::render::Lightning{}.color;  // the preview's
       reply.binary = boltGlb(ribbons, {color.x, color.y, color.z}, strike);

@@ -33,15 +33,6 @@ std::string profilePng() {
 // glTF's colour factors are linear; effectd's frames hold display (sRGB-encoded) values.
 double linearFromSrgb(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
-json bounds(const std::vector<float>& xyz, bool max) {
-  json b = json::array();
-  for (int c = 0; c < 3; ++c) {
-    float m = xyz[size_t(c)];
-    for (size_t i = size_t(c); i < xyz.size(); i += 3) m = max ? std::max(m, xyz[i]) : std::min(m, xyz[i]);
-    b.push_back(m);
-  }
-  return b;
-}
 
 }  // namespace
 
@@ -58,9 +49,7 @@ std::string boltGlb(const std::array<Ribbons, 2>& ribbons, const std::array<doub
   json roots = json::array();
   for (const Ribbons& r : ribbons) {
     if (r.indices.empty()) continue;
-    const int position = glb::addFloatAccessor(a, r.positions, 3, true);
-    a.gltf["accessors"][position]["min"] = bounds(r.positions, false);  // glTF requires POSITION bounds
-    a.gltf["accessors"][position]["max"] = bounds(r.positions, true);
+    const int position = glb::addPositionAccessor(a, r.positions);
     std::vector<float> rgb;
     rgb.reserve(r.intensity.size() * 3);
     for (float i : r.intensity) rgb.insert(rgb.end(), {i, i, i});

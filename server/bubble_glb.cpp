@@ -1,7 +1,5 @@
 #include "bubble_glb.h"
 
-#include <algorithm>
-
 #include "glb.h"
 
 namespace effectd {
@@ -46,16 +44,7 @@ std::string bubbleGlb(const effects::bubble::Mesh& mesh, const effects::bubble::
   a.gltf["bufferViews"] = json::array();
   std::vector<float> tangents = glb::floats<4>(mesh.tangents);
   for (size_t i = 3; i < tangents.size(); i += 4) tangents[i] = -tangents[i];  // glTF: UV origin top left
-  const int position = glb::addFloatAccessor(a, glb::floats<3>(mesh.positions), 3, true);
-  json lo = json::array(), hi = json::array();
-  for (int c = 0; c < 3; ++c) {
-    auto [mn, mx] = std::minmax_element(mesh.positions.begin(), mesh.positions.end(),
-                                        [c](const auto& x, const auto& y) { return x[c] < y[c]; });
-    lo.push_back((*mn)[c]);
-    hi.push_back((*mx)[c]);
-  }
-  a.gltf["accessors"][position]["min"] = lo;  // glTF requires POSITION bounds
-  a.gltf["accessors"][position]["max"] = hi;
+  const int position = glb::addPositionAccessor(a, glb::floats<3>(mesh.positions));
   json attributes = {{"POSITION", position},
                      {"NORMAL", glb::addFloatAccessor(a, glb::floats<3>(mesh.normals), 3, true)},
                      {"TEXCOORD_0", glb::addFloatAccessor(a, glb::floats<2>(mesh.uvs), 2, true)},

@@ -1,5 +1,6 @@
 #include "glb.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <set>
@@ -389,6 +390,20 @@ int addFloatAccessor(Asset& a, const std::vector<float>& data, int components, b
                           {"componentType", 5126},
                           {"count", data.size() / size_t(components)},
                           {"type", typeName(components)}});
+}
+
+int addPositionAccessor(Asset& a, const std::vector<float>& xyz) {
+  const int index = addFloatAccessor(a, xyz, 3, true);
+  json lo = json::array(), hi = json::array();
+  for (size_t c = 0; c < 3; ++c) {
+    float mn = xyz.size() > c ? xyz[c] : 0.0f, mx = mn;
+    for (size_t i = c; i < xyz.size(); i += 3) mn = std::min(mn, xyz[i]), mx = std::max(mx, xyz[i]);
+    lo.push_back(mn);
+    hi.push_back(mx);
+  }
+  a.gltf["accessors"][index]["min"] = lo;
+  a.gltf["accessors"][index]["max"] = hi;
+  return index;
 }
 
 int addPngImage(Asset& a, const std::string& png) {

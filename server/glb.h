@@ -57,6 +57,8 @@ std::vector<float> floats(const std::vector<V>& v) {
 
 // New accessors over data appended to the BIN chunk (tightly packed, 4-byte aligned rows).
 int addFloatAccessor(Asset& asset, const std::vector<float>& data, int components, bool vertexAttribute);
+// A POSITION accessor over flat x, y, z floats, with the min and max glTF requires of it.
+int addPositionAccessor(Asset& asset, const std::vector<float>& xyz);
 int addIndexAccessor(Asset& asset, const std::vector<uint32_t>& indices);
 // A PNG embedded in the BIN chunk as a new image (bufferView + mimeType); its index.
 int addPngImage(Asset& asset, const std::string& png);

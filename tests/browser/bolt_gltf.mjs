@@ -31,24 +31,8 @@ try {
     const out = {};
     const post = (route, body) => fetch(`${api}${route}`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                                             body: JSON.stringify(body) });
-    const lit = (px) => {  // RGBA bytes -> 0/1 per pixel, rows top-down
-      const m = new Uint8Array(size * size);
-      for (let i = 0; i < size * size; ++i) m[i] = Math.max(px[4 * i], px[4 * i + 1], px[4 * i + 2]) > 48;
-      return m;
-    };
-    const near = (m, x, y) => {
-      for (let dy = -1; dy <= 1; ++dy)
-        for (let dx = -1; dx <= 1; ++dx) {
-          const u = x + dx, v = y + dy;
-          if (u >= 0 && v >= 0 && u < size && v < size && m[v * size + u]) return true;
-        }
-      return false;
-    };
-    const found = (a, b) => {  // share of a's lit pixels with a lit pixel of b within one pixel
-      let n = 0, hit = 0;
-      for (let y = 0; y < size; ++y) for (let x = 0; x < size; ++x) if (a[y * size + x]) ++n, hit += near(b, x, y);
-      return { lit: n, share: hit / Math.max(n, 1) };
-    };
+    const { foundWithinAPixel, litMask, readTopDown } = await import('/page_helpers.mjs');
+    const lit = (px) => litMask(px, size), found = (a, b) => foundWithinAPixel(a, b, size);
     const meanLit = (px, m) => {
       const s = [0, 0, 0];
       let n = 0;
@@ -84,10 +68,7 @@ try {
     };
     const frame = (scene, camera) => {
       renderer.render(scene, camera);
-      const gl = renderer.getContext(), px = new Uint8Array(size * size * 4), flipped = new Uint8Array(size * size * 4);
-      gl.readPixels(0, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, px);
-      for (let y = 0; y < size; ++y) flipped.set(px.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
-      return flipped;
+      return readTopDown(renderer.getContext(), size);
     };
     const flat = await load(bolt);
     out.glb = flat.status;

@@ -33,7 +33,7 @@ const browser = await launchWebGl2Chromium(chromium);
 try {
   const page = await openLoggedPage(browser, `${origin}/`);
   const r = await page.evaluate(async ({ api, view }) => {
-    const { colouredShare, partChange, skyCubeFaces } = await import('/page_helpers.mjs');
+    const { colouredShare, flipRows, partChange, skyCubeFaces } = await import('/page_helpers.mjs');
     const out = {};
     const { size, eye, fovY, backdrop, sky, bubble, rPx } = view;
     const json = { 'Content-Type': 'application/json' };
@@ -47,10 +47,10 @@ try {
     c2.width = c2.height = size;
     const ctx = c2.getContext('2d');
     ctx.drawImage(await createImageBitmap(await png.blob()), 0, 0);
-    out.preview = colouredShare(ctx.getImageData(0, 0, size, size).data, size, rPx);
+    const top = ctx.getImageData(0, 0, size, size).data;
+    out.preview = colouredShare(top, size, rPx);
     // The preview's rows bottom-up, as the engines' frames are read back.
-    const top = ctx.getImageData(0, 0, size, size).data, up = new Uint8Array(top.length);
-    for (let y = 0; y < size; ++y) up.set(top.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
+    const up = flipRows(top, size);
     out.previewUp = Array.from(up);
 
     // three.js: the GLB as a glTF viewer loads it, under effectd's sky (its displayed colours,

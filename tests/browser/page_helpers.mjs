@@ -1,5 +1,5 @@
-// Served to the test pages (bubble_webgl.mjs, bubble_gltf.mjs) as /page_helpers.mjs: what a
-// client computes the same way in each of them.
+// Served to the test pages as /page_helpers.mjs: what a client computes the same way in each
+// of them.
 
 // The sky as effectd's renderer evaluates it (render::skyAt, as scene.json documents it) in
 // unit direction d.
@@ -82,4 +82,40 @@ export async function partChange(setOn, frame, size, rPx, reference = null) {
   const out = { change: diff / n, on: colouredShare(on, size, rPx), off: colouredShare(off, size, rPx) };
   if (reference) out.deltaE = { on: meanDeltaE(on, reference, size, rPx), off: meanDeltaE(off, reference, size, rPx) };
   return out;
+}
+
+// A size x size RGBA frame with its rows in the other order (GL reads bottom-up, images top-down).
+export function flipRows(px, size) {
+  const out = new Uint8Array(size * size * 4);
+  for (let y = 0; y < size; ++y) out.set(px.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
+  return out;
+}
+
+// The WebGL context's size x size frame as RGBA bytes, rows from the top.
+export function readTopDown(gl, size) {
+  const px = new Uint8Array(size * size * 4);
+  gl.readPixels(0, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, px);
+  return flipRows(px, size);
+}
+
+// 1 per pixel whose largest channel is above 48/255 (lit), else 0.
+export function litMask(px, size) {
+  const m = new Uint8Array(size * size);
+  for (let i = 0; i < size * size; ++i) m[i] = Math.max(px[4 * i], px[4 * i + 1], px[4 * i + 2]) > 48;
+  return m;
+}
+
+// Of mask a's lit pixels, how many have a lit pixel of mask b within one pixel: {lit, share}.
+export function foundWithinAPixel(a, b, size) {
+  const near = (x, y) => {
+    for (let dy = -1; dy <= 1; ++dy)
+      for (let dx = -1; dx <= 1; ++dx) {
+        const u = x + dx, v = y + dy;
+        if (u >= 0 && v >= 0 && u < size && v < size && b[v * size + u]) return true;
+      }
+    return false;
+  };
+  let n = 0, hit = 0;
+  for (let y = 0; y < size; ++y) for (let x = 0; x < size; ++x) if (a[y * size + x]) ++n, hit += near(x, y);
+  return { lit: n, share: hit / Math.max(n, 1) };
 }

@@ -31,7 +31,7 @@ try {
     const THREE = await import('three');
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
     const kit = await import('/effectd-three.js');
-    const { skyCubeFaces } = await import('/page_helpers.mjs');
+    const { foundWithinAPixel, litMask, readTopDown, skyCubeFaces } = await import('/page_helpers.mjs');
     const size = 128, out = {};
     const post = (route, body) => fetch(`${api}${route}`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                                             body: JSON.stringify(body) });
@@ -41,10 +41,7 @@ try {
     renderer.setPixelRatio(1);
     const frame = (scene, camera) => {  // RGBA rows from the top
       renderer.render(scene, camera);
-      const gl = renderer.getContext(), px = new Uint8Array(size * size * 4), top = new Uint8Array(size * size * 4);
-      gl.readPixels(0, 0, size, size, gl.RGBA, gl.UNSIGNED_BYTE, px);
-      for (let y = 0; y < size; ++y) top.set(px.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
-      return top;
+      return readTopDown(renderer.getContext(), size);
     };
     const preview = async (scene) => {
       const res = await post('/v1/render', { width: size, height: size, ...scene });
@@ -98,15 +95,9 @@ try {
     boltScene.remove(fromJson.object);
     out.boltSame = compare(a, b, null);
     const p = await preview({ background: { color: [...dark, 1] }, lightning: bolt, lightningStyle: { coreWidth: size / 64, glowSigma: 0 } });
-    const lit = (px) => Array.from({ length: size * size }, (_, i) => Math.max(px[4 * i], px[4 * i + 1], px[4 * i + 2]) > 48);
-    const near = (m, i) => {
-      const x = i % size, y = Math.floor(i / size);
-      for (let dy = -1; dy <= 1; ++dy) for (let dx = -1; dx <= 1; ++dx) if (m[(y + dy) * size + x + dx]) return true;
-      return false;
-    };
+    const lit = (px) => litMask(px, size);
     const mk = lit(a), mp = lit(p);
-    const found = (m1, m2) => { let n = 0, hit = 0; m1.forEach((v, i) => { if (v) ++n, hit += near(m2, i); }); return hit / Math.max(n, 1); };
-    out.boltRecall = found(mp, mk), out.boltPrecision = found(mk, mp);
+    out.boltRecall = foundWithinAPixel(mp, mk, size).share, out.boltPrecision = foundWithinAPixel(mk, mp, size).share;
     // The strike through setTime().
     const timed = kit.boltFromGltf(await new GLTFLoader().parseAsync(await (await post('/v1/lightning', { ...bolt, format: 'glb', include: ['timeline'] })).arrayBuffer(), ''));
     boltScene.add(timed.object);

@@ -443,27 +443,22 @@ VkDescriptorSet Device::descriptorSet(VkDescriptorSetLayout layout, const std::m
   bufferInfo.reserve(uniforms.size());
   imageInfo.reserve(textures.size());
   std::vector<VkWriteDescriptorSet> writes;
-  for (const auto& [binding, b] : uniforms) {
-    bufferInfo.push_back({b->buffer, 0, b->size});
-    VkWriteDescriptorSet w{};
+  auto write = [&](uint32_t binding, VkDescriptorType type) -> VkWriteDescriptorSet& {
+    VkWriteDescriptorSet& w = writes.emplace_back();
     w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     w.dstSet = set;
     w.dstBinding = binding;
     w.descriptorCount = 1;
-    w.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    w.pBufferInfo = &bufferInfo.back();
-    writes.push_back(w);
+    w.descriptorType = type;
+    return w;
+  };
+  for (const auto& [binding, b] : uniforms) {
+    bufferInfo.push_back({b->buffer, 0, b->size});
+    write(binding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER).pBufferInfo = &bufferInfo.back();
   }
   for (const auto& [binding, t] : textures) {
     imageInfo.push_back({t->sampler, t->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
-    VkWriteDescriptorSet w{};
-    w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    w.dstSet = set;
-    w.dstBinding = binding;
-    w.descriptorCount = 1;
-    w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    w.pImageInfo = &imageInfo.back();
-    writes.push_back(w);
+    write(binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER).pImageInfo = &imageInfo.back();
   }
   vkUpdateDescriptorSets(device_, uint32_t(writes.size()), writes.data(), 0, nullptr);
   return set;
