@@ -1,0 +1,78 @@
+"""What the tests of docs/using/*.md share: the page's own code, a server, and checks.
+
+Each page holds its steps as one Python block between the markers
+    <!-- using-test:begin -->  and  <!-- using-test:end -->
+and its test runs exactly that block (exec), so the page and the test cannot drift apart: change
+the page's code and the test runs the change. The test then checks the result against something
+the page's code did not compute (the server's own per-point answers, the request's geometry,
+closed forms).
+"""
+import http.client
+import json
+import os
+import re
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.dirname(HERE))  # tests/: effectd_process
+from effectd_process import start  # noqa: E402
+
+BLOCK = re.compile(r"<!-- using-test:begin -->\s*```python\n(.*?)```\s*<!-- using-test:end -->", re.S)
+
+
+def page_code(name):
+    """The Python block of docs/using/<name>.md, run in a fresh namespace that is returned."""
+    path = os.path.join(ROOT, "docs", "using", f"{name}.md")
+    blocks = BLOCK.findall(open(path, encoding="utf-8").read())
+    if len(blocks) != 1:
+        raise SystemExit(f"{path}: expected one python block between the using-test markers, found {len(blocks)}")
+    namespace = {"__name__": f"docs/using/{name}.md"}
+    exec(compile(blocks[0], path, "exec"), namespace)
+    return namespace
+
+
+class Server:
+    """effectd on a free port, spoken to over one kept-alive connection."""
+
+    def __init__(self, binary):
+        self.process, self.port = start(binary, "--access-log", "0")
+        self.connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=60)
+
+    def post(self, path, body, content_type="application/json"):
+        data = body if isinstance(body, bytes) else json.dumps(body).encode()
+        self.connection.request("POST", path, body=data, headers={"Content-Type": content_type})
+        r = self.connection.getresponse()
+        payload = r.read()
+        if r.status != 200:
+            raise SystemExit(f"POST {path}: {r.status} {payload[:400]!r}")
+        if (r.getheader("Content-Type") or "").startswith("application/json"):
+            return json.loads(payload), dict(r.getheaders())
+        return payload, dict(r.getheaders())
+
+    def close(self):
+        self.connection.close()
+        self.process.terminate()
+        self.process.wait(10)
+
+
+class Checks:
+    """Counts checks; collects failures with their detail; exits 1 if any failed."""
+
+    def __init__(self, name):
+        self.name, self.count, self.failures, self.started = name, 0, [], time.monotonic()
+
+    def __call__(self, ok, what, detail=""):
+        self.count += 1
+        if not ok:
+            self.failures.append(f"{what}: {detail}")
+            print(f"FAIL {what}: {detail}", flush=True)
+        return ok
+
+    def finish(self):
+        took = time.monotonic() - self.started
+        if self.failures:
+            print(f"{self.name}: {len(self.failures)} of {self.count} checks failed ({took:.1f} s)")
+            sys.exit(1)
+        print(f"{self.name}: {self.count} checks passed ({took:.1f} s)")
