@@ -57,6 +57,36 @@ class Server:
         self.process.wait(10)
 
 
+class Glb:
+    """A binary glTF read with the standard library: its JSON (`doc`) and accessors as lists."""
+    COMPONENTS = {5120: "b", 5121: "B", 5122: "h", 5123: "H", 5125: "I", 5126: "f"}
+    SIZES = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+    def __init__(self, data):
+        import struct
+        magic, version, length = struct.unpack_from("<4sII", data, 0)
+        if magic != b"glTF" or version != 2 or length != len(data):
+            raise ValueError("not a glTF 2.0 binary")
+        json_length, _ = struct.unpack_from("<I4s", data, 12)
+        self.doc = json.loads(data[20:20 + json_length])
+        at = 20 + json_length
+        self.bin = b""
+        if at < len(data):
+            bin_length, _ = struct.unpack_from("<I4s", data, at)
+            self.bin = data[at + 8:at + 8 + bin_length]
+
+    def accessor(self, index):
+        """Accessor `index` as a list of tuples (one per element; scalars as 1-tuples)."""
+        import struct
+        a = self.doc["accessors"][index]
+        view = self.doc["bufferViews"][a["bufferView"]]
+        code, n = self.COMPONENTS[a["componentType"]], self.SIZES[a["type"]]
+        size = struct.calcsize(code)
+        stride = view.get("byteStride", size * n)
+        start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+        return [struct.unpack_from(f"<{n}{code}", self.bin, start + k * stride) for k in range(a["count"])]
+
+
 class Checks:
     """Counts checks; collects failures with their detail; exits 1 if any failed."""
 
