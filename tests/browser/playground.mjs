@@ -5,7 +5,7 @@
 // gets tangents; the shareable URL restores the request; "copy as curl" is a command that
 // works; --playground and the bind address turn the page off. A screenshot of each effect is
 // saved (PLAYGROUND_SCREENSHOTS, default $TMPDIR/effectd-playground); docs/playground/ holds
-// the ones the README shows.
+// the ones README.md and docs/playground.md show.
 // Usage: node playground.mjs EFFECTD_BINARY [CHROMIUM]
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
