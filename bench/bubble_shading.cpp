@@ -19,8 +19,8 @@
 #include <glm/vec3.hpp>
 #include <render/render.h>
 
-#include "config.h"
-#include "scene.h"
+#include "contract/config.h"
+#include "api/scene.h"
 
 namespace {
 

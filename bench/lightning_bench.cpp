@@ -232,7 +232,7 @@ void fractal() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // As effectd runs (server/main.cpp): blocks over 256 KB from mmap, so the calloc'd per-voxel
+  // As effectd runs (server/app/main.cpp): blocks over 256 KB from mmap, so the calloc'd per-voxel
   // state of a 3-D grid comes as fresh zero pages instead of being cleared.
   mallopt(M_MMAP_THRESHOLD, 256 * 1024);
   for (int i = 1; i < argc; ++i)

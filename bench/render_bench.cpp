@@ -13,8 +13,8 @@
 
 #include <render/render.h>
 
-#include "config.h"
-#include "scene.h"
+#include "contract/config.h"
+#include "api/scene.h"
 
 namespace {
 

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""The README's performance table, from one run of the benchmarks and their peers.
+"""docs/benchmarks.md's performance table, from one run of the benchmarks and their peers.
 
 Runs bench/{fog,lightning,tangents,bubble}_bench (Google Benchmark, JSON output) and the
 MikkTSpace peer (bench/mikktspace_peer.mjs: npm's WebAssembly build of the reference), then
 prints a Markdown table in which every figure stands beside its baseline or peer measured in
-the same run, with the ratio and the goal. With --write, replaces the README section between
-<!-- bench-table:begin --> and <!-- bench-table:end -->.
+the same run, with the ratio and the goal. With --write, replaces the section of
+docs/benchmarks.md between <!-- bench-table:begin --> and <!-- bench-table:end -->.
 
   scripts/build.sh -DEFFECTD_BENCH=ON && scripts/bench-table.py [--write]   (about 2 minutes)
 
@@ -27,7 +27,7 @@ BUILD = os.environ.get("BUILD_DIR", os.path.join(ROOT, "build"))
 
 
 REPETITIONS = 3  # each figure is the median of 3 repetitions: this machine's timings wander
-# The server's allocator settings (server/idle_trim.cpp): freed blocks up to 32 MB stay in one
+# The server's allocator settings (server/http/idle_trim.cpp): freed blocks up to 32 MB stay in one
 # heap between calls instead of being faulted in again by the next one.
 ALLOCATOR = {"MALLOC_MMAP_THRESHOLD_": str(32 << 20), "MALLOC_TRIM_THRESHOLD_": str(1 << 30), "MALLOC_ARENA_MAX": "1"}
 
@@ -143,15 +143,15 @@ def main():
     table = "\n".join(lines)
     print(table)
     if write:
-        readme = os.path.join(ROOT, "README.md")
-        text = open(readme, encoding="utf-8").read()
+        page = os.path.join(ROOT, "docs", "benchmarks.md")
+        text = open(page, encoding="utf-8").read()
         begin, end = "<!-- bench-table:begin -->", "<!-- bench-table:end -->"
         if begin not in text or end not in text:
-            sys.exit(f"README.md lacks the {begin} … {end} markers")
+            sys.exit(f"docs/benchmarks.md lacks the {begin} … {end} markers")
         head, rest = text.split(begin, 1)
         tail = rest.split(end, 1)[1]
-        open(readme, "w", encoding="utf-8").write(head + begin + "\n" + table + "\n" + end + tail)
-        print("README.md updated", file=sys.stderr)
+        open(page, "w", encoding="utf-8").write(head + begin + "\n" + table + "\n" + end + tail)
+        print("docs/benchmarks.md updated", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,9 @@ endpoint, every examples/*.json scene to /v1/render, a large tangents mesh in ea
 level-6 bubble mesh. JSON answers are compared with their run-time fields removed (elapsedMs,
 computeMs and the like differ from run to run); PNGs by their header and pixels (decoded here,
 every chunk's CRC and the zlib stream checked: two encoders may write the same pixels in
-different bytes); glTF and other answers byte for byte.
+different bytes); glTF and other answers byte for byte. The memory each request was admitted with
+(X-Memory-Reserved: the cost model's estimate and the body's share) must be the same too,
+wherever both binaries admitted the request.
 
   scripts/same-answers.py OLD_EFFECTD NEW_EFFECTD     exit 0 when every answer is the same
 """
@@ -56,7 +58,7 @@ def post(port, path, body, ctype="application/json"):
     c.request("POST", path, body=body, headers={"Content-Type": ctype, "Accept-Encoding": "identity"})
     r = c.getresponse()
     data = r.read()
-    return r.status, r.getheader("Content-Type", ""), data
+    return r.status, r.getheader("Content-Type", ""), data, r.getheader("X-Memory-Reserved")
 
 
 def requests():
@@ -100,7 +102,7 @@ def requests():
 
 def main():
     old, new = start(sys.argv[1]), start(sys.argv[2])
-    differ = 0
+    differ, estimates = 0, 0
     try:
         for name, path, body, ctype in requests():
             a, b = post(old[1], path, body, ctype), post(new[1], path, body, ctype)
@@ -111,12 +113,18 @@ def main():
                 same = png_pixels(a[2]) == png_pixels(b[2])
             elif same:
                 same = a[2] == b[2]
+            estimated = a[3] is not None and b[3] is not None
+            estimates += estimated
+            if estimated and a[3] != b[3]:
+                same = False
+                print(f"estimate {a[3]} -> {b[3]} bytes")
             differ += not same
             print(f"{'same' if same else 'DIFFERENT'}  {a[0]}  {path:14} {name}  ({len(b[2])} bytes)")
     finally:
         for p, _ in (old, new):
             p.terminate()
             p.wait()
+    print(f"{estimates} memory estimates compared")
     print(f"{differ} answer(s) differ" if differ else "every answer is the same")
     sys.exit(1 if differ else 0)
 

@@ -10,7 +10,7 @@ PACKAGES=(
   zlib1g-dev         # PNGs written in strips on several threads (render/png.cpp)
   libgtest-dev libgmock-dev libbenchmark-dev
   glslang-tools spirv-tools  # every shader variant compiled and validated by each language's own tools
-  glslang-dev libspirv-cross-c-shared-dev  # GLSL -> SPIR-V -> HLSL / MSL (server/shader_targets.cpp)
+  glslang-dev libspirv-cross-c-shared-dev  # GLSL -> SPIR-V -> HLSL / MSL (server/api/shader_targets.cpp)
   mesa-vulkan-drivers libvulkan-dev  # lavapipe: the SPIR-V drawn by Vulkan on the CPU (tests/vulkan/)
   gnuplot-nox        # plots of the error-against-run-time report (bench/error_report)
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
@@ -19,7 +19,7 @@ PACKAGES=(
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   blender            # the second tangent oracle: Blender's own MikkTSpace (tests/mikktspace/blender_oracle.py)
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)
-  json-schema-test-suite  # the official JSON-Schema tests run against server/schema.cpp
+  json-schema-test-suite  # the official JSON-Schema tests run against server/contract/schema.cpp
   python3-jsonschema # tests/sweep_test.py checks answers against proto/schemas/*-answer.json
   podman debootstrap # scripts/test-image.sh builds the container image and serves from it
 )

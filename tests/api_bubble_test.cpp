@@ -7,8 +7,8 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "codec.h"
-#include "glb.h"
+#include "contract/codec.h"
+#include "api/glb.h"
 #include "test_server.h"
 
 namespace effectd::testing {

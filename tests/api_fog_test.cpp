@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "codec.h"
+#include "contract/codec.h"
 #include "test_server.h"
 
 namespace effectd::testing {

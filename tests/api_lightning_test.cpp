@@ -5,7 +5,7 @@
 
 #include <effects/common.h>
 
-#include "codec.h"
+#include "contract/codec.h"
 #include "test_server.h"
 
 namespace effectd::testing {

@@ -5,7 +5,7 @@
 #include <set>
 #include <sstream>
 
-#include "glb.h"
+#include "api/glb.h"
 #include "test_server.h"
 
 namespace effectd::testing {

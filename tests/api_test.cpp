@@ -6,7 +6,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "resources.h"
+#include "contract/resources.h"
 #include "test_server.h"
 
 namespace effectd::testing {
@@ -264,15 +264,12 @@ TEST(Api, RequestIdIsEchoedWhenSaneAndGeneratedOtherwise) {
 
 TEST(Api, ExceptionsBecome500WithoutInternals) {
   TestServer s;
-  // An endpoint that throws, registered the way real ones are.
+  // An endpoint whose run step throws, registered the way real ones are.
   Config c = TestServer::quietConfig();
   Service svc(c);
-  svc.addJsonEndpoint(
-      "/v1/fog", "fog.json",
-      [](const json&, const RequestContext&) -> JsonReply {
-        throw std::runtime_error("secret internal detail /etc/passwd");
-      },
-      [](const json&, const Config&) { return Cost{}; });
+  svc.addJsonEndpoint("/v1/fog", "fog.json", [](const json&, const RequestContext&) {
+    return PreparedRequest{Cost{}, []() -> JsonReply { throw std::runtime_error("secret internal detail /etc/passwd"); }};
+  });
   int port = svc.bind();
   std::thread t([&] { svc.run(); });
   svc.waitUntilRunning(std::chrono::seconds(5));

@@ -9,7 +9,7 @@
 #include <malloc.h>
 #include <unistd.h>
 
-#include "codec.h"
+#include "contract/codec.h"
 #include "test_server.h"
 
 namespace effectd::testing {

@@ -559,6 +559,25 @@ TEST(Fog, AtmosphericPerChannel) {
   }
 }
 
+// X3D's visibilityRange 0 turns the fog off: no distance completes it, and the error names that
+// parameter rather than the range no distance reaches; with a range the table is all clear.
+TEST(Fog, OffX3dFogNamesItsVisibilityRange) {
+  for (FogType type : {FogType::kX3dLinear, FogType::kX3dExponential}) {
+    Fog f = make(type);
+    f.visibilityRange = 0;
+    auto t = buildTable(f, TableOptions{});
+    ASSERT_FALSE(t.ok());
+    EXPECT_EQ(t.error().field, "/visibilityRange");
+    EXPECT_EQ(t.error().kind, effects::ErrorKind::kUnsatisfiable);
+    TableOptions o;
+    o.rangeEnd = 10.0;
+    o.size = 4;
+    t = buildTable(f, o);
+    ASSERT_TRUE(t.ok());
+    for (float v : t.value().transmittanceRgb) EXPECT_EQ(v, 1.0f);
+  }
+}
+
 TEST(Fog, Validation) {
   Fog f = make(FogType::kX3dLinear);
   f.visibilityRange = -1;

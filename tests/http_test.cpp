@@ -6,9 +6,9 @@
 #include <chrono>
 #include <vector>
 
-#include "config.h"
-#include "encoding.h"
-#include "json_writer.h"
+#include "contract/config.h"
+#include "http/encoding.h"
+#include "contract/json_writer.h"
 #include "test_server.h"
 
 namespace effectd::testing {

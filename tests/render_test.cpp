@@ -18,7 +18,7 @@
 #include <glm/geometric.hpp>
 
 #include "../render/internal.h"
-#include "codec.h"
+#include "contract/codec.h"
 #include "test_server.h"
 
 namespace effectd::testing {

@@ -1,4 +1,4 @@
-// server/schema.cpp against the official JSON-Schema-Test-Suite (Debian's json-schema-test-suite;
+// server/contract/schema.cpp against the official JSON-Schema-Test-Suite (Debian's json-schema-test-suite;
 // draft 7 is the newest it ships). Every test group whose schema stays within the validator's
 // keyword subset must give the suite's verdict on every instance; groups using a keyword
 // outside the subset are refused at load (as the registry refuses any such contract) and only
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "schema.h"
+#include "contract/schema.h"
 
 namespace effectd {
 namespace {
@@ -16,7 +16,7 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// The keywords server/schema.h accepts, one suite file each, plus $ref and boolean schemas.
+// The keywords server/contract/schema.h accepts, one suite file each, plus $ref and boolean schemas.
 const char* const kFiles[] = {"type",
                               "enum",
                               "const",

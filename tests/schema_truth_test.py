@@ -2,7 +2,9 @@
 """The contract's defaults and ranges are the server's: for every property of every request
 schema (proto/schemas/*.json) that has one,
   - "default": the answer without the property equals the answer with it set to the default
-    (so the handler's and the library's defaults are the schema's);
+    (so the handler's and the library's defaults are the schema's), and so does the memory the
+    server reserves for it (X-Memory-Reserved, the two bodies padded to one length: the cost
+    model reads the same parsed request);
   - "minimum"/"maximum" (and exclusive bounds nudged inside), every "enum" value: a request
     with that value is not refused with 400 naming that field (so validate() is no stricter
     than the schema; 413 and 422 remain possible: server limits, impossible combinations).
@@ -44,21 +46,23 @@ class Server:
     def __init__(self):
         self.p, self.port = start(BIN, "--access-log", "0", "--response-cache-mb", "0")
 
-    def post(self, path, body):
+    def post(self, path, body, length=0):
+        """(status, answer, X-Memory-Reserved); the body padded with spaces to `length` bytes."""
         start = time.monotonic()
         try:
-            return self._post(path, body)
+            return self._post(path, body, length)
         finally:
             if time.monotonic() - start > 2:
                 print(f"slow: {time.monotonic() - start:.1f} s {path} {json.dumps(body)[:300]}", flush=True)
 
-    def _post(self, path, body):
+    def _post(self, path, body, length):
         c = http.client.HTTPConnection("127.0.0.1", self.port, timeout=120)
-        c.request("POST", path, body=json.dumps(body), headers={"Content-Type": "application/json"})
+        text = json.dumps(body)
+        c.request("POST", path, body=text + " " * (length - len(text)), headers={"Content-Type": "application/json"})
         r = c.getresponse()
         data = r.read()
         c.close()
-        return r.status, (json.loads(data) if data[:1] in (b"{", b"[") else data)
+        return r.status, (json.loads(data) if data[:1] in (b"{", b"[") else data), r.getheader("X-Memory-Reserved")
 
 
 def names_field(answer, pointer):
@@ -87,7 +91,7 @@ def main():
             items, _ = resolve(include.get("items", {}), name)
             if "enum" in items:
                 base["include"] = [v for v in items["enum"] if v not in NOT_INCLUDED.get(name, [])]
-            status, _ = server.post(path, base)
+            status, _, _ = server.post(path, base)
             if status != 200:
                 failures.append(f"{example}: {status}")
                 continue
@@ -96,10 +100,13 @@ def main():
                     without = with_value(base, pointer, None, remove=True)
                     given = with_value(base, pointer, prop["default"])
                     if without is not None:
-                        a, b = server.post(path, without), server.post(path, given)
+                        length = max(len(json.dumps(without)), len(json.dumps(given)))
+                        a, b = server.post(path, without, length), server.post(path, given, length)
                         checked["default"] += 1
                         check(name, pointer, "default", a[0] == b[0] and scrub(a[1]) == scrub(b[1]),
                               f"absent -> {a[0]}, default {json.dumps(prop['default'])} -> {b[0]}; answers differ")
+                        check(name, pointer, "default (cost)", a[2] == b[2],
+                              f"absent -> X-Memory-Reserved {a[2]}, default {json.dumps(prop['default'])} -> {b[2]}")
                 values = []
                 if prop.get("type") in ("number", "integer"):
                     lo, hi = prop.get("minimum"), prop.get("maximum")
@@ -114,7 +121,7 @@ def main():
                     if body is None:
                         continue
                     checked[kind] += 1
-                    status, answer = server.post(path, body)
+                    status, answer, _ = server.post(path, body)
                     check(name, pointer, f"{kind} {json.dumps(v)}", not (status == 400 and names_field(answer, pointer)),
                           f"{status} {answer.get('detail') if isinstance(answer, dict) else ''}")
     finally:

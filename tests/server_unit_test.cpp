@@ -6,11 +6,12 @@
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
-#include "bolt_ribbons.h"
-#include "codec.h"
-#include "config.h"
-#include "json_reader.h"
-#include "schema.h"
+#include "api/bolt_ribbons.h"
+#include "contract/codec.h"
+#include "contract/config.h"
+#include "contract/json_reader.h"
+#include "contract/problem.h"
+#include "contract/schema.h"
 
 namespace effectd {
 namespace {
@@ -31,6 +32,22 @@ SchemaRegistry registry() {
       }})"},
        {"b.json",
         R"({"$defs": {"vec": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}})"}});
+}
+
+// An effect's field placed in a request through an endpoint's table: renamed, scaled to the
+// wire's flat arrays, pointed at as a whole, or left under the prefix passed down.
+TEST(Problem, PlacesAnEffectsFieldThroughItsTable) {
+  const FieldTable mesh = {{"positions", {"/mesh/positions", 3}}, {"level", {"/mesh/level"}}};
+  EXPECT_EQ(placeField("/positions/7", "/mesh", mesh), "/mesh/positions/21");
+  EXPECT_EQ(placeField("/positions", "/mesh", mesh), "/mesh/positions");
+  EXPECT_EQ(placeField("/level", "", mesh), "/mesh/level");
+  EXPECT_EQ(placeField("/indices/4", "/mesh", mesh), "/mesh/indices/4");
+  EXPECT_EQ(placeField("", "/fog", mesh), "/fog");
+  EXPECT_EQ(placeField("/range/1", "/fog", {{"range", {"/table/range"}}}), "/table/range/1");
+  const FieldTable whole = {{"uvs", {"/p/attributes/TEXCOORD_1", 0}}, {"", {"/p/indices", 0}}};
+  EXPECT_EQ(placeField("/uvs/3", "/p", whole), "/p/attributes/TEXCOORD_1");
+  EXPECT_EQ(placeField("/weights/3", "/p", whole), "/p/indices");
+  EXPECT_EQ(placeField("", "/p", whole), "/p/indices");
 }
 
 TEST(Schema, AcceptsValidInstances) {

@@ -13,7 +13,7 @@
 
 #include <effects/bubble.h>
 
-#include "shader_targets.h"
+#include "api/shader_targets.h"
 
 namespace effectd::testing {
 namespace {

@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "endpoints.h"
-#include "service.h"
+#include "app/endpoints.h"
+#include "http/service.h"
 
 namespace effectd::testing {
 

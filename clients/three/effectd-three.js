@@ -72,7 +72,7 @@ void main() {
 }`;
 
 // Each vertex's offset from its ribbon's middle: the ribbons' vertices come in pairs (2k, 2k + 1),
-// the two edges at one polyline vertex (server/bolt_ribbons.cpp).
+// the two edges at one polyline vertex (server/api/bolt_ribbons.cpp).
 function acrossAttribute(geometry) {
   const p = geometry.attributes.position, out = new Float32Array(p.count * 3);
   for (let i = 0; i < p.count; ++i)
@@ -80,7 +80,7 @@ function acrossAttribute(geometry) {
   geometry.setAttribute('_across', new THREE.BufferAttribute(out, 3));
 }
 
-// The channel's cross-section over v, as the GLB embeds it (server/bolt_glb.cpp): 1 x 32 texels,
+// The channel's cross-section over v, as the GLB embeds it (server/api/bolt_glb.cpp): 1 x 32 texels,
 // alpha 1 over the middle third, smoothstep to 0 at the edges, 8 bits.
 function profileTexture() {
   const data = new Uint8Array(32 * 4).fill(255);

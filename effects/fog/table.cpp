@@ -266,6 +266,11 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   // The contract's numbers stop at 1e300 (common.json's finite): a default range end beyond it
   // could not be sent back as the request's range.
   constexpr double kLargestDistance = 1e300;
+  const bool x3d = fog.type == FogType::kX3dLinear || fog.type == FogType::kX3dExponential;
+  if (!o.rangeEnd && x3d && fog.visibilityRange <= 0)  // X3D's rule: visibilityRange 0 turns the fog off
+    return unsatisfiable("/visibilityRange", std::string("is 0, which turns X3D fog off (fogType ") + toString(fog.type) +
+                                                 "; LINEAR is the default): give visibilityRange > 0, another "
+                                                 "fogType, or table.range");
   if (!o.rangeEnd && !(std::isfinite(end) && end > start && end <= kLargestDistance))
     return unsatisfiable("/range", "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) within "
                                    "1e300 beyond range[0]; give range explicitly");

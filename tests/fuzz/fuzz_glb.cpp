@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "api_tangents.h"
+#include "api/api_tangents.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static effectd::Config config = [] {

@@ -1,4 +1,4 @@
-// libFuzzer: a JSON request body through the real path — parse (server/json_reader.h, checked
+// libFuzzer: a JSON request body through the real path — parse (server/contract/json_reader.h, checked
 // against nlohmann's parser on every input it accepts), schema
 // validation, the endpoint's handler — for every JSON endpoint. The first byte picks the
 // endpoint. Limits are small so that valid inputs stay fast; ApiError is the expected way out.
@@ -6,13 +6,13 @@
 #include <cstdint>
 #include <string>
 
-#include "api_bubble.h"
-#include "api_fog.h"
-#include "api_lightning.h"
-#include "api_tangents.h"
-#include "json_reader.h"
-#include "scene.h"
-#include "service.h"
+#include "api/api_bubble.h"
+#include "api/api_fog.h"
+#include "api/api_lightning.h"
+#include "api/api_tangents.h"
+#include "contract/json_reader.h"
+#include "api/scene.h"
+#include "http/service.h"
 
 namespace {
 

@@ -23,7 +23,7 @@
 #include <render/render.h>
 #include <spirv_cross/spirv_cross.hpp>
 
-#include "codec.h"
+#include "contract/codec.h"
 #include "test_server.h"
 #include "vulkan_device.h"
 

@@ -13,8 +13,8 @@
 //
 // Methods (how Phi is obtained):
 //   kFast    seed 002 eqns 4-8: Phi_i = a^G / (B * N * P), candidates live `lifetime` steps.
-//            Defaults calibrated to DBM (docs/lightning-calibration.md): a = 1.2 per cell,
-//            candidates never expire; the paper's literal a = 2, lifetime 4 are kPaper*.
+//            Defaults calibrated to DBM (calibrate(), below); the paper's literal a = 2,
+//            lifetime 4 are kPaper*.
 //   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
 //            Phi = 1). Solver kCapacitance (the default): the exact solution by the
 //            capacitance-matrix method, one Cholesky row per step, while the fixed cells are
@@ -59,37 +59,17 @@ enum class Guide { kAuto, kAstar, kNone };
 // Seed 002's literal eqn 8 and lifetime (the `paper` variant): bolts thinner than DBM's.
 inline constexpr double kPaperAxisGrowth = 2.0;
 inline constexpr int kPaperLifetime = 4;
-// The base per cell that meets DBM's statistics (docs/lightning-calibration.md):
-// 1.2 in the 8-neighbourhood below 256^2 (lifetime 0, N of the adjacent cells); in the
-// 4-neighbourhood below 512^2 the fitted base falls with the grid and rises with eta, as
-// ln a = (0.155 + 0.06 min(eta, 3)) (128 / L)^0.35, L = the grid's longer side. In 3-D it falls with
-// the grid too: ln a = 0.25 (32 / L)^0.6 with 26 neighbours, 0.32 (32 / L)^0.55 with 6 (L the
-// longest side). From 256^2 up (8-neighbourhood; 512^2 in the 4-neighbourhood; 2-D) base, radius
-// and lifetime come from a table per grid and eta (sections 12-16): N counted within radius 3
-// (8-neighbourhood: 2 at eta 3 up to 512^2) and candidates that never expire, bases 1.13 at 256^2,
-// 1.085-1.115 at 512^2 and 1.08-1.09 from 1024^2 (8-neighbourhood), 1.095-1.125 at 512^2 and
-// 1.0875-1.125 from 1024^2 (4-neighbourhood; radius 2 at eta 3 from 513^2), rising with eta; at
-// low eta the larger grids need candidates that expire (the 1024^2 entries of open grids:
-// 8-neighbourhood, eta 0.5: base 1.015, lifetime 300, for eta up to 0.75; eta 1: base 1.035, N
-// within radius 7, lifetime 100, for eta 0.75-1.5; 4-neighbourhood, N within radius 7: eta 1:
-// base 1.015, lifetime 75; eta 0.5: base 1.0075, lifetime 300, and at 512^2 already 1.03 with
-// lifetime 200; on grids with obstacles no lifetime, which would make the guide's legs flood a
-// maze) or radius 5 (4-neighbourhood at 512^2: base 1.08 for eta up to 1.5, on open grids from
-// eta 0.75). Most 1024^2 entries reach down to 513^2 from a foot measured
-// there (8-neighbourhood: 1.03 with lifetime 200 at eta 0.5, 1.065 with 100 at eta 1, 1.11 at
-// eta 3; 4-neighbourhood: 1.03 with 200 at eta 0.5, 1.05 with 75 at eta 1, 1.105 with radius 2
-// at eta 2, 1.10 at eta 3), base linear and lifetime geometric in log L between, the radius the
-// foot's up to half-way; elsewhere radius and lifetime are the nearer row's (half-way). Columns
-// that share the radius and whether candidates expire blend, the base linear and the lifetime
-// geometric in eta; elsewhere the nearer column's.
+// The calibration (effects/lightning/calibration.cpp, printed in docs/lightning-calibration.md
+// "Current table"): for each grid and eta, the base per cell, the radius eqn 6's N is counted
+// within and the candidates' lifetime that make the fast method's bolts meet DBM's fractal
+// dimension, cell count and branch tips. Below 256^2 in the 8-neighbourhood (2-D) the base is:
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 struct Params;
 double calibratedAxisGrowth(const Params& p);
 // eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
-// the paper): the table's radius from 256^2 up (512^2 in the 4-neighbourhood) for 2-D fast, else 1.
+// the paper); the calibration's radius for 2-D fast, else 1.
 int calibratedScreeningRadius(const Params& p);
-// Steps a fast candidate lives (0 = forever): the table's lifetime where it holds (geometric in
-// the side from an entry's foot to its row, and in eta between columns), else 0.
+// Steps a fast candidate lives (0 = forever): the calibration's lifetime.
 int calibratedLifetime(const Params& p);
 // Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth and
 // lifetime (the radius follows from screeningRadius 0 when the bolt grows).
@@ -98,10 +78,8 @@ void calibrate(Params& p);
 // one; 1 for every method but 2-D fast.
 int screeningRadius(const Params& p);
 // kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
-// gives DBM's dimension at `eta` (docs/lightning-calibration.md section 6, fitted over
-// 64^2-256^2, eta 0.5-4): 5.2 eta^0.7 (L / 128)^0.2, L = the grid's longer side. Used with
-// the parameter itself at eta, their potential is far less screened than DBM's: D 1.73 at 64^2,
-// eta 2, where DBM gives 1.24.
+// gives DBM's dimension at the grid's eta (the calibration's charges law). Used with the
+// parameter itself at eta, their potential is far less screened than DBM's.
 double calibratedChargesEta(const Params& p);
 
 const char* toString(Method m);

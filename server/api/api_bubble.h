@@ -1,0 +1,46 @@
+// POST /v1/bubble: the soap bubble's uniforms, shaders, mesh and thin-film table
+// (proto/schemas/bubble.json).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <effects/bubble.h>
+
+#include "api/requests.h"
+#include "http/service.h"
+
+namespace effectd {
+
+void addBubbleEndpoints(Service& service);
+// The endpoint's two steps (http/service.h, twoSteps), and both at once (a scene's part).
+BubbleRequest parseBubbleRequest(const nlohmann::json& body, const RequestContext& ctx);
+JsonReply runBubble(const BubbleRequest& request, const nlohmann::json& body, const RequestContext& ctx);
+JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
+// The parts of a bubble body; `pointer` is where that part sits in the request (problems name
+// fields under it): params at "/params", the body itself at "" (or "/bubble" in a scene).
+effects::bubble::Params parseBubbleParams(const nlohmann::json& j, const std::string& pointer);
+// Features from the body's "features" and its "shading" model.
+effects::bubble::Features parseBubbleFeatures(const nlohmann::json& body);
+// The thickness field of the body's "film" (413 over --max-thin-film-texels, naming pointer/film/width).
+effects::bubble::ThicknessOptions parseFilm(const nlohmann::json& body, const Config& config, const std::string& pointer);
+// The body's "lights" (the default sun when absent).
+std::vector<effects::bubble::Light> parseLights(const nlohmann::json& body, const std::string& pointer);
+// The thin-film table's thickness axis, nm: the body's thinFilm.thicknessRange, else [0, 1000],
+// or up to the film's thickest for the film model.
+nlohmann::json thicknessRange(const nlohmann::json& body, const effects::bubble::Features& f,
+                              const effects::bubble::ThicknessOptions& film);
+// Throws 413 over --max-thin-film-texels.
+effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
+                                                 const nlohmann::json& range, const Config& config,
+                                                 const std::string& pointer);
+// Where the icosphere's own parameters (level, radius) sit: under `at`/mesh.
+FieldTable meshFields(const std::string& at);
+// Icosphere subdivisions: the most a request may ask for (327 680 triangles), and the default
+// of a rendered bubble (a /v1/bubble mesh defaults to MeshOptions{}.level).
+inline constexpr int kMaxIcosphereLevel = 7;
+inline constexpr int kRenderedIcosphereLevel = 4;
+
+}  // namespace effectd

@@ -1,0 +1,314 @@
+// POST /v1/lightning — grid + obstacles + start/targets -> bolt tree, polylines, quality.
+#include <optional>
+
+#include <effects/lightning.h>
+#include <render/render.h>
+
+#include "api/api_common.h"
+#include "api/api_lightning.h"
+#include "api/bolt_ribbons.h"
+#include "contract/codec.h"
+#include "api/costs.h"
+
+namespace effectd {
+namespace {
+
+using nlohmann::json;
+namespace lt = effects::lightning;
+
+std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::string& at) {
+  for (const char* threeD : {"boxes", "spheres", "mesh", "glb"})
+    if (o.contains(threeD)) throw fieldError(400, at + "/" + threeD, "is for 3-D grids (grid.depth)");
+  std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
+  bool any = false;
+  if (o.contains("rects")) {
+    for (const auto& r : o["rects"]) {
+      int x0 = r[0], y0 = r[1], rw = r[2], rh = r[3];
+      for (int y = y0; y < std::min(h, y0 + rh); ++y)
+        for (int x = x0; x < std::min(w, x0 + rw); ++x) grid[size_t(y) * w + x] = 1;
+      any = true;
+    }
+  }
+  if (o.contains("rows")) {
+    const json& rows = o["rows"];
+    for (size_t i = 0; i < rows.size(); ++i) {
+      int y = rows[i]["y"];
+      if (y >= h) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/y", "is outside the grid");
+      if (rows[i].contains("z")) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/z", "is for 3-D grids (grid.depth)");
+      for (const auto& run : rows[i]["runs"]) {
+        int x0 = run[0], len = run[1];
+        for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;
+      }
+      any = true;
+    }
+  }
+  if (o.contains("bitmap")) {
+    auto bytes = base64Decode(o["bitmap"].get<std::string>());
+    if (!bytes) throw fieldError(400, at + "/bitmap", "is not valid base64 (standard alphabet, padded)");
+    size_t need = (grid.size() + 7) / 8;
+    if (bytes->size() != need)
+      throw fieldError(400, at + "/bitmap",
+                       "must decode to " + std::to_string(need) + " bytes (width*height bits), got " +
+                           std::to_string(bytes->size()));
+    for (size_t i = 0; i < grid.size(); ++i)
+      if ((uint8_t((*bytes)[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
+    any = true;
+  }
+  if (!any) grid.clear();
+  return grid;
+}
+
+// A cell of the request: [x, y] on a 2-D grid, [x, y, z] on a 3-D one.
+lt::Cell cellOf(const json& j, int depth, const std::string& at) {
+  if (j.size() != (depth ? 3u : 2u))
+    throw fieldError(400, at, depth ? "must be [x, y, z] on a 3-D grid" : "must be [x, y] on a 2-D grid (no grid.depth)");
+  return {j[0].get<int>(), j[1].get<int>(), depth ? j[2].get<int>() : 0};
+}
+
+// "polylines": per line its channel, width, flat [x, y, ...] points (3-D: [x, y, z, ...], in
+// world units with "world"), and per point the step and intensity.
+json polylinesJson(const std::vector<lt::Polyline>& polylines, int depth, const World& world) {
+  json lines = json::array();
+  for (const auto& l : polylines) {
+    json xy = json::array(), step = json::array(), intensity = json::array();
+    for (const auto& v : l.vertices) {
+      if (depth) {
+        const auto p = world.toWorld(v.x, v.y, v.z);
+        for (double c : p) xy.push_back(wire(c));
+      } else {
+        xy.push_back(v.x);
+        xy.push_back(v.y);
+      }
+      step.push_back(v.step);
+      intensity.push_back(v.intensity);
+    }
+    lines.push_back({{"channel", l.main ? "main" : "branch"},
+                     {"width", world.given ? wire(l.width * world.cellSize) : double(l.width)},
+                     {"points", std::move(xy)},
+                     {"step", std::move(step)},
+                     {"intensity", std::move(intensity)}});
+  }
+  return lines;
+}
+
+// "cells": the bolt's cells in growth order, flat [x, y, ...].
+json cellsJson(const lt::Bolt& bolt) {
+  json c = json::array();
+  for (const auto& n : bolt.nodes) {
+    c.push_back(n.cell.x);
+    c.push_back(n.cell.y);
+    if (bolt.depth) c.push_back(n.cell.z);
+  }
+  return c;
+}
+
+// "tree": each node's parent and step, and the main channel's nodes.
+json treeJson(const lt::Bolt& bolt) {
+  json parent = json::array(), step = json::array();
+  for (const auto& n : bolt.nodes) {
+    parent.push_back(n.parent);
+    step.push_back(n.step);
+  }
+  return {{"parent", std::move(parent)}, {"step", std::move(step)}, {"mainChannel", bolt.mainChannel}};
+}
+
+// "guide": the A* waypoints, [[x, y], ...].
+json guideJson(const lt::Bolt& bolt) {
+  json g = json::array();
+  for (const auto& c : bolt.guide) g.push_back(bolt.depth ? json::array({c.x, c.y, c.z}) : json::array({c.x, c.y}));
+  return g;
+}
+
+// The strike without its per-vertex times: connect, duration, strokes and the channels' keyframes.
+json strikeJson(const lt::Timeline& tl) {
+  json strokes = json::array();
+  for (const auto& s : tl.strokes) strokes.push_back({{"t", s.t}, {"peak", s.peak}});
+  json t = json::array(), leader = json::array(), main = json::array(), branches = json::array();
+  for (const auto& k : tl.keyframes) {
+    t.push_back(k.t);
+    leader.push_back(k.leader);
+    main.push_back(k.main);
+    branches.push_back(k.branches);
+  }
+  return {{"connect", tl.connect},
+          {"duration", tl.duration},
+          {"strokes", std::move(strokes)},
+          {"keyframes", {{"t", std::move(t)}, {"leader", std::move(leader)}, {"main", std::move(main)}, {"branches", std::move(branches)}}}};
+}
+
+// "timeline": the strike and, per polyline, when each vertex lights.
+json timelineJson(const lt::Timeline& tl) {
+  json lines = json::array();
+  for (size_t i = 0; i < tl.leader.size(); ++i) lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
+  json out = strikeJson(tl);
+  out["polylines"] = std::move(lines);
+  return out;
+}
+
+// The strike's physics: top-level animationSeed (default: seed) and timeScale, "timeline".
+lt::TimelineParams parseTimeline(const json& body, uint64_t seed, const std::string& at) {
+  lt::TimelineParams t;
+  t.seed = body.value("animationSeed", seed);
+  t.timeScale = body.value("timeScale", t.timeScale);
+  const json o = body.value("timeline", json::object());
+  t.cellSize = o.value("cellSize", t.cellSize);
+  t.leaderStep = o.value("leaderStep", t.leaderStep);
+  if (o.contains("leaderPause")) t.pauseMinUs = o["leaderPause"][0], t.pauseMaxUs = o["leaderPause"][1];
+  t.returnStrokeSpeed = o.value("returnStrokeSpeed", t.returnStrokeSpeed);
+  t.strokes = o.value("strokes", t.strokes);
+  if (o.contains("strokeInterval")) t.intervalMinMs = o["strokeInterval"][0], t.intervalMaxMs = o["strokeInterval"][1];
+  t.flashMs = o.value("flashDecay", t.flashMs);
+  t.glowMs = o.value("glowDecay", t.glowMs);
+  t.leaderBrightness = o.value("leaderBrightness", t.leaderBrightness);
+  t.flicker = o.value("flicker", t.flicker);
+  if (auto e = lt::validate(t)) throwError(*e, at);
+  return t;
+}
+
+}  // namespace
+
+LightningRequest parseLightning(const json& body, const Config& config, const std::string& at) {
+  LightningRequest r;
+  lt::Params& p = r.params;
+  p.width = body["grid"]["width"];
+  p.height = body["grid"]["height"];
+  p.depth = body["grid"].value("depth", 0);
+  const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
+  if (cells > config.limits.maxGridCells)
+    throw fieldError(413, at + "/grid",
+                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
+                         std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
+  const std::string method = body.value("method", "fast");
+  p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+  const size_t solverLimit = p.depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells;
+  if (p.method != lt::Method::kFast && cells > solverLimit)
+    throw fieldError(413, at + "/grid",
+                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " + std::to_string(solverLimit) +
+                         " for method " + method +
+                         (p.depth ? " (--max-solver-volume-cells)" : " (--max-solver-grid-cells)") +
+                         "; the fast method takes up to " + std::to_string(config.limits.maxGridCells));
+  if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
+  r.world = parseWorld(body);
+  p.start = cellOf(body["start"], p.depth, at + "/start");
+  p.targets.clear();
+  for (size_t i = 0; i < body["targets"].size(); ++i)
+    p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
+  p.eta = body.value("eta", p.eta);
+  p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
+  const std::string solver = body.value("solver", "capacitance");  // the schema's enum
+  p.solver = solver == "cg" ? lt::Solver::kCg : solver == "mgpcg" ? lt::Solver::kMgpcg : lt::Solver::kCapacitance;
+  p.tolerance = body.value("tolerance", p.tolerance);
+  const std::string guide = body.value("guide", "auto");
+  p.guide = guide == "astar" ? lt::Guide::kAstar : guide == "none" ? lt::Guide::kNone : lt::Guide::kAuto;
+  p.seed = body.value("seed", uint64_t(1));
+  p.maxSteps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
+  lt::ShapeParams& shape = r.shape;
+  const json s = body.value("shape", json::object());
+  shape.jitter = s.value("jitter", shape.jitter);
+  shape.jitterSeed = s.value("jitterSeed", p.seed);
+  shape.branchWidth = s.value("branchWidth", shape.branchWidth);
+  shape.branchIntensity = s.value("branchIntensity", shape.branchIntensity);
+  shape.branchFalloff = s.value("branchFalloff", shape.branchFalloff);
+  r.timeline = parseTimeline(body, p.seed, at);
+  r.include = Includes(body, kLightningIncludes);
+  r.glb = body.value("format", "json") == "glb";
+  r.variant = body.value("variant", r.variant);
+  return r;
+}
+
+lt::Params boltParams(const LightningRequest& r, const json& body, const Config& config, const std::string& at) {
+  lt::Params p = r.params;
+  if (body.contains("obstacles"))  // a mesh is voxelised here
+    p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
+                                                 at + "/obstacles")
+                          : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
+  lt::calibrate(p);  // from one look at the obstacles
+  if (r.variant == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
+    p.lifetime = lt::kPaperLifetime;
+    p.axisGrowth = lt::kPaperAxisGrowth;
+    p.chargesEta = p.eta;
+    p.screeningRadius = 1;  // eqn 6's N: the adjacent cells
+  }
+  p.lifetime = body.value("lifetime", p.lifetime);
+  p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
+  return p;
+}
+
+lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
+  auto grown = lt::grow(p);
+  if (!grown.ok()) {
+    effects::Error e = grown.error();
+    if (e.field == "/maxSteps") e.message += " (--max-growth-steps / maxSteps)";
+    throwError(e, at);
+  }
+  return std::move(grown.value());
+}
+
+LightningRequest parseLightningRequest(const json& body, const RequestContext& ctx) {
+  return parseLightning(body, ctx.config, ctx.at);
+}
+
+JsonReply runLightning(const LightningRequest& request, const json& body, const RequestContext& ctx) {
+  const Includes& include = request.include;
+  const bool glbFormat = request.glb;  // include: only timeline applies
+  lt::Params p = boltParams(request, body, ctx.config, ctx.at);
+  p.measureError = include.has("error") && !glbFormat;
+  const lt::Bolt bolt = growBolt(p, ctx.at);
+  JsonReply reply;
+  reply.method = bolt.stats.method;
+  reply.computeMs = bolt.stats.elapsedMs;
+  json out = {{"method", bolt.stats.method},
+              {"grid", p.depth ? json::array({p.width, p.height, p.depth}) : json::array({p.width, p.height})}};
+  if (request.world.given)
+    out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};
+  if (p.method != lt::Method::kDbm) out["variant"] = request.variant;
+  out["mainChannelLength"] = bolt.mainChannel.size();
+  out["cellCount"] = bolt.nodes.size();
+  out["steps"] = bolt.nodes.back().step;
+
+  if (include.has("polylines") || include.has("timeline") || include.has("mesh") || glbFormat) {
+    const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
+    std::optional<lt::Timeline> timeline;
+    if (include.has("timeline")) timeline = lt::timeline(bolt, lines, request.timeline);
+    if (glbFormat) {  // the ribbons as one file instead of JSON; the timeline's times per vertex
+      const json strike = timeline ? strikeJson(*timeline) : json(nullptr);
+      const auto ribbons = boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr);
+      const glm::dvec3 color = effects::render::Lightning{}.color;  // the preview's
+      reply.binary = boltGlb(ribbons, {color.x, color.y, color.z}, strike);
+      reply.contentType = "model/gltf-binary";
+      return reply;
+    }
+    if (include.has("polylines")) out["polylines"] = polylinesJson(lines, p.depth, request.world);
+    if (include.has("mesh"))
+      out["mesh"] = ribbonsJson(boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr));
+    if (timeline) out["timeline"] = timelineJson(*timeline);
+  }
+  if (include.has("cells")) out["cells"] = cellsJson(bolt);
+  if (include.has("tree")) out["tree"] = treeJson(bolt);
+  if (include.has("guide")) out["guide"] = guideJson(bolt);
+  if (include.has("fractalDimension")) {
+    std::vector<lt::Cell> cellsOnly;
+    for (const auto& n : bolt.nodes) cellsOnly.push_back(n.cell);
+    out["fractalDimension"] = p.depth ? lt::fractalDimension(cellsOnly, p.width, p.height, p.depth)
+                                      : lt::fractalDimension(cellsOnly, p.width, p.height);
+  }
+  if (include.has("error")) {
+    out["error"] = {{"meanTotalVariation", bolt.stats.error.value_or(0.0)},
+                    {"metric", bolt.stats.errorMetric},
+                    {"reference", bolt.stats.reference}};
+  }
+  if (include.has("stats")) out["stats"] = statsJson(bolt.stats);
+  reply.body = std::move(out);
+  return reply;
+}
+
+JsonReply handleLightning(const json& body, const RequestContext& ctx) {
+  return runLightning(parseLightningRequest(body, ctx), body, ctx);
+}
+
+void addLightningEndpoints(Service& service) {
+  service.addJsonEndpoint("/v1/lightning", "lightning.json",
+                          twoSteps(parseLightningRequest, lightningCost, runLightning));
+}
+
+}  // namespace effectd

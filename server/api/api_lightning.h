@@ -1,0 +1,30 @@
+// POST /v1/lightning: bolts grown on a grid around obstacles (proto/schemas/lightning.json).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <effects/lightning.h>
+
+#include "api/lightning_volume.h"
+#include "api/requests.h"
+#include "http/service.h"
+
+namespace effectd {
+
+void addLightningEndpoints(Service& service);
+// The endpoint's two steps (http/service.h, twoSteps), and both at once (a scene's part).
+LightningRequest parseLightningRequest(const nlohmann::json& body, const RequestContext& ctx);
+JsonReply runLightning(const LightningRequest& request, const nlohmann::json& body, const RequestContext& ctx);
+JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx);
+// The request at JSON pointer `at` ("" for the endpoint's body); problems name fields under it.
+LightningRequest parseLightning(const nlohmann::json& body, const Config& config, const std::string& at);
+// The bolt's parameters, completed by the heavy step: the obstacles (a mesh voxelised), the
+// calibration for them, and the variant's and the body's overrides.
+effects::lightning::Params boltParams(const LightningRequest& request, const nlohmann::json& body,
+                                      const Config& config, const std::string& at);
+effects::lightning::Bolt growBolt(const effects::lightning::Params& params, const std::string& at);  // throws ApiError
+
+}  // namespace effectd

@@ -1,0 +1,166 @@
+// POST /v1/render (scene -> image/png) and POST /v1/scene (scene -> each effect's JSON).
+#include <memory>
+
+#include "api/api_bubble.h"
+#include "api/api_common.h"
+#include "api/api_fog.h"
+#include "api/api_lightning.h"
+#include "api/api_render.h"
+#include "api/costs.h"
+#include "api/movie.h"
+#include "api/scene.h"
+
+namespace effectd {
+
+using nlohmann::json;
+namespace rd = effects::render;
+
+namespace {
+
+// A scene's part at `at`: the context its endpoint's problems are named in.
+RequestContext partContext(const RequestContext& ctx, const std::string& at) {
+  RequestContext c = ctx;
+  c.at = at;
+  return c;
+}
+
+// The scene's bubbles, "bubble" then each of "bubbles": (their bodies, their pointers).
+std::vector<std::pair<const json*, std::string>> sceneBubbles(const json& body) {
+  std::vector<std::pair<const json*, std::string>> out;
+  if (body.contains("bubble")) out.emplace_back(&body["bubble"], "/bubble");
+  if (body.contains("bubbles"))
+    for (size_t i = 0; i < body["bubbles"].size(); ++i)
+      out.emplace_back(&body["bubbles"][i]["bubble"], "/bubbles/" + std::to_string(i) + "/bubble");
+  return out;
+}
+
+// Each part read by its endpoint's parser at its pointer; a bubble's lights are the scene's
+// when it has them, as the render lights it.
+SceneRequest parseSceneRequest(const json& body, const RequestContext& ctx) {
+  SceneRequest r;
+  if (body.contains("lightning")) r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
+  if (body.contains("fog")) r.fog = parseFogRequest(body["fog"], partContext(ctx, "/fog"));
+  for (const auto& [bubble, at] : sceneBubbles(body)) {
+    json lit = *bubble;
+    if (body.contains("lights")) lit["lights"] = body["lights"];
+    r.bubbles.push_back(parseBubbleRequest(lit, partContext(ctx, at)));
+  }
+  return r;
+}
+
+JsonReply runScene(const SceneRequest& request, const json& body, const RequestContext& ctx) {
+  JsonReply reply;
+  reply.method = "scene";
+  json out = json::object();
+  // One part's answer; its problems name fields under `at`.
+  auto answer = [&](JsonReply r, const std::string& at, const char* endpoint) {
+    if (!r.binary.empty())  // e.g. bubble "format": "glb"
+      throw fieldError(422, at + "/format",
+                       "a scene answers JSON: ask /v1/" + std::string(endpoint) + " itself for this binary format");
+    reply.computeMs += r.computeMs;
+    return std::move(r.body);
+  };
+  if (request.lightning)
+    out["lightning"] = answer(runLightning(*request.lightning, body["lightning"], partContext(ctx, "/lightning")),
+                              "/lightning", "lightning");
+  if (request.fog) out["fog"] = answer(runFog(*request.fog, body["fog"], partContext(ctx, "/fog")), "/fog", "fog");
+  if (body.contains("bubbles")) out["bubbles"] = json::array();
+  const auto bubbles = sceneBubbles(body);
+  for (size_t i = 0; i < bubbles.size(); ++i) {
+    const auto& [bubble, at] = bubbles[i];
+    json part = answer(runBubble(request.bubbles[i], *bubble, partContext(ctx, at)), at, "bubble");
+    if (at == "/bubble")
+      out["bubble"] = std::move(part);
+    else
+      out["bubbles"].push_back(std::move(part));
+  }
+  reply.body = std::move(out);
+  return reply;
+}
+
+RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
+  RenderRequest r;
+  r.scene = parseSceneRequest(body, ctx);
+  r.reference = body.value("reference", r.reference);
+  const rd::Scene defaults;
+  r.width = body.value("width", defaults.width);
+  r.height = body.value("height", defaults.height);
+  if (body.contains("frames")) r.frames = body["frames"]["count"].get<int>();
+  r.backgroundImage = body.contains("background") && body["background"].contains("image");
+  return r;
+}
+
+// `reference: true`: the bubble ray traced on the CPU (render::referenceRender), a still of
+// at most kMaxReferencePixels.
+JsonReply referenceReply(const RenderRequest& request, const json& body, const RequestContext& ctx) {
+  if (request.frames) throw fieldError(422, "/frames", "the reference is a still: leave frames out");
+  const size_t pixels = size_t(request.width) * size_t(request.height);
+  if (pixels > kMaxReferencePixels)
+    throw fieldError(413, "/width",
+                     "the reference traces " + std::to_string(rd::kReferenceWavelengths) +
+                         " wavelengths per pixel: at most " + std::to_string(kMaxReferencePixels) + " pixels");
+  JsonReply reply;
+  reply.method = "reference";
+  rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+  auto r = rd::referenceRender(scene, ctx.parallel);
+  // Its one bubble may be the first of "bubbles".
+  if (!r.ok()) throwError(r.error(), "", {{"bubble", {body.contains("bubble") ? "/bubble" : "/bubbles/0/bubble"}}});
+  auto png = rd::encodePng(r.value().image, scene.bitDepth, ctx.parallel);
+  if (!png.ok()) throwError(png.error());
+  reply.binary = std::move(png.value());
+  reply.contentType = "image/png";
+  reply.computeMs += r.value().ms;
+  reply.headers = {{"X-Renderer", "reference: CPU ray tracing, " + std::to_string(rd::kReferenceWavelengths) +
+                                      " wavelengths"}};
+  return reply;
+}
+
+}  // namespace
+
+void addRenderEndpoints(Service& service) {
+  const Config& config = service.config();
+  auto pool =
+      std::make_shared<rd::RenderPool>(rd::PoolOptions{config.renderThreads, config.renderQueue, config.eglPlatform});
+  service.addReadinessCheck("renderer", [pool] { return pool->start(); });
+  service.addReadinessInfo("renderer", [pool] { return pool->description(); });
+  service.addJsonEndpoint("/v1/scene", "scene.json", twoSteps(parseSceneRequest, sceneCost, runScene));
+  Metrics* metrics = &service.metrics();
+  auto run = [pool, metrics](const RenderRequest& request, const json& body, const RequestContext& ctx) {
+    if (request.reference) return referenceReply(request, body, ctx);
+    JsonReply reply;
+    reply.method = "render";
+    Animation animation;
+    rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
+    auto drawn = renderScene(std::move(scene), animation, ctx.parallel, [&pool](rd::Scene s, const rd::Sequence* sequence) {
+      auto job = sequence ? pool->submit(std::move(s), *sequence) : pool->submit(std::move(s));
+      if (!job)
+        throw ApiError{503,
+                       "render-queue-full",
+                       "Render queue full",
+                       "every render thread is busy and the queue is full; retry shortly (--render-queue)",
+                       {},
+                       {{"Retry-After", "1"}}};
+      return job->get();
+    });
+    if (!drawn.ok()) throwError(drawn.error());
+    const rd::Frame& f = drawn.value().frame;
+    reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
+    reply.binary = std::move(drawn.value().output.bytes);
+    reply.contentType = drawn.value().output.contentType;
+    for (auto& [name, value] : drawn.value().output.headers) reply.headers[name] = std::move(value);
+    for (const auto& p : f.passes) metrics->count("render_passes", p);
+    metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
+    const double encodeMs = drawn.value().encodeMs;
+    reply.stages = {{"scene", reply.computeMs}, {"queue", f.queueMs}, {"draw", f.drawMs},
+                    {"read", f.readMs},         {"encode", encodeMs}};
+    reply.computeMs += f.ms + encodeMs;
+    reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
+                        {"X-Render-Ms", std::to_string(f.ms)}};
+    return reply;
+  };
+  service.addJsonEndpoint("/v1/render", "scene.json", twoSteps(parseRenderRequest, renderCost, run));
+  // The same scene renders alike on the same renderer: it is part of the render's ETag.
+  service.setEtagSalt("/v1/render", [pool] { return pool->start().empty() ? pool->description() : std::string(); });
+}
+
+}  // namespace effectd

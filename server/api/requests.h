@@ -1,0 +1,92 @@
+// The endpoints' typed requests: a body read and checked into one of these is the first of an
+// endpoint's two steps (http/service.h, twoSteps). Its cost (costs.h) is estimated from it, and
+// the run step answers from it; the body itself is kept only for what shapes the answer.
+// Each field's default is applied where the body is read (the endpoint's parse function).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include <effects/bubble.h>
+#include <effects/fog.h>
+#include <effects/lightning.h>
+#include <effects/tangents.h>
+
+#include "api/lightning_volume.h"
+
+namespace effectd {
+
+// The body's "include" list as a set test; `defaults` applies when "include" is absent.
+class Includes {
+ public:
+  Includes(const nlohmann::json& body, std::vector<std::string> defaults);
+  bool has(const std::string& what) const;
+
+ private:
+  std::vector<std::string> items_;
+};
+
+// What each endpoint answers when the body has no "include" list.
+inline const std::vector<std::string> kFogIncludes = {"table"};
+inline const std::vector<std::string> kLightningIncludes = {"polylines"};
+inline const std::vector<std::string> kTangentsIncludes = {"tangents", "remap", "indices"};
+inline const std::vector<std::string> kBubbleIncludes = {"uniforms", "shader"};
+
+struct FogRequest {
+  Includes include{nlohmann::json::object(), kFogIncludes};
+  effects::fog::Fog fog;
+  std::vector<effects::fog::Region> regions;
+  effects::fog::TableOptions table;  // maxSize: the configured limit
+  size_t objectColors = 0;           // how many colours the table is also given for
+  size_t samplePoints = 0;
+};
+
+struct LightningRequest {
+  Includes include{nlohmann::json::object(), kLightningIncludes};
+  bool glb = false;                             // "format": "glb"
+  std::string variant = "calibrated";           // or "paper"
+  effects::lightning::Params params;            // obstacles, calibration: added by the run step
+  effects::lightning::ShapeParams shape;
+  effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
+  World world;                                  // 3-D: where the grid lies ("world")
+};
+
+struct TangentsRequest {
+  Includes include{nlohmann::json::object(), kTangentsIncludes};
+  effects::tangents::Mesh mesh;
+  effects::tangents::Mode mode = effects::tangents::Mode::kMikkTSpace;
+};
+
+struct BubbleRequest {
+  Includes include{nlohmann::json::object(), kBubbleIncludes};
+  bool glb = false;  // "format": "glb"
+  effects::bubble::Params params;
+  effects::bubble::Features features;
+  effects::bubble::ThicknessOptions film;
+  std::vector<effects::bubble::Light> lights;
+  effects::bubble::MeshOptions mesh;  // level, radius, camera; the rest is set when it is built
+  double time = 0;
+  nlohmann::json thicknessRange;  // the thin-film table's axis, nm
+  effects::bubble::ThinFilmOptions thinFilm;
+};
+
+// /v1/scene: the parts a scene has, each read by its endpoint's parser at its pointer.
+struct SceneRequest {
+  std::optional<LightningRequest> lightning;
+  std::optional<FogRequest> fog;
+  std::vector<BubbleRequest> bubbles;  // "bubble", then each of "bubbles"
+};
+
+// /v1/render: the scene's parts, and the frame.
+struct RenderRequest {
+  SceneRequest scene;
+  bool reference = false;  // CPU ray tracing instead of the GPU
+  int width = 0, height = 0;  // render::Scene's defaults unless given
+  std::optional<int> frames;  // "frames.count"; none: a still
+  bool backgroundImage = false;
+};
+
+}  // namespace effectd

@@ -1,0 +1,227 @@
+#include "contract/config.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+namespace effectd {
+namespace {
+
+struct Option {
+  const char* flag;  // without the leading "--"
+  const char* env;
+  const char* help;
+  std::function<bool(const std::string&, Config&)> set;
+};
+
+bool parseInt(const std::string& s, long long lo, long long hi, long long& out) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  long long v = std::strtoll(s.c_str(), &end, 10);
+  if (errno || *end != '\0' || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+template <class T>
+std::function<bool(const std::string&, Config&)> intField(T Config::*field, long long lo, long long hi) {
+  return [=](const std::string& s, Config& c) {
+    long long v;
+    if (!parseInt(s, lo, hi, v)) return false;
+    c.*field = static_cast<T>(v);
+    return true;
+  };
+}
+
+std::function<bool(const std::string&, Config&)> limitField(size_t Limits::*field, long long lo, long long hi) {
+  return [=](const std::string& s, Config& c) {
+    long long v;
+    if (!parseInt(s, lo, hi, v)) return false;
+    c.limits.*field = static_cast<size_t>(v);
+    return true;
+  };
+}
+
+// --cors-origins: a comma list of origins (scheme://host[:port]) or "*"; spaces around an
+// entry and trailing slashes are dropped.
+bool setCorsOrigins(const std::string& s, Config& c) {
+  c.corsOrigins.clear();
+  size_t pos = 0;
+  while (pos <= s.size()) {
+    size_t end = std::min(s.find(',', pos), s.size());
+    std::string o = s.substr(pos, end - pos);
+    while (!o.empty() && o.front() == ' ') o.erase(0, 1);
+    while (!o.empty() && (o.back() == ' ' || o.back() == '/')) o.pop_back();
+    if (!o.empty()) {
+      if (o != "*" && o.find("://") == std::string::npos) return false;
+      c.corsOrigins.push_back(o);
+    }
+    pos = end + 1;
+  }
+  return true;
+}
+
+// Long because it is the flag table, one entry per flag in --help order: it reads best whole.
+const std::vector<Option>& options() {
+  static const std::vector<Option> opts = {
+      {"host", "EFFECTD_HOST", "address to listen on (default 127.0.0.1)",
+       [](const std::string& s, Config& c) {
+         c.host = s;
+         return !s.empty();
+       }},
+      {"port", "EFFECTD_PORT", "TCP port, 0 = any free port (default 8080)", intField(&Config::port, 0, 65535)},
+      {"threads", "EFFECTD_THREADS", "HTTP worker threads kept ready (default 8)", intField(&Config::threads, 1, 1024)},
+      {"max-connections", "EFFECTD_MAX_CONNECTIONS",
+       "connections served at once, one thread each, growing from --threads (default 512); slow clients cannot starve "
+       "the rest below it",
+       intField(&Config::maxConnections, 1, 65536)},
+      {"read-timeout", "EFFECTD_READ_TIMEOUT", "seconds to receive a request (default 10)",
+       intField(&Config::readTimeoutS, 1, 3600)},
+      {"write-timeout", "EFFECTD_WRITE_TIMEOUT", "seconds to send a response (default 10)",
+       intField(&Config::writeTimeoutS, 1, 3600)},
+      {"keep-alive-timeout", "EFFECTD_KEEP_ALIVE_TIMEOUT",
+       "idle seconds before a keep-alive connection closes (default 5)", intField(&Config::keepAliveTimeoutS, 0, 3600)},
+      {"keep-alive-max", "EFFECTD_KEEP_ALIVE_MAX", "requests per connection (default 100)",
+       intField(&Config::keepAliveMaxCount, 1, 1000000)},
+      {"access-log", "EFFECTD_ACCESS_LOG", "1/0: one JSON line per request on stderr (default 1)",
+       [](const std::string& s, Config& c) {
+         if (s != "0" && s != "1" && s != "true" && s != "false") return false;
+         c.accessLog = s == "1" || s == "true";
+         return true;
+       }},
+      {"max-body-bytes", "EFFECTD_MAX_BODY_BYTES", "largest request body (default 16777216)",
+       limitField(&Limits::maxBodyBytes, 1024, 1LL << 32)},
+      {"max-grid-cells", "EFFECTD_MAX_GRID_CELLS", "largest lightning grid, width*height (default 16777216)",
+       limitField(&Limits::maxGridCells, 9, 1LL << 28)},
+      {"max-growth-steps", "EFFECTD_MAX_GROWTH_STEPS", "lightning cells added per request (default 2000000)",
+       limitField(&Limits::maxGrowthSteps, 1, 1LL << 30)},
+      {"max-solver-grid-cells", "EFFECTD_MAX_SOLVER_GRID_CELLS",
+       "largest grid for the dbm and charges methods, whose every step costs O(cells) (default 65536)",
+       limitField(&Limits::maxSolverGridCells, 9, 1LL << 28)},
+      {"max-solver-volume-cells", "EFFECTD_MAX_SOLVER_VOLUME_CELLS",
+       "largest 3-D grid (width*height*depth) for method dbm (default 262144 = 64^3)",
+       limitField(&Limits::maxSolverVolumeCells, 27, 1LL << 28)},
+      {"max-table-size", "EFFECTD_MAX_TABLE_SIZE", "fog table entries (default 65536)",
+       limitField(&Limits::maxTableSize, 2, 1LL << 24)},
+      {"max-mesh-vertices", "EFFECTD_MAX_MESH_VERTICES", "vertices per mesh (default 2000000)",
+       limitField(&Limits::maxMeshVertices, 3, 1LL << 28)},
+      {"max-mesh-triangles", "EFFECTD_MAX_MESH_TRIANGLES", "triangles per mesh (default 4000000)",
+       limitField(&Limits::maxMeshTriangles, 1, 1LL << 28)},
+      {"max-render-pixels", "EFFECTD_MAX_RENDER_PIXELS",
+       "render width*height and decoded image pixels (default 16777216)",
+       limitField(&Limits::maxRenderPixels, 1, 1LL << 28)},
+      {"max-thin-film-texels", "EFFECTD_MAX_THIN_FILM_TEXELS", "bubble thin-film table width*height (default 1048576)",
+       limitField(&Limits::maxThinFilmTexels, 4, 1LL << 26)},
+      {"render-threads", "EFFECTD_RENDER_THREADS", "render threads, one EGL context each (default 2)",
+       intField(&Config::renderThreads, 1, 64)},
+      {"render-queue", "EFFECTD_RENDER_QUEUE", "renders waiting beyond the running ones before 503 (default 8)",
+       intField(&Config::renderQueue, 0, 10000)},
+      {"egl-platform", "EFFECTD_EGL_PLATFORM", "auto (device, then surfaceless), device or surfaceless (default auto)",
+       [](const std::string& s, Config& c) {
+         c.eglPlatform = s;
+         return s == "auto" || s == "device" || s == "surfaceless";
+       }},
+      {"memory-budget-mb", "EFFECTD_MEMORY_BUDGET_MB",
+       "memory all requests together may reserve at their estimated peaks; beyond it they wait, then 503 "
+       "(default 0 = 60 % of the cgroup memory limit, or of physical memory without one)",
+       intField(&Config::memoryBudgetMb, 0, 1LL << 22)},
+      {"heavy-threads", "EFFECTD_HEAVY_THREADS",
+       "heavy computations (Laplace solvers, huge grids and meshes) at once, so cheap requests keep a core "
+       "(default 0 = cores - 1, at least 1)",
+       intField(&Config::heavyThreads, 0, 1024)},
+      {"admission-queue", "EFFECTD_ADMISSION_QUEUE",
+       "requests waiting for memory or a heavy slot before 503 (default 64)",
+       intField(&Config::admissionQueue, 0, 100000)},
+      {"admission-timeout-ms", "EFFECTD_ADMISSION_TIMEOUT_MS",
+       "longest wait for memory or a heavy slot before 503 (default 10000)",
+       intField(&Config::admissionTimeoutMs, 0, 3600000)},
+      {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB",
+       "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
+       intField(&Config::responseCacheMb, 0, 1LL << 20)},
+      {"cors-origins", "EFFECTD_CORS_ORIGINS",
+       "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
+       "none)",
+       setCorsOrigins},
+      {"playground", "EFFECTD_PLAYGROUND",
+       "auto|on|off: the browser playground at / (default auto: on when listening on loopback only)",
+       [](const std::string& s, Config& c) {
+         if (s == "1" || s == "true") c.playground = "on";
+         else if (s == "0" || s == "false") c.playground = "off";
+         else if (s == "auto" || s == "on" || s == "off") c.playground = s;
+         else return false;
+         return true;
+       }},
+      {"playground-three", "EFFECTD_PLAYGROUND_THREE",
+       "URL of three.js's ES module (three.module.js, r187) that the playground's live view imports; the browser "
+       "fetches it, so offline point it at a copy you serve (default https://unpkg.com/three@0.187.0/build/three.module.js)",
+       [](const std::string& s, Config& c) {
+         // http(s), and nothing that could leave the JavaScript string or the CSP it is put in.
+         const bool scheme = s.rfind("https://", 0) == 0 || s.rfind("http://", 0) == 0;
+         if (!scheme || s.find_first_of(" \t\r\n'\"\\<>;`") != std::string::npos) return false;
+         c.playgroundThree = s;
+         return true;
+       }},
+  };
+  return opts;
+}
+
+}  // namespace
+
+std::string usage() {
+  std::ostringstream os;
+  os << "usage: effectd [serve] [--flag=value ...]          serve HTTP until SIGTERM/SIGINT\n"
+        "       effectd render SCENE.json -o OUT.png [--egl-platform=...] [--max-*=N]\n"
+        "                                                   render a /v1/render scene to a PNG, no server\n"
+        "       effectd --help | --version\n\n"
+        "Flags (environment variable in brackets; flags win over the environment):\n";
+  for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";
+  return os.str();
+}
+
+bool playgroundEnabled(const Config& config) {
+  if (config.playground != "auto") return config.playground == "on";
+  const std::string& h = config.host;
+  return h == "localhost" || h == "::1" || h == "[::1]" || h.rfind("127.", 0) == 0;
+}
+
+std::string parseConfig(const std::vector<std::string>& args, Config& config, bool& help) {
+  help = false;
+  for (const auto& o : options()) {
+    if (const char* v = std::getenv(o.env)) {
+      if (!o.set(v, config)) return std::string("invalid value for ") + o.env + ": '" + v + "'";
+    }
+  }
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      help = true;
+      return "";
+    }
+    if (a.rfind("--", 0) != 0) return "unexpected argument '" + a + "'";
+    std::string name = a.substr(2), value;
+    auto eq = name.find('=');
+    if (eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    } else if (i + 1 < args.size()) {
+      value = args[++i];
+    } else {
+      return "flag --" + name + " needs a value";
+    }
+    bool known = false;
+    for (const auto& o : options()) {
+      if (name != o.flag) continue;
+      known = true;
+      if (!o.set(value, config)) return "invalid value for --" + name + ": '" + value + "'";
+    }
+    if (!known) return "unknown flag --" + name;
+  }
+  return "";
+}
+
+std::string buildVersion() { return EFFECTD_VERSION; }
+
+}  // namespace effectd

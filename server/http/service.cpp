@@ -1,0 +1,406 @@
+// The service: routes, the contract documents, the POST path (cache, schema, ETag,
+// admission, handler, coding) and the listening socket. The policy around every request is
+// in http_policy.cpp.
+#include "http/service.h"
+
+#include <httplib.h>
+
+#include <thread>
+
+#include <sys/socket.h>
+
+#include <effects/common.h>
+
+#include "http/elastic_pool.h"
+#include "http/encoding.h"
+#include "http/etag.h"
+#include "contract/json_reader.h"
+#include "contract/json_writer.h"
+#include "http/request_state.h"
+#include "contract/resources.h"
+#include "http/route.h"
+
+namespace effectd {
+
+using nlohmann::json;
+
+namespace {
+
+json parseBody(const std::string& body) {
+  try {
+    return readJson(body);
+  } catch (const JsonSyntaxError& e) {
+    if (e.tooDeep)
+      throw ApiError{400,
+                     "invalid-json",
+                     "Malformed JSON",
+                     "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels",
+                     {{"", "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}},
+                     {}};
+    throw ApiError{400,
+                   "invalid-json",
+                   "Malformed JSON",
+                   std::string("request body is not valid JSON: ") + e.what(),
+                   {{e.pointer, "not valid JSON"}},
+                   {}};
+  }
+}
+
+// A JSON body that the route's schema refuses: a 400 problem naming the first violation and
+// listing them all.
+void throwIfInvalid(const std::vector<FieldError>& violations) {
+  if (violations.empty()) return;
+  std::string detail = violations.front().pointer + ": " + violations.front().message;
+  if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
+  throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
+}
+
+// Parses a JSON body into `body` and checks it against `schema`, adding both steps' times to
+// `stages`.
+void parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema, json& body,
+                      Stages& stages) {
+  effects::Stopwatch parse;
+  body = parseBody(text);
+  stages.emplace_back("parse", parse.ms());
+  effects::Stopwatch validate;
+  throwIfInvalid(schemas.validate(schema, body));
+  stages.emplace_back("validate", validate.ms());
+}
+
+// What determines a JSON request's answer: its document's CBOR, one encoding per JSON value
+// whatever the spacing, key order or number spelling, in a third of the time of the text.
+std::string canonicalJson(const json& body) {
+  std::string canonical = "application/json\n";
+  json::to_cbor(body, canonical);
+  return canonical;
+}
+
+// Writes `a` as the response, or a 304 when it carries an ETag that If-None-Match names.
+void sendAnswer(const CachedAnswer& a, const std::string& inm, httplib::Response& res) {
+  if (!a.etag.empty()) {  // "" = an answer with timings in it: no validator, never cached
+    res.set_header("ETag", a.etag);
+    if (etagMatches(inm, a.etag)) {
+      res.status = 304;
+      return;
+    }
+  }
+  for (const auto& [name, value] : a.headers) res.set_header(name, value);
+  if (!a.contentEncoding.empty()) res.set_header("Content-Encoding", a.contentEncoding);
+  res.set_content(a.body, a.contentType);
+}
+
+// Runs a binary body's handler into `answer`; returns its compute time.
+double answerBinary(const BinaryHandler& handler, const std::string& body, const RequestContext& ctx,
+                    CachedAnswer& answer) {
+  BinaryReply reply = handler(body, ctx);
+  if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
+  answer.headers.insert(reply.headers.begin(), reply.headers.end());
+  answer.body = std::move(reply.body);
+  answer.contentType = reply.contentType;
+  return reply.computeMs;
+}
+
+// Server-Timing's value: compute first, then its stages, then the request's own (parse, validate,
+// etag, write).
+std::string serverTiming(double computeMs, const Stages& stages, const Stages& requestStages = {}) {
+  std::string timing = "compute;dur=" + std::to_string(computeMs);
+  for (const Stages* list : {&stages, &requestStages})
+    for (const auto& [name, ms] : *list) timing += ", " + name + ";dur=" + std::to_string(ms);
+  return timing;
+}
+
+// Runs a prepared JSON request into `answer` (JSON, or the bytes it answers with instead) and
+// frees the request document; the run's own headers (Server-Timing included, with
+// `requestStages` and the answer's writing after the run's own) go to `res` only.
+void answerJson(const PreparedRequest& prepared, json& body, CachedAnswer& answer, httplib::Response& res,
+                Stages requestStages) {
+  JsonReply reply = prepared.run();
+  body = json();  // the request document is no longer needed
+  if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
+  answer.headers.insert(reply.headers.begin(), reply.headers.end());
+  for (const auto& [name, value] : reply.runHeaders) res.set_header(name, value);
+  if (!reply.contentType.empty()) {
+    answer.body = std::move(reply.binary);
+    answer.contentType = reply.contentType;
+  } else {
+    effects::Stopwatch write;
+    answer.body = writeJson(reply.body);
+    answer.contentType = "application/json";
+    requestStages.emplace_back("write", write.ms());
+  }
+  res.set_header("Server-Timing", serverTiming(reply.computeMs, reply.stages, requestStages));
+}
+
+// Encodes an answer worth compressing in the negotiated coding.
+void encodeAnswer(Coding coding, CachedAnswer& answer) {
+  if (coding != Coding::kIdentity && compressible(answer.contentType) && answer.body.size() >= kMinCompressBytes) {
+    answer.body = encode(coding, answer.body);
+    answer.contentEncoding = codingName(coding);
+  }
+}
+
+using Probes = std::vector<std::pair<std::string, std::function<std::string()>>>;
+
+// /readyz: each component "ready" or why not (503 when one is not), and the info values.
+void answerReadiness(const Probes& readiness, const Probes& info, httplib::Response& res) {
+  json components = json::object();
+  bool ready = true;
+  for (const auto& [name, probe] : readiness) {
+    std::string why = probe();
+    components[name] = why.empty() ? json("ready") : json(why);
+    ready = ready && why.empty();
+  }
+  json out = {{"status", ready ? "ready" : "not ready"}, {"components", components}};
+  for (const auto& [name, value] : info) out["info"][name] = value();
+  res.status = ready ? 200 : 503;
+  res.set_content(out.dump(), "application/json");
+}
+
+// /v1/schemas/<name>: a contract document.
+void answerSchemaDocument(const httplib::Request& req, httplib::Response& res) {
+  auto it = resources().find("schemas/" + req.matches[1].str());
+  if (it == resources().end()) {
+    writeProblem(res, {404, "not-found", "Not Found", "no such schema", {}, {}}, tl.requestId);
+    return;
+  }
+  res.set_content(std::string(it->second), "application/schema+json");
+}
+
+}  // namespace
+
+namespace {
+Admission::Options admissionOptions(const Config& c) {
+  Admission::Options o;
+  o.budgetBytes =
+      c.memoryBudgetMb ? c.memoryBudgetMb << 20 : size_t(double(detectMemoryLimit().bytes) * kDefaultBudgetFraction);
+  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  o.heavySlots = c.heavyThreads > 0 ? c.heavyThreads : std::max(1, cores - 1);
+  o.maxWaiting = c.admissionQueue;
+  o.maxWait = std::chrono::milliseconds(c.admissionTimeoutMs);
+  return o;
+}
+}  // namespace
+
+Service::Service(Config config)
+    : config_(std::move(config)),
+      admission_(std::make_unique<Admission>(admissionOptions(config_))),
+      cache_(config_.responseCacheMb << 20),
+      http_(std::make_unique<httplib::Server>()),
+      compute_(std::make_unique<effects::ThreadPool>(effects::ThreadPool::besideCaller())),
+      idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
+  std::map<std::string, std::string> docs;
+  for (const auto& [name, data] : resources())
+    if (name.rfind("schemas/", 0) == 0) docs[name.substr(8)] = std::string(data);
+  schemas_ = std::make_unique<SchemaRegistry>(docs);
+  installCore();
+  installHttpPolicy();
+  metrics_.addSource([this] {
+    return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
+           "# TYPE effectd_memory_trims_total counter\n"
+           "effectd_memory_trims_total " +
+           std::to_string(idleTrim_->trims()) + "\n";
+  });
+}
+
+Service::~Service() = default;
+
+const Service::Route* Service::findRoute(const std::string& path) const {
+  for (const auto& r : routes_)
+    if (r->path == path) return r.get();
+  return nullptr;
+}
+
+void Service::installCore() {
+  httplib::Server& s = *http_;
+  const size_t threads = size_t(config_.threads), connections = size_t(config_.maxConnections);
+  s.new_task_queue = [threads, connections] { return new ElasticPool(threads, connections); };
+  s.set_payload_max_length(config_.limits.maxBodyBytes);
+  s.set_read_timeout(config_.readTimeoutS, 0);
+  s.set_write_timeout(config_.writeTimeoutS, 0);
+  s.set_keep_alive_timeout(config_.keepAliveTimeoutS);
+  s.set_keep_alive_max_count(static_cast<size_t>(config_.keepAliveMaxCount));
+  // cpp-httplib writes a response in two send()s (headers, then body). With Nagle's algorithm
+  // on, the body waits for the ACK of the headers, and a keep-alive client delays that ACK by
+  // up to 40 ms: every request after the first on a connection took ~44 ms. TCP_NODELAY is set
+  // on the listening socket and Linux copies it to every accepted socket (measured: keep-alive
+  // p50 44 ms -> 0.36 ms; Http.KeepAliveHasNoNagleStall guards it).
+  s.set_tcp_nodelay(true);
+  // cpp-httplib's default socket option is SO_REUSEPORT, which lets a second effectd bind the
+  // same port and silently take half the connections. SO_REUSEADDR alone restarts cleanly over
+  // TIME_WAIT and makes a port in use an error.
+  s.set_socket_options([this](int sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    listenSocket_ = sock;
+  });
+
+  auto addGet = [this](const std::string& path, httplib::Server::Handler h) {
+    auto r = std::make_unique<Route>();
+    r->path = path;
+    r->methods = {"GET", "HEAD"};
+    routes_.push_back(std::move(r));
+    if (h) http_->Get(path, std::move(h));
+  };
+  addGet("/healthz", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content("{\"status\":\"ok\"}", "application/json");
+  });
+  addGet("/readyz",
+         [this](const httplib::Request&, httplib::Response& res) { answerReadiness(readiness_, info_, res); });
+  addGet("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  addGet("/v1/openapi.yaml", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(resources().at("openapi.yaml")), "application/yaml");
+  });
+  // Route table entry "/v1/schemas/" stands for every schema document below it.
+  addGet("/v1/schemas/", nullptr);
+  http_->Get(R"(/v1/schemas/([A-Za-z0-9_.-]+))", answerSchemaDocument);
+}
+
+void Service::addJsonEndpoint(const std::string& path, const std::string& schema, JsonEndpoint endpoint) {
+  schemas_->document(schema);  // fail at startup, not at the first request
+  auto r = std::make_unique<Route>();
+  r->path = path;
+  r->methods = {"POST"};
+  r->schema = schema;
+  r->json = std::move(endpoint);
+  const Route* raw = r.get();
+  routes_.push_back(std::move(r));
+  http_->Post(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handlePost(*raw, req, res); });
+}
+
+void Service::addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler,
+                                   BinaryEstimator cost) {
+  for (auto& r : routes_)
+    if (r->path == path) r->binary[contentType] = {std::move(handler), std::move(cost)};
+}
+
+void Service::addStatic(const std::string& path, const std::string& contentType, std::string body,
+                        const std::string& scriptOrigin) {
+  auto r = std::make_unique<Route>();
+  r->path = path;
+  r->methods = {"GET", "HEAD"};
+  routes_.push_back(std::move(r));
+  const bool html = contentType.rfind("text/html", 0) == 0;
+  const std::string csp = "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'" +
+                          (scriptOrigin.empty() ? "" : " " + scriptOrigin) + "; connect-src 'self'; frame-ancestors 'none'";
+  http_->Get(path, [contentType, html, csp, body = std::move(body)](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    if (html) res.set_header("Content-Security-Policy", csp);
+    res.set_content(body, contentType);
+  });
+}
+
+void Service::addReadinessCheck(const std::string& name, std::function<std::string()> probe) {
+  readiness_.emplace_back(name, std::move(probe));
+}
+
+void Service::setEtagSalt(const std::string& path, std::function<std::string()> salt) {
+  for (auto& r : routes_)
+    if (r->path == path) r->etagSalt = std::move(salt);
+}
+
+void Service::addReadinessInfo(const std::string& name, std::function<std::string()> value) {
+  info_.emplace_back(name, std::move(value));
+}
+
+void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
+  RequestContext ctx{tl.requestId, config_, compute_.get()};
+  for (const auto& [k, v] : req.params) ctx.query[k] = v;
+  const std::string type = mediaType(req.get_header_value("Content-Type"));
+  // Part of what determines a binary answer; as JSON, so that no two queries read the same.
+  const std::string query = ctx.query.empty() ? std::string() : json(ctx.query).dump();
+  const Coding coding = negotiate(tl.acceptEncoding);
+  const std::string inm = req.get_header_value("If-None-Match");
+  tl.encoded = true;
+  // The exact request bytes find a cached answer before any parsing.
+  const std::string requestKey =
+      req.body.size() <= ResponseCache::kMaxAliasKeyBytes
+          ? route.path + "?" + query + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
+          : std::string();
+  try {
+    if (auto hit = cache_.byRequest(requestKey)) {
+      res.set_header("Server-Timing", "cache;desc=\"hit\"");
+      return sendAnswer(*hit, inm, res);
+    }
+    const auto binary = route.binary.find(type);
+    const bool isBinary = binary != route.binary.end();
+    json body;
+    Stages requestStages;  // parse, validate, etag (and write): for Server-Timing
+    if (!isBinary) parseJsonRequest(req.body, *schemas_, route.schema, body, requestStages);
+    // Deterministic answers: a strong validator per representation (request and coding), over
+    // what determines the answer; none for a JSON request that asks for timings.
+    std::string tag;
+    if (isBinary || !asksForTimings(body)) {
+      effects::Stopwatch hashing;
+      tag = etagFor(route.path, route.etagSalt ? route.etagSalt() : "",
+                    isBinary ? type + "\n" + query + "\n" + req.body : canonicalJson(body), coding);
+      requestStages.emplace_back("etag", hashing.ms());
+      if (etagMatches(inm, tag)) {
+        res.set_header("ETag", tag);
+        res.status = 304;
+        return;
+      }
+      if (auto hit = cache_.byTag(tag)) {
+        cache_.alias(requestKey, tag);
+        res.set_header("Server-Timing", "cache;desc=\"hit\"");
+        return sendAnswer(*hit, inm, res);
+      }
+    }
+    // The typed request and its cost; admission: the estimated peak is reserved until the
+    // answer has been written.
+    PreparedRequest prepared;
+    if (!isBinary) prepared = route.json(body, ctx);
+    const Cost cost = isBinary ? binary->second.cost(req.body, config_) : prepared.cost;
+    tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
+    res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
+
+    auto answer = std::make_shared<CachedAnswer>();
+    answer->etag = tag;
+    if (isBinary)
+      res.set_header("Server-Timing",
+                     serverTiming(answerBinary(binary->second.handler, req.body, ctx, *answer), {}, requestStages));
+    else
+      answerJson(prepared, body, *answer, res, std::move(requestStages));
+    encodeAnswer(coding, *answer);
+    sendAnswer(*answer, inm, res);
+    if (!tag.empty()) cache_.put(std::move(answer), requestKey);
+  } catch (const ApiError& e) {
+    res.headers.erase("ETag");  // problems are not cacheable representations
+    res.headers.erase("Server-Timing");
+    tl.encoded = false;
+    writeProblem(res, e, ctx.requestId);
+  }
+}
+
+int Service::bind() {
+  const int port = config_.port == 0 ? http_->bind_to_any_port(config_.host)
+                                     : (http_->bind_to_port(config_.host, config_.port) ? config_.port : -1);
+  // cpp-httplib 0.11.4 listens with a backlog of 5 (compiled into Debian's .so). Clients that
+  // open connections in bursts (64 wrk connections reconnecting after --keep-alive-max) then
+  // overflow the accept queue, the kernel drops their SYNs, and they retry after a second:
+  // wrk -c64 saw p99 1.4 s with p90 4.6 ms (nstat: TcpExtListenOverflows). Calling listen()
+  // again on a listening socket sets its backlog (Linux), capped by net.core.somaxconn.
+  if (port > 0 && listenSocket_ >= 0) ::listen(listenSocket_, SOMAXCONN);
+  return port;
+}
+
+bool Service::run() { return http_->listen_after_bind(); }
+
+void Service::stop() {
+  // stop() before the listen loop runs would be lost (cpp-httplib 0.11.4): wait for it.
+  waitUntilRunning(std::chrono::milliseconds(2000));
+  http_->stop();
+}
+
+bool Service::waitUntilRunning(std::chrono::milliseconds timeout) const {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!http_->is_running()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+}  // namespace effectd
