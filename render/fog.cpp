@@ -30,7 +30,7 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
   auto add = [&](const fog::Fog& g) {
     types.push_back(int(g.type));
     const double cutoff = std::isfinite(g.cutoffDistance) ? g.cutoffDistance : 0.0;
-    for (double x : {g.startDistance, cutoff, 1.0 - g.maxOpacity, 0.0}) engine.push_back(x);
+    for (double x : {g.startDistance, cutoff, 1.0 - g.maxOpacity, double(int(g.convention))}) engine.push_back(x);
     const fog::HeightLayer l = g.secondLayer.value_or(fog::HeightLayer{});
     const glm::dvec4 l2 = heightLayerUniform(l.density, l.heightFalloff, l.baseHeight);
     for (int i = 0; i < 4; ++i) layer2.push_back(l2[i]);
@@ -118,6 +118,8 @@ std::string FogVariant::key() const {
   if (opacity) k += ":maxOpacity";
   if (secondLayer) k += ":secondLayer";
   if (directional) k += ":directional";
+  if (filament) k += ":filament";
+  if (unreal) k += ":unreal";
   return k;
 }
 
@@ -130,6 +132,8 @@ FogVariant fogVariant(const Fog& f) {
     v.opacity |= g.maxOpacity < 1.0;
     v.secondLayer |= g.secondLayer.has_value();
     v.directional |= g.directional.has_value();
+    v.filament |= g.convention == fog::Convention::kFilament;
+    v.unreal |= g.convention == fog::Convention::kUnreal;
   };
   add(f.global);
   for (const auto& r : f.regions) add(r.fog);
@@ -137,6 +141,62 @@ FogVariant fogVariant(const Fog& f) {
   v.types.erase(std::unique(v.types.begin(), v.types.end()), v.types.end());
   v.regions = f.regions.size();
   return v;
+}
+
+// HEIGHT fog in the engines' conventions (effects/fog/conventions.cpp, term for term): the
+// fogged colour with its glow, per slot.
+std::string engineConventionsGlsl(const FogVariant& v) {
+  std::ostringstream s;
+  const std::string glowStart = "  vec4 sun = uFogSun[slot], sc = uFogSunColor[slot];\n"
+                                "  float c = d > 0.0 ? clamp(dot(ray / d, sun.xyz), -1.0, 1.0) : 0.0;\n"
+                                "  float lobe = c > 0.0 ? pow(c, sun.w - 2.0) : 0.0;\n";
+  if (v.filament) {
+    s << "vec3 fogFilament(int slot, vec3 world, vec3 rgb) {  // Filament's surface fog\n"
+         "  vec4 q = uFogParams[slot], e = uFogEngine[slot];\n"
+         "  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n"
+         "  if (q.w < 0.5 || d < e.x || (e.y > 0.0 && d > e.y)) return rgb;\n"
+         "  float fh = q.y * ray.y;  // the mean density over [0, d], or the camera's near level\n"
+         "  float mean = exp(min(q.x - q.y * (uFogCamera.y - q.z) + (abs(fh) > 0.00125 ? fogLogG(fh) : 0.0), 80.0));\n"
+         "  vec3 c0 = mix(uFogColor[slot], rgb, max(exp(-mean * max(d - e.x, 0.0)), e.z));\n";
+    if (v.directional)
+      s << glowStart << "  if (dot(sc.rgb, sc.rgb) > 0.0) c0 += (1.0 - exp(-mean * max(d - sc.w, 0.0))) * sc.rgb * lobe;\n";
+    s << "  return c0;\n}\n";
+  }
+  if (v.unreal) {
+    s << "float fogUnrealLine(float falloff, float rise, float origin) {  // CalculateLineIntegralShared\n"
+         "  float f = max(-127.0, falloff * rise);\n"
+         "  return abs(f) > 0.01 ? origin * (1.0 - exp2(-f)) / f : origin * (0.6931472 - 0.2402265 * f);\n"
+         "}\n"
+         "vec3 fogUnreal(int slot, vec3 world, vec3 rgb) {  // Unreal's ExponentialHeightFog, base 2\n"
+         "  vec4 e = uFogEngine[slot];\n"
+         "  vec4 q[2];\n  q[0] = uFogParams[slot];\n"
+      << (v.secondLayer ? "  q[1] = uFogLayer2[slot];\n" : "  q[1] = vec4(0.0);\n")
+      << "  float density[2], falloff[2];\n"
+         "  float observer = uFogCamera.y;\n"
+         "  for (int i = 0; i < 2; ++i) {\n"
+         "    density[i] = q[i].w > 0.5 ? exp(q[i].x) / 0.480453 : 0.0;  // a / ln2^2\n"
+         "    falloff[i] = q[i].y / 0.6931472;\n"
+         "    if (density[i] > 0.0) observer = min(observer, q[i].z + 65536.0);\n"
+         "  }\n"
+         "  vec3 v = world - uFogCamera;\n  v.y += uFogCamera.y - observer;\n"
+         "  float d = length(v), rayLength = d, rise = v.y;\n"
+         "  float origin[2];\n"
+         "  for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(clamp(-falloff[i] * (observer - q[i].z), -125.0, 126.0));\n"
+         "  if (e.x > 0.0 && d > 0.0) {  // the ray from the start distance on\n"
+         "    float t = e.x / d;\n    float startY = observer + t * v.y;\n"
+         "    rayLength = (1.0 - t) * d;\n    rise = v.y - t * v.y;\n"
+         "    for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(-max(-127.0, falloff[i] * (startY - q[i].z)));\n"
+         "  }\n"
+         "  float perUnit = fogUnrealLine(falloff[0], rise, origin[0]) + fogUnrealLine(falloff[1], rise, origin[1]);\n"
+         "  if (e.y > 0.0 && d > e.y) return rgb;\n"
+         "  vec3 c0 = mix(uFogColor[slot], rgb, max(clamp(exp2(-perUnit * rayLength), 0.0, 1.0), e.z));\n";
+    if (v.directional)
+      s << "  vec3 ray = v;\n" << glowStart
+        << "  if (dot(sc.rgb, sc.rgb) > 0.0)\n"
+           "    c0 += (1.0 - clamp(exp2(-perUnit * max(rayLength - sc.w, 0.0)), 0.0, 1.0)) * sc.rgb * lobe;\n";
+    s << "  return c0;\n}\n";
+  }
+  return s.str();
 }
 
 // Long because it is one GLSL program read top to bottom: uniforms, each fog type's function,
@@ -154,7 +214,9 @@ std::string fogGlsl(const FogVariant& v) {
   if (v.regions)
     s << "uniform vec4 uRegionLo[" << v.regions << "];  // box min | sphere centre; w: 0 box, 1 sphere\n"
       << "uniform vec4 uRegionHi[" << v.regions << "];  // box max | x = sphere radius\n";
-  if (v.engine()) s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity\n";
+  if (v.engine())
+    s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity"
+      << (v.filament || v.unreal ? ", convention (0 effectd, 1 filament, 2 unreal)" : "") << "\n";
   if (v.secondLayer) s << "uniform vec4 uFogLayer2[" << slots << "];  // HEIGHT's second layer: log a, b, h, a > 0\n";
   if (has(T::kAtmospheric)) s << "uniform vec3 uFogInscatter[" << slots << "];  // ATMOSPHERIC: inscattering per channel\n";
   if (v.directional)
@@ -165,7 +227,7 @@ std::string fogGlsl(const FogVariant& v) {
   // (fogHeightTau); otherwise the one-layer form below it.
   const bool startParam = v.start || v.directional;
   const bool layered = startParam || v.secondLayer;
-  if (has(T::kHeight))
+  if (has(T::kHeight) || v.filament)
     s << "float fogLogG(float x) {  // log((1 - e^-x) / x), stable for every x\n"
          "  if (abs(x) < 1e-3) return -0.5 * x + x * x / 24.0;\n"
          "  if (x > 0.0) return log(1.0 - exp(-x)) - log(x);\n"
@@ -257,8 +319,11 @@ std::string fogGlsl(const FogVariant& v) {
     if (v.opacity) s << "  t = max(t, vec3(e.z));\n  w = min(w, vec3(1.0 - e.z));\n";
     s << "  return rgb * t + w * uFogColor[slot];\n}\n";
   }
+  if (v.filament || v.unreal) s << engineConventionsGlsl(v);
   s << "vec3 applyFog(vec3 rgb, vec3 world) {\n"
        "  int slot = fogSlot(world);\n";
+  if (v.filament) s << "  if (uFogEngine[slot].w == 1.0) return fogFilament(slot, world, rgb);\n";
+  if (v.unreal) s << "  if (uFogEngine[slot].w == 2.0) return fogUnreal(slot, world, rgb);\n";
   if (has(T::kAtmospheric))
     s << "  if (uFogType[slot] == " << int(T::kAtmospheric) << ") return fogAtmospheric(slot, world, rgb)" << glow << ";\n";
   s << "  return mix(uFogColor[slot], rgb, fogFactor(slot, world))" << glow << ";\n}\n";

@@ -21,7 +21,8 @@ struct FogVariant {
   size_t regions = 0;
   // The engine terms some slot uses (effects/fog.h): only those are compiled in.
   bool start = false, cutoff = false, opacity = false, secondLayer = false, directional = false;
-  bool engine() const { return start || cutoff || opacity || directional; }
+  bool filament = false, unreal = false;  // some slot follows that engine's convention
+  bool engine() const { return start || cutoff || opacity || directional || filament || unreal; }
   std::string key() const;
 };
 FogVariant fogVariant(const Fog& fog);

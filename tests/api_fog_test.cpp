@@ -283,5 +283,39 @@ TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
   }
 }
 
+// The engines' conventions in the shader: each slot's own function, valid SPIR-V and HLSL, the
+// convention in uFogEngine.w; an effectd region beside them keeps effectd's formula.
+TEST(FogApi, ShaderFunctionForEachConvention) {
+  TestServer s;
+  for (const char* convention : {"filament", "unreal"}) {
+    json body = {{"fog",
+                  {{"fogType", "HEIGHT"},
+                   {"convention", convention},
+                   {"density", 0.05},
+                   {"startDistance", 2},
+                   {"directional", {{"exponent", 8}, {"startDistance", 10}}}}},
+                 {"regions", {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "HEIGHT"}}}}}},
+                 {"include", {"shader"}}};
+    if (std::string(convention) == "unreal") body["fog"]["secondLayer"] = {{"density", 0.01}};
+    auto r = s.postJson("/v1/fog", body);
+    ASSERT_EQ(r->status, 200) << r->body;
+    json j = json::parse(r->body);
+    const std::string glsl = j["shader"]["code"];
+    const bool filament = std::string(convention) == "filament";
+    EXPECT_EQ(glsl.find("fogFilament") != std::string::npos, filament) << convention;
+    EXPECT_EQ(glsl.find("fogUnreal") != std::string::npos, !filament) << convention;
+    EXPECT_EQ(j["shader"]["uniforms"]["uFogEngine"]["values"][3], filament ? 1 : 2);
+    EXPECT_EQ(j["shader"]["uniforms"]["uFogEngine"]["values"][7], 0);  // the region: effectd
+    body["shader"] = {{"language", "spirv"}};
+    auto words = base64Decode(json::parse(s.postJson("/v1/fog", body)->body)["shader"]["code"].get<std::string>());
+    ASSERT_TRUE(words);
+    EXPECT_TRUE(toolAccepts("spirv-val --target-env vulkan1.0", *words, ".spv")) << convention;
+    body["shader"]["language"] = "hlsl";
+    json hlsl = json::parse(s.postJson("/v1/fog", body)->body);
+    EXPECT_TRUE(toolAccepts("glslangValidator -V -o /dev/null -D -e main -S frag", hlsl["shader"]["code"], ".hlsl"))
+        << convention << hlsl["shader"]["code"].get<std::string>();
+  }
+}
+
 }  // namespace
 }  // namespace effectd::testing

@@ -257,6 +257,64 @@ TEST(Render, FogGlowsTowardsTheSun) {
   }
 }
 
+// Filament's and Unreal's conventions drawn by the GPU: quads looked at from 2 units up, on rays
+// up and down and at distances before the start and in the fog, each centre pixel the colour of
+// the answer's sample at that point (object * T + S + glow).
+TEST(Render, FogConventionsDrawAsTheirSamples) {
+  TestServer s;
+  const int W = 256, H = 128;
+  const double aspect = double(W) / H, tanHalf = std::tan(30.0 * M_PI / 180), cameraY = 2;
+  const glm::dvec3 quadColor(0.9, 0.6, 0.2);
+  for (const char* convention : {"filament", "unreal"}) {
+    const json fogDef = {{"fogType", "HEIGHT"},
+                         {"convention", convention},
+                         {"color", {0.55, 0.6, 0.7}},
+                         {"density", 0.06},
+                         {"heightFalloff", 0.3},
+                         {"startDistance", 4},
+                         {"maxOpacity", 0.9},
+                         {"directional",
+                          {{"color", {1.5, 0.8, 0.3}}, {"direction", {0.3, 0.2, -1}}, {"exponent", 6}, {"startDistance", 5}}}};
+    json scene = {{"width", W},
+                  {"height", H},
+                  {"camera", {{"position", {0, cameraY, 0}}, {"target", {0, cameraY, -1}}, {"fovY", 60}}},
+                  {"background", {{"color", {0, 0, 0}}}},
+                  {"fog", {{"fog", fogDef}}},
+                  {"quads", json::array()}};
+    json points = json::array();
+    std::vector<std::pair<int, int>> pixels;
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 6; ++col) {
+        const double ndcX = -0.8 + 1.6 * col / 5, ndcY = -0.6 + 1.2 * row / 3;
+        const double d = 3 + 37.0 * (row * 6 + col) / 23;
+        const glm::dvec3 dir = glm::normalize(glm::dvec3(ndcX * tanHalf * aspect, ndcY * tanHalf, -1));
+        const glm::dvec3 c = glm::dvec3(0, cameraY, 0) + dir * d;
+        scene["quads"].push_back({{"center", {c.x, c.y, c.z}},
+                                  {"normal", {-dir.x, -dir.y, -dir.z}},
+                                  {"size", {0.03 * d, 0.03 * d}},
+                                  {"color", {quadColor.r, quadColor.g, quadColor.b}}});
+        points.push_back({c.x, c.y, c.z});
+        pixels.emplace_back(int(std::floor((ndcX * 0.5 + 0.5) * W)), int(std::floor((0.5 - ndcY * 0.5) * H)));
+      }
+    auto a = s.postJson("/v1/fog", json{{"fog", fogDef},
+                                        {"include", {"samples"}},
+                                        {"samples", {{"camera", {0, cameraY, 0}}, {"points", points}}}});
+    ASSERT_EQ(a->status, 200) << a->body;
+    const json samples = json::parse(a->body)["samples"];
+    auto r = render(s, scene);
+    ASSERT_EQ(r->status, 200) << r->body;
+    rd::Image img = decode(r->body);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const glm::vec4 got = pixel(img, pixels[i].first, pixels[i].second);
+      for (int c = 0; c < 3; ++c) {
+        const double want = quadColor[c] * samples[i]["transmittance"][size_t(c)].get<double>() +
+                            samples[i]["fogColor"][size_t(c)].get<double>();
+        EXPECT_NEAR(got[c], std::min(want, 1.0), 2.0 / 255) << convention << " quad " << i << " channel " << c;
+      }
+    }
+  }
+}
+
 double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
   glm::dvec2 ab = b - a;
   double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;

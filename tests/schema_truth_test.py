@@ -34,6 +34,10 @@ ALLOWED = {
        "6 and 26 are the 3-D neighbourhoods: the example's grid is 2-D (no grid.depth), where 4 and 8 apply"
        for schema, pointer in (("lightning.json", "/neighbourhood"), ("scene.json", "/lightning/neighbourhood"))
        for n in (6, 26)},
+    **{("fog.json", "/fog/convention", f'enum "{engine}"'):
+       "an engine's convention is its height fog: the example's fog is X3D LINEAR, refused at /fog/convention "
+       "(tests/fog_engines/conventions_test.py tries every convention on HEIGHT fogs)"
+       for engine in ("filament", "unreal")},
     ("bubble.json", "/thinFilm/thicknessRange", "default"):
         "the thin-film table's default is [0, 1000] nm as stated; the glTF extension block keeps "
         "KHR_materials_iridescence's own 100-400 nm unless a range is given (api_bubble.cpp)",

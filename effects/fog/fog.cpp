@@ -51,7 +51,32 @@ std::optional<FogType> fogTypeFromString(const std::string& name) {
   return std::nullopt;
 }
 
+const char* toString(Convention convention) {
+  switch (convention) {
+    case Convention::kEffectd: return "effectd";
+    case Convention::kFilament: return "filament";
+    case Convention::kUnreal: return "unreal";
+  }
+  return "?";
+}
+
+std::optional<Convention> conventionFromString(const std::string& name) {
+  for (Convention c : {Convention::kEffectd, Convention::kFilament, Convention::kUnreal})
+    if (name == toString(c)) return c;
+  return std::nullopt;
+}
+
 std::optional<Error> validate(const Fog& fog) {
+  if (fog.convention != Convention::kEffectd) {
+    const std::string engine = fog.convention == Convention::kFilament ? "Filament" : "Unreal";
+    if (fog.type != FogType::kHeight)
+      return invalid("/convention", "an engine's convention is its height fog: use fogType HEIGHT");
+    if (fog.convention == Convention::kFilament && fog.secondLayer)
+      return invalid("/secondLayer", "Filament's fog has one layer");
+    if (fog.directional && !fog.directional->exponent)
+      return invalid("/directional/exponent",
+                     engine + "'s glow lobe is max(cos theta, 0)^exponent: give exponent (g is effectd's lobe)");
+  }
   for (int i = 0; i < 3; ++i) {
     if (!(fog.color[i] >= 0.0 && fog.color[i] <= 1.0))
       return invalid("/color/" + std::to_string(i), "must be in [0, 1]");
@@ -186,6 +211,7 @@ double engineLimits(const Fog& fog, double distance, double f) {
 }
 
 double factorAtElevation(const Fog& fog, double originY, double dirY, double distance) {
+  if (fog.convention != Convention::kEffectd) return engineFactor(fog, originY, dirY, distance);
   if (fog.type != FogType::kHeight)
     return engineLimits(fog, distance, modeFactor(fog, std::max(0.0, distance - fog.startDistance)));
   return engineLimits(fog, distance, std::exp(-heightDepth(fog, originY, dirY, distance)));
@@ -218,8 +244,9 @@ glm::dvec3 scattered(const Fog& fog, double originY, double dirY, double distanc
 
 double inscatterWeight(const Fog& fog, double originY, double dirY, double distance) {
   if (!fog.directional) return 0.0;
+  if (fog.convention != Convention::kEffectd) return engineInscatterWeight(fog, originY, dirY, distance);
   Fog beyond = fog;  // the same fog, over the ray's part where the glow starts
-  beyond.startDistance = std::max(fog.startDistance, fog.directional->startDistance);
+  beyond.startDistance = glowStart(fog);
   return 1.0 - factorAtElevation(beyond, originY, dirY, distance);
 }
 
@@ -238,8 +265,10 @@ glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye
   const double dirY = d > 0.0 ? std::clamp(ray.y / d, -1.0, 1.0) : 0.0;
   glm::dvec3 c = object * transmittance(fog, eye.y, dirY, d) + scattered(fog, eye.y, dirY, d);
   if (fog.directional && d > 0.0) {
+    glm::dvec3 view = ray;  // Unreal's lobe looks from its clamped observer height
+    view.y += eye.y - observerHeight(fog, eye.y);
     c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color *
-         lobe(*fog.directional, glm::dot(ray / d, glm::normalize(fog.directional->direction)));
+         lobe(*fog.directional, glm::dot(glm::normalize(view), glm::normalize(fog.directional->direction)));
   }
   return c;
 }
@@ -306,7 +335,7 @@ double completeDistance(const Fog& fog, double cameraHeight) {
   const double mode = level >= 1.0 ? 0.0 : modeDistanceTo(fog, level, cameraHeight);
   double d = fog.startDistance + mode;
   if (fog.directional)  // the glow starts later, and is done as much later
-    d = std::max(d, std::max(fog.startDistance, fog.directional->startDistance) + mode);
+    d = std::max(d, glowStart(fog) + mode);
   return std::min(d, fog.cutoffDistance);
 }
 

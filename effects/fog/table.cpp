@@ -27,13 +27,13 @@ double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
 // M' = M + rho (M + 1), rho = e^{-k dt} - 1, which keeps its relative precision for small k t
 // (no 1 - e^{-x} cancellation). That leaves one exp per entry. Rows where c or e^{|k| t}
 // could overflow take the closed form per entry (heightOpticalDepth's log-space evaluation),
-// as do fogs with a start distance or a second layer.
+// as do fogs with a start distance, a second layer or an engine's convention.
 bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table& t, float* row) {
   const double a = fog.density, b = fog.heightFalloff;
   const double k = b * dirY;
   const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
   if (a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * t.rangeEnd > 700.0) return false;
-  if (fog.startDistance > 0.0 || fog.secondLayer) return false;
+  if (fog.startDistance > 0.0 || fog.secondLayer || fog.convention != Convention::kEffectd) return false;
   if (k != 0.0 && std::fabs(k) < 1e-290) return false;  // -m/k would lose its precision in subnormals
   const double c = std::exp(logC);
   const double dt = (t.rangeEnd - t.rangeStart) / double(t.width - 1);

@@ -359,7 +359,8 @@ bb::ThicknessField thicknessField(const bb::Params& params, const bb::ThicknessO
 }  // namespace
 
 BubbleRequest parseBubbleRequest(const json& body, const RequestContext& ctx) {
-  BubbleRequest r{Includes(body, kBubbleIncludes)};
+  BubbleRequest r;
+  r.include = Includes(body, kBubbleIncludes);
   r.glb = body.value("format", "json") == "glb";
   r.params = parseBubbleParams(body.value("params", json::object()), ctx.at + "/params");
   r.features = parseBubbleFeatures(body);

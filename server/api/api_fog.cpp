@@ -20,7 +20,8 @@ namespace fog = effects::fog;
 
 fog::Fog parseFog(const json& j, const std::string& pointer) {
   fog::Fog f;
-  f.type = *fog::fogTypeFromString(j.value("fogType", "LINEAR"));  // enum checked by the schema
+  f.type = *fog::fogTypeFromString(j.value("fogType", "LINEAR"));  // enums checked by the schema
+  f.convention = *fog::conventionFromString(j.value("convention", fog::toString(f.convention)));
   if (j.contains("color")) f.color = toVec3(j["color"]);
   f.visibilityRange = j.value("visibilityRange", f.visibilityRange);
   f.start = j.value("start", f.start);
@@ -223,7 +224,8 @@ json fogShaderJson(const fog::Fog& global, const std::vector<fog::Region>& regio
 }  // namespace
 
 FogRequest parseFogRequest(const json& body, const RequestContext& ctx) {
-  FogRequest r{Includes(body, kFogIncludes)};
+  FogRequest r;
+  r.include = Includes(body, kFogIncludes);
   r.fog = parseFog(body["fog"], ctx.at + "/fog");
   if (body.contains("regions"))
     for (size_t i = 0; i < body["regions"].size(); ++i)
@@ -243,6 +245,7 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
 
   JsonReply reply;
   reply.method = std::string("table-") + fog::toString(global.type);
+  if (global.convention != fog::Convention::kEffectd) reply.method += std::string("-") + fog::toString(global.convention);
   json out = {{"method", reply.method}};
   json stats = json::array();
   auto build = [&](const fog::Fog& f, const std::string& pointer) {
@@ -261,7 +264,10 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
     out["table"] = build(global, ctx.at + "/fog");
     out["error"] = {{"maxError", out["table"]["maxError"]},
                     {"metric", "max |linear interpolation of the table - exact f|"},
-                    {"reference", "exact closed form"}};
+                    {"reference", global.convention == fog::Convention::kEffectd
+                                      ? "exact closed form"
+                                      : std::string("the closed form of the ") + fog::toString(global.convention) +
+                                            " convention (its shader's formula in double precision)"}};
   }
   if (include.has("regionTables")) {
     json list = json::array();

@@ -45,7 +45,8 @@ void flipW(tg::Output& out) {
 }  // namespace
 
 TangentsRequest parseTangentsRequest(const json& body, const RequestContext&) {
-  TangentsRequest r{Includes(body, kTangentsIncludes)};
+  TangentsRequest r;
+  r.include = Includes(body, kTangentsIncludes);
   const json& m = body["mesh"];
   r.mesh.positions = unflatten<glm::vec3, 3>(m["positions"], "/mesh/positions");
   if (m.contains("normals")) r.mesh.normals = unflatten<glm::vec3, 3>(m["normals"], "/mesh/normals");

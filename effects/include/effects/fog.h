@@ -71,8 +71,21 @@ struct Directional {
   double startDistance = 0.0;            // >= 0; the glow starts at max(this, fog startDistance)
 };
 
+// Whose formulas a HEIGHT fog follows, with the same parameters (docs/effects.md §2.4):
+//   kEffectd   the exact optical depth over [startDistance, d], the glow from max(startDistance,
+//              directional.startDistance) capped like the fog;
+//   kFilament  Filament's surface fog: the mean density over [0, d] times (d - startDistance),
+//              near-level rays at the camera's density, the glow from directional.startDistance,
+//              not capped; one layer; the glow's lobe max(cos, 0)^exponent;
+//   kUnreal    Unreal's ExponentialHeightFog in its base-2 form (density a / ln2^2, falloff b / ln2
+//              per unit), its near-level Taylor term, exponent clamps and observer height clamp
+//              (65536 units above the lowest layer), the glow from startDistance +
+//              directional.startDistance, not capped; the lobe max(cos, 0)^exponent.
+enum class Convention { kEffectd, kFilament, kUnreal };
+
 struct Fog {
   FogType type = FogType::kX3dLinear;
+  Convention convention = Convention::kEffectd;  // kHeight only
   glm::dvec3 color{1.0, 1.0, 1.0};    // X3D default 1 1 1; each component in [0, 1]
   double visibilityRange = 0.0;       // X3D V >= 0; 0 = no fog
   double start = 0.0, end = 1.0;      // GL_LINEAR, 0 <= start < end
@@ -96,9 +109,22 @@ struct Fog {
   std::optional<Directional> directional;  // every mode
 };
 
-// Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT").
+// Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT"; "effectd", ...).
 const char* toString(FogType type);
 std::optional<FogType> fogTypeFromString(const std::string& name);
+const char* toString(Convention convention);
+std::optional<Convention> conventionFromString(const std::string& name);
+
+// The weight f and the glow's weight 1 - f_dir of a HEIGHT fog in an engine's convention
+// (kFilament, kUnreal; conventions.cpp), for a ray from height originY with unit direction
+// y component dirY: what factorAtElevation and inscatterWeight return for them.
+double engineFactor(const Fog& fog, double originY, double dirY, double distance);
+double engineInscatterWeight(const Fog& fog, double originY, double dirY, double distance);
+// Where the glow starts along a ray in the fog's convention.
+double glowStart(const Fog& fog);
+// The height the fog is seen from: the eye's, but Unreal's at most 65536 units above its lowest
+// layer with density (its rays, and its glow's lobe, start there).
+double observerHeight(const Fog& fog, double eyeY);
 
 // Field errors name the Fog member, e.g. "/visibilityRange".
 std::optional<Error> validate(const Fog& fog);
