@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "effects/fog.h"
+#include "log_mean.h"
 
 namespace effects::fog {
 
@@ -14,16 +15,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 const double kLn2 = std::log(2.0);
 
-// x * y with 0 * inf = 0 (a level ray to the sky rises by 0).
-double times(double x, double y) { return x == 0.0 || y == 0.0 ? 0.0 : x * y; }
-
-// log((1 - e^-x) / x), the mean of e^(-x s) over s in [0, 1], stable for every x.
-double logMean(double x) {
-  if (std::fabs(x) < 1e-8) return -0.5 * x;
-  if (x > 0.0) return std::log(-std::expm1(-x)) - std::log(x);
-  if (x > -700.0) return std::log(std::expm1(-x)) - std::log(-x);
-  return -x - std::log(-x);
-}
+using detail::logG;
+using detail::mulZero;
 
 // ---- Filament (shaders/src/surface_fog.fs, fog()) ----------------------------------------------
 // Its mean density over the whole ray [0, d]: the density at the camera, times the mean of the
@@ -43,7 +36,7 @@ double filamentDepth(const Fog& fog, double originY, double dirY, double d, doub
     return kInf;
   }
   const double fh = b * dirY * d;
-  const double l = logDensity + (std::fabs(fh) > kFilamentNearLevel ? logMean(fh) : 0.0) + std::log(d - from);
+  const double l = logDensity + (std::fabs(fh) > kFilamentNearLevel ? logG(fh) : 0.0) + std::log(d - from);
   return l > 709.0 ? kInf : std::exp(l);
 }
 
@@ -82,8 +75,8 @@ UnrealRay unrealRay(const Fog& fog, double originY, double dirY, double distance
   const int n = unrealLayers(fog, layers);
   const double observer = observerHeight(fog, originY);
   // The vector from the observer to the point: the camera's, lowered with the observer.
-  const double horizontal = times(distance, std::sqrt(std::max(0.0, 1.0 - dirY * dirY)));
-  const double vy = times(distance, dirY) + (originY - observer);
+  const double horizontal = mulZero(distance, std::sqrt(std::max(0.0, 1.0 - dirY * dirY)));
+  const double vy = mulZero(distance, dirY) + (originY - observer);
   UnrealRay r;
   r.length = std::hypot(horizontal, vy);
   r.rayLength = r.length;

@@ -1,4 +1,5 @@
 #include "effects/fog.h"
+#include "log_mean.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,16 +15,8 @@ const double kLn255 = std::log(255.0);  // -ln(1/255): complete to 8 bits
 
 bool finite(double v) { return std::isfinite(v); }
 
-// x * y where 0 * infinity counts as 0: a zero coefficient means "no fog", whatever the distance.
-double mulZero(double x, double y) { return (x == 0.0 || y == 0.0) ? 0.0 : x * y; }
-
-// log g(x), g(x) = (1 - e^-x) / x, stable for all real x.
-double logG(double x) {
-  if (x == 0.0) return 0.0;
-  if (x > 0.0) return std::log(-std::expm1(-x)) - std::log(x);
-  if (x > -700.0) return std::log(std::expm1(-x)) - std::log(-x);
-  return -x - std::log(-x);  // e^-x dominates; log1p(-e^x) underflows to 0
-}
+using detail::logG;
+using detail::mulZero;
 
 }  // namespace
 

@@ -104,7 +104,8 @@ Where Filament differs from effectd's exact integral (effectd at cea8743):
   weight ((1 - f) * color), the strict cutoff (d > cutOffDistance), no fog before the start.
 """
 import math
-import struct
+
+from floats import f32
 
 INF = math.inf
 FLT_EPSILON = 1.1920928955078125e-07
@@ -120,16 +121,6 @@ ENGINE_DEFAULTS = {
     "iblSample": None, "iblLevels": 1, "cameraNear": 0.1, "cameraFar": 100.0,
     "blendMode": "opaque", "alpha": 1.0,
 }
-
-
-def f32(x):
-    """x stored as a C++ float (round to nearest; overflow to +-inf)."""
-    if math.isnan(x) or math.isinf(x):
-        return x
-    try:
-        return struct.unpack("f", struct.pack("f", x))[0]
-    except OverflowError:
-        return math.copysign(INF, x)
 
 
 def _exp(x):

@@ -116,7 +116,8 @@ Where Unreal differs from effectd's exact integral (effectd at cea8743):
   cutoff (L > cutoff), the exact integral over [StartDistance, L] with two layers.
 """
 import math
-import struct
+
+from floats import f32
 
 INF = math.inf
 FLT_MAX = 3.4028234663852886e38
@@ -134,16 +135,6 @@ DEFAULTS = {
     "DirectionalInscatteringLuminance": (0.0, 0.0, 0.0),
 }
 ENGINE_DEFAULTS = {"SunLightColor": (1.0, 1.0, 1.0), "ExcludeDistance": 0.0, "SimpleFog": False}
-
-
-def f32(x):
-    """x stored as a C++ float (round to nearest; overflow to +-inf)."""
-    if math.isnan(x) or math.isinf(x):
-        return x
-    try:
-        return struct.unpack("f", struct.pack("f", x))[0]
-    except OverflowError:
-        return math.copysign(INF, x)
 
 
 def _exp2(x):
