@@ -228,6 +228,7 @@ TEST(FogApi, TableOverTheLimitIs413) {
   auto p =
       expectProblem(s.postJson("/v1/fog", json{{"fog", {{"visibilityRange", 5}}}, {"table", {{"size", 1001}}}}), 413);
   EXPECT_TRUE(hasPointer(p, "/table/size")) << p;
+  EXPECT_NE(p["detail"].get<std::string>().find("--max-table-size"), std::string::npos) << p;  // the flag to raise
 }
 
 

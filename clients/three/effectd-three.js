@@ -178,9 +178,10 @@ export function boltFromAnswer(answer, options = {}) {
 
 // ---- bubble -----------------------------------------------------------------------------------
 
-// The draws /v1/bubble's shader.draw and shader.blend name: the film's far side then its near
-// side, each what passes through (multiplied) then what it reflects (added); the paper model's
-// near side, alpha-blended.
+// The draws /v1/bubble's shader.draw and shader.blend name: the film's far side (unless
+// features.backFace is off: shader.draw then says front faces only) then its near side, each what
+// passes through (multiplied) then what it reflects (added); the paper model's near side,
+// alpha-blended.
 const FILM_PASSES = [
   { side: THREE.BackSide, pass: 0 }, { side: THREE.BackSide, pass: 1 },
   { side: THREE.FrontSide, pass: 0 }, { side: THREE.FrontSide, pass: 1 },
@@ -235,7 +236,10 @@ export function bubbleFromAnswer(answer, { environment = null, flow = null } = {
   const group = new THREE.Group();
   group.name = 'effectd bubble';
   const materials = [];
-  for (const [order, { side, pass }] of (film ? FILM_PASSES : [{ side: THREE.FrontSide, pass: 0 }]).entries()) {
+  const backFaces = film && shader.draw.startsWith('back faces');
+  const passes = film ? (backFaces ? FILM_PASSES : FILM_PASSES.filter((p) => p.side === THREE.FrontSide))
+                      : [{ side: THREE.FrontSide, pass: 0 }];
+  for (const [order, { side, pass }] of passes.entries()) {
     const uniforms = {
       uModel: { value: new THREE.Matrix4() }, uViewProjection: { value: new THREE.Matrix4() },
       uCameraPosition: { value: new THREE.Vector3() }, uEnvironment: { value: environment }, uFlowTexture: { value: flow },

@@ -297,7 +297,7 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
                  {"attributes", s.attributes},
                  {"blend", filmModel ? "uPass 0: colour ZERO, SRC_COLOR, alpha ZERO, SRC_ALPHA; uPass 1: ONE, ONE (or "
                                        "uPass 2 alone: ONE, ONE_MINUS_SRC_ALPHA, grey transmission)"
-                                     : "SRC_ALPHA, ONE_MINUS_SRC_ALPHA"},
+                                     : "colour SRC_ALPHA, ONE_MINUS_SRC_ALPHA; alpha ONE, ONE_MINUS_SRC_ALPHA"},
                  {"draw", std::string(filmModel && features.backFace ? "back faces (cull front), then front faces "
                                                                        "(cull back)"
                                                                      : "front faces (cull back)") +

@@ -121,6 +121,8 @@ try {
       ['paper', { shading: 'paper', mesh: { level: 4 }, features: { wobble: false, textureFlow: false, iridescence: true }, time: 3 }],
       // The mesh at rest, the shader wobbles it: one wobble, as the preview draws it (not two).
       ['film, wobbling', { mesh: { level: 4 }, params: { wobbleAmplitude: 0.12 }, time: 3 }],
+      // Without back faces the answer draws the near side only: so must the kit.
+      ['film, front faces only', { mesh: { level: 4 }, features: { wobble: false, backFace: false }, time: 3 }],
     ]) {
       const film = name.startsWith('film');
       const answer = await (await post('/v1/bubble', { ...request, shader: { language: 'glsl-es-300' }, thinFilm: { encoding: 'rgba16f' },
