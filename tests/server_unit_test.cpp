@@ -48,6 +48,13 @@ TEST(Problem, PlacesAnEffectsFieldThroughItsTable) {
   EXPECT_EQ(placeField("/uvs/3", "/p", whole), "/p/attributes/TEXCOORD_1");
   EXPECT_EQ(placeField("/weights/3", "/p", whole), "/p/indices");
   EXPECT_EQ(placeField("", "/p", whole), "/p/indices");
+  // A limit's flag is named in a 413's message, only there.
+  const FieldTable limited = {{"size", {"/table/size", 1, "--max-table-size"}}};
+  ApiError over = toApiError({effects::ErrorKind::kLimitExceeded, "/size", "too large"}, "/fog", limited);
+  EXPECT_EQ(over.errors.at(0).pointer, "/table/size");
+  EXPECT_EQ(over.errors.at(0).message, "too large (--max-table-size)");
+  ApiError invalid = toApiError({effects::ErrorKind::kInvalidArgument, "/size", "must be >= 2"}, "/fog", limited);
+  EXPECT_EQ(invalid.errors.at(0).message, "must be >= 2");
 }
 
 TEST(Schema, AcceptsValidInstances) {

@@ -251,14 +251,11 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
   auto build = [&](const fog::Fog& f, const std::string& pointer) {
     auto t = fog::buildTable(f, request.table);
     // The table's options sit under "table"; the fog's own parameters under its pointer.
-    if (!t.ok()) {
-      effects::Error e = t.error();
-      if (e.kind == effects::ErrorKind::kLimitExceeded) e.message += " (--max-table-size)";
-      throwError(e, pointer,
+    if (!t.ok())
+      throwError(t.error(), pointer,
                  {{"range", {ctx.at + "/table/range"}},
-                  {"size", {ctx.at + "/table/size"}},
+                  {"size", {ctx.at + "/table/size", 1, "--max-table-size"}},
                   {"maxError", {ctx.at + "/table/maxError"}}});
-    }
     reply.computeMs += t.value().stats.elapsedMs;
     stats.push_back(statsJson(t.value().stats));
     return tableJson(t.value(), f, tableOpts, objectColors);

@@ -236,11 +236,7 @@ lt::Params boltParams(const LightningRequest& r, const json& body, const Config&
 
 lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
   auto grown = lt::grow(p);
-  if (!grown.ok()) {
-    effects::Error e = grown.error();
-    if (e.field == "/maxSteps") e.message += " (--max-growth-steps / maxSteps)";
-    throwError(e, at);
-  }
+  if (!grown.ok()) throwError(grown.error(), at, {{"maxSteps", {at + "/maxSteps", 1, "--max-growth-steps / maxSteps"}}});
   return std::move(grown.value());
 }
 

@@ -1,5 +1,4 @@
 // POST /v1/tangents — indexed triangle mesh (JSON) or binary glTF -> vertex tangents.
-#include <cstring>
 #include <map>
 
 #include <effects/tangents.h>

@@ -26,15 +26,26 @@ const char* statusTitle(int status) {
   }
 }
 
-std::string placeField(const std::string& field, const std::string& prefix, const FieldTable& table) {
-  // field = "/name" then, optionally, "/element" and deeper parts.
+namespace {
+
+// The table's entry for `field` ("/name..."): its name's, else "", else none.
+const FieldPlace* placeOf(const std::string& field, const FieldTable& table) {
   const size_t nameEnd = field.find('/', 1);
   const std::string name = field.substr(field.empty() ? 0 : 1, nameEnd == std::string::npos ? std::string::npos : nameEnd - 1);
-  const std::string rest = nameEnd == std::string::npos ? "" : field.substr(nameEnd);
   auto place = table.find(name);
   if (place == table.end() || field.empty()) place = table.find("");
-  if (place == table.end()) return prefix + field;
-  const FieldPlace& to = place->second;
+  return place == table.end() ? nullptr : &place->second;
+}
+
+}  // namespace
+
+std::string placeField(const std::string& field, const std::string& prefix, const FieldTable& table) {
+  // field = "/name" then, optionally, "/element" and deeper parts.
+  const FieldPlace* place = placeOf(field, table);
+  if (!place) return prefix + field;
+  const FieldPlace& to = *place;
+  const size_t nameEnd = field.find('/', 1);
+  const std::string rest = nameEnd == std::string::npos ? "" : field.substr(nameEnd);
   if (to.width == 0) return to.pointer;
   if (to.width == 1 || rest.empty()) return to.pointer + rest;
   // "/7/..." -> the element's first number on the wire: 7 * width.
@@ -55,8 +66,12 @@ ApiError toApiError(const effects::Error& error, const std::string& prefix, cons
       e = {413, "limit-exceeded", "Request exceeds a configured limit", "", {}, {}};
       break;
   }
-  e.detail = (pointer.empty() ? std::string("request") : pointer) + ": " + error.message;
-  e.errors.push_back({pointer, error.message});
+  std::string message = error.message;
+  if (const FieldPlace* place = placeOf(error.field, table);
+      place && !place->flag.empty() && error.kind == effects::ErrorKind::kLimitExceeded)
+    message += " (" + place->flag + ")";
+  e.detail = (pointer.empty() ? std::string("request") : pointer) + ": " + message;
+  e.errors.push_back({pointer, message});
   return e;
 }
 

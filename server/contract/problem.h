@@ -33,9 +33,11 @@ struct ApiError {
 // many wire numbers one of its elements takes (a vertex of flat positions: 3; 0: the element is
 // not on the wire, point at the whole field). The entry "" places every name the table does not
 // list; without it they go under the prefix passed down (RequestContext::at and the like).
+// `flag`: the operator's flag (or field) that sets the field's limit, named in a 413's message.
 struct FieldPlace {
   std::string pointer;
   size_t width = 1;
+  std::string flag = "";
 };
 using FieldTable = std::map<std::string, FieldPlace>;
 // The JSON pointer of an effect's `field` (above).

@@ -16,13 +16,13 @@
 
 #include <effects/parallel.h>
 
-#include "http/admission.h"
 #include "contract/config.h"
+#include "contract/problem.h"
+#include "contract/schema.h"
+#include "http/admission.h"
 #include "http/idle_trim.h"
 #include "http/metrics.h"
-#include "contract/problem.h"
 #include "http/response_cache.h"
-#include "contract/schema.h"
 
 namespace effects {
 struct Error;
