@@ -1,6 +1,9 @@
 // effects/fog: the paper's worked example, X3D semantics, stiff and extreme inputs, tables.
 #include <cmath>
 #include <limits>
+#include <random>
+#include <vector>
+#include <algorithm>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -655,6 +658,141 @@ TEST(Fog, SmallestSizeForErrorMeetsIt) {
         EXPECT_GT(buildTable(f, smaller).value().maxError, target) << toString(t) << " not minimal";
       }
     }
+  }
+}
+
+// Example 08's fog (examples/08-sunset-fog.json) and the steep single layer of issue 47.
+Fog sunsetFog() {
+  Fog f;
+  f.type = FogType::kHeight;
+  f.color = {0.42, 0.36, 0.42};
+  f.density = 0.012;
+  f.heightFalloff = 0.06;
+  f.startDistance = 3;
+  f.maxOpacity = 0.97;
+  f.secondLayer = HeightLayer{0.05, 0.9, 0.0};
+  Directional d;
+  d.color = {0.2, 0.1, 0.04};
+  d.direction = {0.02, 0.06, -1};
+  d.g = 0.55;
+  d.startDistance = 10;
+  f.directional = d;
+  return f;
+}
+Fog steepFog() {
+  Fog f;
+  f.type = FogType::kHeight;
+  f.density = 0.05;
+  f.heightFalloff = 0.2;
+  return f;
+}
+
+// A warped table looked up as docs/using/fog.md does it (v by asinh, u over the row's span,
+// bilinear between entries), written here from the formulas, not through table.cpp's sampler.
+double warpedLookup(const Table& t, const std::vector<float>& values, double start, double y, double d) {
+  const WarpedAxes& a = t.warped;
+  const double v = 0.5 + std::asinh(a.rowK * y) / (2.0 * std::asinh(a.rowK));
+  const double span = warpedSpan(a, y, start);
+  const double u = span > 0.0 ? std::clamp((d - start) / span, 0.0, 1.0) : 1.0;
+  const double x = u * double(t.width - 1), yy = v * double(t.height - 1);
+  const size_t i = std::min(size_t(x), t.width - 2), j = std::min(size_t(yy), t.height - 2);
+  const double fx = x - double(i), fy = yy - double(j);
+  auto at = [&](size_t jj, size_t ii) { return double(values[jj * t.width + ii]); };
+  return (at(j, i) * (1 - fx) + at(j, i + 1) * fx) * (1 - fy) + (at(j + 1, i) * (1 - fx) + at(j + 1, i + 1) * fx) * fy;
+}
+
+// The largest lookup error at random rays and distances (half of them within 0.05 of the
+// horizon, where rows are dense): an estimate that does not share the table's own sampling.
+double randomLookupError(const Fog& f, const Table& t, double cameraHeight, int n) {
+  std::mt19937 rng(47);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double worst = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double y = k % 2 ? -1.0 + 2.0 * unit(rng) : -0.05 + 0.1 * unit(rng);
+    const double d = t.rangeEnd * unit(rng);
+    worst = std::max(worst, std::fabs(warpedLookup(t, t.factor, t.warped.factorStart, y, d) -
+                                      factorAtElevation(f, cameraHeight, y, d)));
+    if (!t.inscatter.empty())
+      worst = std::max(worst, std::fabs(warpedLookup(t, t.inscatter, t.warped.inscatterStart, y, d) -
+                                        inscatterWeight(f, cameraHeight, y, d)));
+  }
+  return worst;
+}
+
+TEST(Fog, WarpedHeightTablesMeetAHundredthAt64x32) {
+  struct Case {
+    const char* name;
+    Fog fog;
+    double cameraHeight;
+    double linearError;  // below the 64 x 32 linear table's error (0.485 sunset, 0.0139 steep)
+  };
+  for (const Case& c : {Case{"sunset", sunsetFog(), 1.7, 0.4}, Case{"steep", steepFog(), 2.0, 0.0139}}) {
+    TableOptions o;
+    o.size = 64;
+    o.elevations = 32;
+    o.cameraHeight = c.cameraHeight;
+    auto linear = buildTable(c.fog, o);
+    ASSERT_TRUE(linear.ok());
+    EXPECT_GT(linear.value().maxError, c.linearError) << c.name;
+    o.layout = TableOptions::Layout::kWarped;
+    o.elevations = 0;  // warped: half the columns
+    auto warped = buildTable(c.fog, o);
+    ASSERT_TRUE(warped.ok()) << warped.error().message;
+    const Table& t = warped.value();
+    EXPECT_EQ(t.height, 32u) << c.name;
+    EXPECT_LE(t.maxError, 0.01) << c.name;
+    // The reported error against an estimate it was not computed with.
+    const double measured = randomLookupError(c.fog, t, c.cameraHeight, 40000);
+    EXPECT_LE(measured, t.maxError * 1.25 + 1e-6) << c.name << ": reported " << t.maxError;
+    EXPECT_GT(measured, t.maxError * 0.5) << c.name << ": reported " << t.maxError << " is far above the lookup's";
+  }
+}
+
+TEST(Fog, WarpedTablesOfEachConventionAndTheSmallestForAnError) {
+  for (Convention conv : {Convention::kEffectd, Convention::kFilament, Convention::kUnreal}) {
+    Fog f = steepFog();
+    f.convention = conv;
+    f.startDistance = 4;
+    TableOptions o;
+    o.layout = TableOptions::Layout::kWarped;
+    o.cameraHeight = 2;
+    o.maxError = 0.01;
+    auto t = buildTable(f, o);
+    ASSERT_TRUE(t.ok()) << toString(conv) << t.error().message;
+    EXPECT_LE(t.value().maxError, 0.01) << toString(conv);
+    EXPECT_EQ(t.value().height, tableRows(o, t.value().width));
+    EXPECT_LT(t.value().width * t.value().height, 64u * 32u) << toString(conv);
+    EXPECT_LE(randomLookupError(f, t.value(), 2, 20000), t.value().maxError * 1.25 + 1e-6) << toString(conv);
+    TableOptions smaller = o;
+    smaller.maxError = 0;
+    smaller.size = t.value().width - 1;
+    EXPECT_GT(buildTable(f, smaller).value().maxError, 0.01) << toString(conv) << " not minimal";
+  }
+}
+
+TEST(Fog, WarpedAxesStayFiniteOnStiffFogs) {
+  // Dense, thin, steep, flat, a camera far below and far above its layer, no opacity at all.
+  struct Case {
+    double density, falloff, base, camera, maxOpacity;
+  };
+  for (const Case& c : {Case{50, 5, 0, 0, 1}, Case{1e-9, 0.01, 0, 0, 1}, Case{0.05, 50, 0, 2, 1}, Case{0.05, 0, 0, 2, 1},
+                        Case{0.05, 0.2, 0, -3000, 1}, Case{0.05, 0.2, 0, 3000, 1}, Case{0.05, 0.2, 0, 2, 0}}) {
+    Fog f = steepFog();
+    f.density = c.density;
+    f.heightFalloff = c.falloff;
+    f.maxOpacity = c.maxOpacity;
+    TableOptions o;
+    o.layout = TableOptions::Layout::kWarped;
+    o.size = 64;
+    o.cameraHeight = c.camera;
+    o.rangeEnd = 1000.0;
+    auto t = buildTable(f, o);
+    ASSERT_TRUE(t.ok()) << t.error().message;
+    const WarpedAxes& a = t.value().warped;
+    for (double v : {a.rowK, a.kappa, a.lambda, a.falloff, t.value().maxError}) EXPECT_TRUE(std::isfinite(v)) << c.density;
+    for (float x : t.value().factor) ASSERT_TRUE(x >= 0.0f && x <= 1.0f) << c.density << " " << c.falloff;
+    EXPECT_LE(randomLookupError(f, t.value(), c.camera, 4000), t.value().maxError * 1.25 + 1e-6)
+        << c.density << " " << c.falloff << " " << c.camera;
   }
 }
 

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "effects/fog.h"
@@ -9,12 +10,90 @@
 #include <glm/vec3.hpp>
 
 namespace effects::fog {
+
+WarpedAxes warpedAxes(const Fog& fog, double cameraHeight, double rangeStart, double rangeEnd) {
+  WarpedAxes a;
+  a.end = rangeEnd;
+  a.factorStart = std::clamp(fog.startDistance, rangeStart, rangeEnd);  // f = 1 nearer, in every convention
+  a.inscatterStart = std::clamp(std::max(fog.startDistance, glowStart(fog)), rangeStart, rangeEnd);
+  // The steepest layer that has fog, and its density at the camera in log space (a camera far
+  // below the layer's base would overflow it). Far along a downward ray it is the densest;
+  // nearer, another layer may add to it, which only shortens the distance to completeness.
+  double logDensity = -std::numeric_limits<double>::infinity();
+  auto add = [&](double density, double falloff, double base) {
+    if (!(density > 0.0) || falloff < a.falloff) return;
+    const double l = std::log(density) - falloff * (cameraHeight - base);
+    logDensity = falloff > a.falloff ? l : std::max(logDensity, l);
+    a.falloff = falloff;
+  };
+  add(fog.density, fog.heightFalloff, fog.baseHeight);
+  if (fog.secondLayer) add(fog.secondLayer->density, fog.secondLayer->heightFalloff, fog.secondLayer->baseHeight);
+  if (!(a.falloff > 0.0) || !std::isfinite(logDensity)) return a;  // no height dependence: even columns, rows
+  // q: the optical depth at which the fog is complete, f = max(1/255, 1 - maxOpacity).
+  const double q = -std::log(std::max(1.0 / 255.0, 1.0 - fog.maxOpacity));
+  constexpr double kSpanOverComplete = 1.5;  // columns reach 1.5x the distance where f is complete
+  a.kappa = std::exp(std::clamp(std::log(q * a.falloff) - logDensity, -690.0, 69.0));
+  a.lambda = kSpanOverComplete / a.falloff;
+  // At the far end a point's fog changes with elevation on the scale 1 / (falloff span); rows
+  // spaced by asinh(K y) are 2 asinh(K) / (K (rows - 1)) apart there.
+  a.rowK = std::clamp(0.5 * a.falloff * (rangeEnd - a.factorStart), 1.0, 1e6);
+  return a;
+}
+
+const char* toString(TableOptions::Layout layout) {
+  return layout == TableOptions::Layout::kWarped ? "warped" : "linear";
+}
+
+std::optional<TableOptions::Layout> layoutFromString(const std::string& name) {
+  for (auto l : {TableOptions::Layout::kLinear, TableOptions::Layout::kWarped})
+    if (name == toString(l)) return l;
+  return std::nullopt;
+}
+
+size_t tableRows(const TableOptions& o, size_t size) {
+  if (o.elevations) return o.elevations;
+  return o.layout == TableOptions::Layout::kWarped ? std::max<size_t>(2, (size + 1) / 2) : size;
+}
+
+double warpedRowY(const WarpedAxes& a, double v) {
+  return std::clamp(std::sinh(std::asinh(a.rowK) * (2.0 * v - 1.0)) / a.rowK, -1.0, 1.0);
+}
+
+double warpedSpan(const WarpedAxes& a, double y, double start) {
+  const double full = std::max(a.end - start, 0.0);
+  if (!(y < 0.0) || !(a.kappa > 0.0)) return full;
+  const double k = a.kappa * std::exp(a.falloff * y * start);  // kappa at the row's start
+  const double x = -k * y;
+  const double lnOverX = x > 0.0 ? std::log1p(x) / x : 1.0;
+  // A smooth minimum of the two: a kink in span(y) would be a kink along every column.
+  const double l = a.lambda * k * lnOverX, lo = std::min(full, l), hi = std::max(full, l);
+  return hi > 0.0 ? lo * std::pow(1.0 + std::pow(lo / hi, 8.0), -1.0 / 8.0) : 0.0;
+}
+
 namespace {
 
-double dirYAt(const Table& t, double row) { return t.height == 1 ? 0.0 : -1.0 + 2.0 * row / double(t.height - 1); }
-double distAt(const Table& t, double col) {
-  if (col >= double(t.width - 1)) return t.rangeEnd;  // exactly: a cutoff at the end must not round past it
-  return t.rangeStart + (t.rangeEnd - t.rangeStart) * col / double(t.width - 1);
+using Layout = TableOptions::Layout;
+
+// Where row `row` and column `col` (fractional indices) of a table sit: the ray's y component,
+// and the distance along it. A warped table's columns depend on the row's y and on the
+// channel: the glow's columns begin where the glow does.
+double rowY(const Table& t, double row) {
+  if (t.height == 1) return 0.0;
+  if (t.layout == Layout::kWarped) return warpedRowY(t.warped, row / double(t.height - 1));
+  return -1.0 + 2.0 * row / double(t.height - 1);
+}
+struct Extent {
+  double start, span, end;
+};
+Extent rowExtent(const Table& t, double y, bool glow) {
+  if (t.layout == Layout::kLinear) return {t.rangeStart, t.rangeEnd - t.rangeStart, t.rangeEnd};
+  const double start = glow ? t.warped.inscatterStart : t.warped.factorStart;
+  return {start, warpedSpan(t.warped, y, start), t.warped.end};
+}
+double columnDistance(const Extent& e, const Table& t, double col) {
+  // exactly: a cutoff at the end must not round past it
+  if (col >= double(t.width - 1)) return e.span >= e.end - e.start ? e.end : e.start + e.span;
+  return e.start + e.span * col / double(t.width - 1);
 }
 
 double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
@@ -28,19 +107,20 @@ double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
 // (no 1 - e^{-x} cancellation). That leaves one exp per entry. Rows where c or e^{|k| t}
 // could overflow take the closed form per entry (heightOpticalDepth's log-space evaluation),
 // as do fogs with a start distance, a second layer or an engine's convention.
-bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Table& t, float* row) {
+bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Extent& e, size_t width, float* row) {
   const double a = fog.density, b = fog.heightFalloff;
   const double k = b * dirY;
   const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
-  if (a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * t.rangeEnd > 700.0) return false;
+  const double rangeStart = e.start, rangeEnd = e.start + e.span;
+  if (width < 2 || a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * rangeEnd > 700.0) return false;
   if (fog.startDistance > 0.0 || fog.secondLayer || fog.convention != Convention::kEffectd) return false;
   if (k != 0.0 && std::fabs(k) < 1e-290) return false;  // -m/k would lose its precision in subnormals
   const double c = std::exp(logC);
-  const double dt = (t.rangeEnd - t.rangeStart) / double(t.width - 1);
+  const double dt = e.span / double(width - 1);
   const double rho = std::expm1(-k * dt);
-  double m = std::expm1(-k * t.rangeStart);  // e^{-k t} - 1 at the first distance
-  for (size_t i = 0; i < t.width; ++i) {
-    const double d = i + 1 == t.width ? t.rangeEnd : t.rangeStart + dt * double(i);
+  double m = std::expm1(-k * rangeStart);  // e^{-k t} - 1 at the first distance
+  for (size_t i = 0; i < width; ++i) {
+    const double d = i + 1 == width ? rangeEnd : rangeStart + dt * double(i);
     const double tau = k == 0.0 ? c * d : c * (-m / k);
     row[i] = static_cast<float>(engineLimits(fog, d, std::exp(-tau)));
     m += rho * (m + 1.0);
@@ -67,7 +147,7 @@ bool fillAtmosphericRow(const Fog& fog, Table& t, size_t j) {
   }
   bool anchored = false;
   for (size_t i = 0; i < w; ++i) {
-    const double d = distAt(t, double(i));
+    const double d = columnDistance(rowExtent(t, 0.0, false), t, double(i));
     const double beyond = d - fog.startDistance;  // the ray's part past the start
     if (!(beyond > 0.0)) {
       ext = ins = glm::dvec3(1.0);
@@ -100,14 +180,16 @@ void fill(const Fog& fog, double cameraHeight, Table& t) {
   if (fog.directional) t.inscatter.resize(n);
   if (rgb) t.transmittanceRgb.resize(3 * n), t.scatteredRgb.resize(3 * n);
   for (size_t j = 0; j < t.height; ++j) {
-    const double dirY = dirYAt(t, double(j));
-    const bool rowDone = fog.type == FogType::kHeight ? fillHeightRow(fog, cameraHeight, dirY, t, &t.factor[j * t.width])
+    const double dirY = rowY(t, double(j));
+    const Extent ef = rowExtent(t, dirY, false), eg = rowExtent(t, dirY, true);
+    const bool rowDone = fog.type == FogType::kHeight ? fillHeightRow(fog, cameraHeight, dirY, ef, t.width, &t.factor[j * t.width])
                                                       : rgb && fillAtmosphericRow(fog, t, j);
     for (size_t i = 0; i < t.width; ++i) {
       const size_t e = j * t.width + i;
-      const double d = distAt(t, double(i));
-      if (fog.directional) t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, d));
+      if (fog.directional)
+        t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, columnDistance(eg, t, double(i))));
       if (rowDone) continue;
+      const double d = columnDistance(ef, t, double(i));
       t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
       if (!rgb) continue;
       const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
@@ -125,6 +207,10 @@ Result<Table> sized(const Fog& fog, const TableOptions& o, size_t width, size_t 
   t.height = height;
   t.rangeStart = start;
   t.rangeEnd = end;
+  if (fog.type == FogType::kHeight && o.layout == Layout::kWarped) {
+    t.layout = Layout::kWarped;
+    t.warped = warpedAxes(fog, o.cameraHeight, start, end);
+  }
   Stopwatch watch;
   fill(fog, o.cameraHeight, t);
   t.stats.elapsedMs = watch.ms();
@@ -137,15 +223,23 @@ Result<Table> sized(const Fog& fog, const TableOptions& o, size_t width, size_t 
 
 double measureTableError(const Fog& fog, const Table& t, double cameraHeight, int sub, double* where) {
   double worst = 0.0, worstAt = t.rangeStart;
-
+  auto note = [&](double e, double d) {
+    if (e > worst) worst = e, worstAt = d;
+  };
   const size_t rows = t.height == 1 ? 1 : (t.height - 1) * size_t(sub) + 1;
   const size_t cols = (t.width - 1) * size_t(sub) + 1;
+  // A warped row's lookup holds its last column past the row's span, up to the range's end:
+  // as many samples again there, evenly in distance.
+  const size_t past = t.layout == Layout::kWarped ? cols : 0;
   for (size_t r = 0; r < rows; ++r) {
     double row = t.height == 1 ? 0.0 : double(r) / sub;
     size_t j0 = std::min(size_t(row), t.height - 1), j1 = std::min(j0 + 1, t.height - 1);
     double fy = row - double(j0);
-    for (size_t c = 0; c < cols; ++c) {
-      double col = double(c) / sub;
+    const double y = rowY(t, row);
+    const Extent ef = rowExtent(t, y, false), eg = rowExtent(t, y, true);
+    for (size_t c = 0; c < cols + past; ++c) {
+      const bool beyond = c >= cols;
+      double col = beyond ? double(t.width - 1) : double(c) / sub;
       size_t i0 = std::min(size_t(col), t.width - 1), i1 = std::min(i0 + 1, t.width - 1);
       double fx = col - double(i0);
       auto lerp = [&](const std::vector<float>& v, size_t stride = 1, size_t channel = 0) {
@@ -154,20 +248,25 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
         double lerp1 = at(j1, i0) + (at(j1, i1) - at(j1, i0)) * fx;
         return lerp0 + (lerp1 - lerp0) * fy;
       };
-      double d = distAt(t, col);
-      double e = std::fabs(lerp(t.factor) - exact(fog, cameraHeight, d, dirYAt(t, row)));
-      if (!t.inscatter.empty())
-        e = std::max(e, std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, dirYAt(t, row), d)));
-      if (!t.transmittanceRgb.empty()) {
-        const glm::dvec3 tr = transmittance(fog, cameraHeight, dirYAt(t, row), d);
-        const glm::dvec3 sc = scattered(fog, cameraHeight, dirYAt(t, row), d);
-        for (size_t c = 0; c < 3; ++c)
-          e = std::max({e, std::fabs(lerp(t.transmittanceRgb, 3, c) - tr[int(c)]),
-                        std::fabs(lerp(t.scatteredRgb, 3, c) - sc[int(c)])});
+      auto distance = [&](const Extent& e) {
+        if (!beyond) return columnDistance(e, t, col);
+        const double last = e.start + e.span, k = double(c - cols + 1) / double(past);
+        return last + (e.end - last) * k;
+      };
+      const double d = distance(ef);
+      if (beyond && !(d > ef.start + ef.span) && !(distance(eg) > eg.start + eg.span)) continue;
+      note(std::fabs(lerp(t.factor) - exact(fog, cameraHeight, d, y)), d);
+      if (!t.inscatter.empty()) {
+        const double dg = distance(eg);
+        note(std::fabs(lerp(t.inscatter) - inscatterWeight(fog, cameraHeight, y, dg)), dg);
       }
-      if (e > worst) {
-        worst = e;
-        worstAt = d;
+      if (!t.transmittanceRgb.empty()) {
+        const glm::dvec3 tr = transmittance(fog, cameraHeight, y, d);
+        const glm::dvec3 sc = scattered(fog, cameraHeight, y, d);
+        for (size_t c3 = 0; c3 < 3; ++c3)
+          note(std::max(std::fabs(lerp(t.transmittanceRgb, 3, c3) - tr[int(c3)]),
+                        std::fabs(lerp(t.scatteredRgb, 3, c3) - sc[int(c3)])),
+               d);
       }
     }
   }
@@ -199,7 +298,7 @@ void measure(const Fog& fog, const TableOptions& o, int sub, Table& t) {
 
 // The table of the size asked for (o.size, and o.elevations for height fog).
 Result<Table> fixedSize(const Fog& fog, const TableOptions& o, bool twoD, int sub, double start, double end) {
-  size_t m = twoD ? (o.elevations ? o.elevations : o.size) : 1;
+  size_t m = twoD ? tableRows(o, o.size) : 1;
   if (o.size < 2 || (twoD && m < 2)) return invalid("/size", "must be >= 2");
   if (entries(twoD, o.size, m) > o.maxSize)
     return overLimit("/size", "table of " + std::to_string(entries(twoD, o.size, m)) +
@@ -209,24 +308,38 @@ Result<Table> fixedSize(const Fog& fog, const TableOptions& o, bool twoD, int su
   return t;
 }
 
-// Smallest N with error <= maxError: double N until it meets the bound, then bisect.
-// (Height fog tables stay square.) The error of linear interpolation falls like 1/N^2 for
-// smooth f, so the search ends after a handful of measurements.
+// Smallest N with error <= maxError: double N until it meets the bound, then bisect. Height
+// fog tables have N rows (kLinear, square), or the asked elevations, or N/2 rows (kWarped: its
+// rows need fewer samples than its columns). The error of linear interpolation falls like
+// 1/N^2 for smooth f, so the search ends after a handful of measurements.
 Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD, int sub, double start, double end) {
   if (!(o.maxError > 0.0)) return invalid("/maxError", "must be > 0 when size is not given");
   Stopwatch total;
+  const bool warped = twoD && o.layout == Layout::kWarped;
+  auto rowsFor = [&](size_t n) -> size_t {
+    if (!twoD) return 1;
+    return warped ? tableRows(o, n) : n;
+  };
+  auto cells = [&](size_t n) { return double(n) * double(rowsFor(n)); };
   auto errorFor = [&](size_t n) {
-    auto t = sized(fog, o, n, twoD ? n : 1, start, end);
+    auto t = sized(fog, o, n, rowsFor(n), start, end);
     measure(fog, o, sub, t.value());
     return t;
   };
-  const size_t cap = twoD ? size_t(std::sqrt(double(o.maxSize))) : o.maxSize;  // largest N allowed
+  if (cells(2) > double(o.maxSize)) return unsatisfiable("/maxError", "not reachable within the table size limit");
+  // The largest N allowed: from an estimate, then to the exact bound.
+  size_t cap = !twoD ? o.maxSize
+               : !warped ? size_t(std::sqrt(double(o.maxSize)))
+               : o.elevations ? o.maxSize / o.elevations
+                              : size_t(std::sqrt(2.0 * double(o.maxSize)));
+  while (cap > 2 && cells(cap) > double(o.maxSize)) --cap;
+  while (cells(cap + 1) <= double(o.maxSize)) ++cap;
   size_t lo = 1, hi = 2;
   auto best = errorFor(hi);
   int measurements = 1;
   while (best.value().maxError > o.maxError) {
     lo = hi;
-    if (entries(twoD, hi * 2, hi * 2) > o.maxSize) {
+    if (cells(hi * 2) > double(o.maxSize)) {
       if (cap <= hi) return unsatisfiable("/maxError", "not reachable within the table size limit");
       hi = cap;
     } else {
@@ -236,7 +349,7 @@ Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD,
     ++measurements;
     if (best.value().maxError > o.maxError && hi == cap)
       return unsatisfiable("/maxError", "error " + shortNumber(best.value().maxError) + " at the size limit (" +
-                                            std::to_string(entries(twoD, hi, hi)) + " entries) is above the requested maximum " +
+                                            std::to_string(size_t(cells(hi))) + " entries) is above the requested maximum " +
                                             shortNumber(o.maxError));
   }
   while (hi - lo > 1) {

@@ -121,7 +121,20 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
   if (std::isfinite(f.cutoffDistance)) out["cutoffDistance"] = f.cutoffDistance;
   if (t.height > 1) {
     out["elevations"] = t.height;
-    out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";
+    if (t.layout == fog::TableOptions::Layout::kWarped) {  // (kLinear answers are as they were before layouts)
+      const fog::WarpedAxes& a = t.warped;
+      out["layout"] = fog::toString(t.layout);
+      out["elevationAxis"] = "ray direction y at v = 1/2 + asinh(k y) / (2 asinh k), row 0 at v = 0 (straight down)";
+      out["axes"] = {{"k", a.rowK},
+                     {"factorStart", a.factorStart},
+                     {"inscatterStart", a.inscatterStart},
+                     {"end", a.end},
+                     {"falloff", a.falloff},
+                     {"kappa", a.kappa},
+                     {"lambda", a.lambda}};
+    } else {
+      out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";
+    }
   }
   const std::string encoding = options.value("encoding", "json");
   out["encoding"] = encoding;
@@ -184,6 +197,7 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
   }
   opt.elevations = o.value("elevations", size_t(0));
   opt.cameraHeight = o.value("cameraHeight", 0.0);
+  opt.layout = *fog::layoutFromString(o.value("layout", fog::toString(opt.layout)));
   return opt;
 }
 

@@ -24,7 +24,7 @@ Cost fogCost(const FogRequest& r, const Config& config) {
   // With maxError the table grows until it meets the bound: at most the limit.
   const size_t size = r.table.maxError > 0 ? config.limits.maxTableSize : r.table.size;
   const bool height = r.fog.type == effects::fog::FogType::kHeight;
-  size_t entries = height ? size * (r.table.elevations ? r.table.elevations : size) : size;
+  size_t entries = height ? size * effects::fog::tableRows(r.table, size) : size;
   entries = std::min(entries, config.limits.maxTableSize);
   return {kBase + entries * (64 + kAnswerNumber * (4 + 3 * r.objectColors)) + r.samplePoints * 8 * kAnswerNumber,
           false};

@@ -117,5 +117,42 @@ for y in ys:
         rays.append((d, y))
 compare("HEIGHT rgba16f, 64 x 16", height, camera, points, rays, height["fog"]["color"])
 
+# 6. A warped HEIGHT table (section 4): example 08's sunset fog at 64 x 32, half floats. The page's
+#    lookup against the exact samples at random rays, a third of them near the horizon.
+import json
+import os
+import random
+sunset = json.load(open(os.path.join(os.path.dirname(__file__), "..", "..", "examples", "08-sunset-fog.json")))["fog"]["fog"]
+camera = (0.0, 1.7, 0.0)
+rng = random.Random(47)
+points, rays = [], []
+for k in range(3000):
+    y = rng.uniform(-0.05, 0.05) if k % 3 == 0 else rng.uniform(-1, 1)
+    d = rng.uniform(0, 180)
+    horizontal = math.sqrt(max(0.0, 1 - y * y))
+    points.append([camera[0], camera[1] + d * y, camera[2] - d * horizontal])
+    rays.append((d, y))
+for encoding in ("json", "rgba16f"):
+    request = {"fog": sunset, "table": {"size": 64, "cameraHeight": 1.7, "layout": "warped", "encoding": encoding},
+               "include": ["table", "samples"], "samples": {"camera": list(camera), "points": points}}
+    answer, _ = server.post("/v1/fog", request)
+    table = answer["table"]
+    check(table["layout"] == "warped" and table["elevations"] == 32 and table["maxError"] <= 0.01,
+          f"warped {encoding}: 64 x 32 meets 0.01", (table.get("elevations"), table["maxError"]))
+    texels = page["fog_texels"](table)
+    bound = table["maxError"] + ROUNDING[encoding]
+    worst = 0.0
+    for (d, y), sample in zip(rays, answer["samples"]):
+        got = page["fogged_warped"](table, texels, OBJECT, d, y)
+        want = [sample["factor"] * o + (1 - sample["factor"]) * c for o, c in zip(OBJECT, sunset["color"])]
+        worst = max(worst, max(abs(g - w) for g, w in zip(got, want)))
+    check(worst <= bound, f"warped {encoding}: the page's lookup within maxError + rounding",
+          f"{worst:.3g} > {bound:.3g}")
+    print(f"warped sunset {encoding}: 3000 random rays, worst {worst:.3g} (maxError {table['maxError']:.3g})")
+# Without layout the table is the linear one, as before.
+linear, _ = server.post("/v1/fog", {"fog": sunset, "table": {"size": 64, "elevations": 32, "cameraHeight": 1.7}})
+check("layout" not in linear["table"] and linear["table"]["maxError"] > 0.4, "no layout: the linear table",
+      linear["table"]["maxError"])
+
 server.close()
 check.finish()

@@ -23,13 +23,15 @@ BLOCK = re.compile(r"<!-- using-test:begin -->\s*```python\n(.*?)```\s*<!-- usin
 
 
 def page_code(name):
-    """The Python block of docs/using/<name>.md, run in a fresh namespace that is returned."""
+    """The Python blocks of docs/using/<name>.md, run in order in one fresh namespace that is
+    returned (a later block may use an earlier one's functions, as the page's reader does)."""
     path = os.path.join(ROOT, "docs", "using", f"{name}.md")
     blocks = BLOCK.findall(open(path, encoding="utf-8").read())
-    if len(blocks) != 1:
-        raise SystemExit(f"{path}: expected one python block between the using-test markers, found {len(blocks)}")
+    if not blocks:
+        raise SystemExit(f"{path}: no python block between the using-test markers")
     namespace = {"__name__": f"docs/using/{name}.md"}
-    exec(compile(blocks[0], path, "exec"), namespace)
+    for block in blocks:
+        exec(compile(block, path, "exec"), namespace)
     return namespace
 
 

@@ -201,16 +201,49 @@ struct TableOptions {
                                                // 0 = same as size
   double cameraHeight = 0.0;                   // kHeight only
   bool measureError = true;                    // dense-sampling error measurement (costs ~8 evaluations/entry)
+  // kHeight only. kLinear: rows even in the ray's y, columns even in distance (the layout of
+  // every table before it). kWarped: rows dense near the horizon and each row's columns over
+  // its own span, so that f is smooth along both axes (WarpedAxes). Other fog types ignore it.
+  enum class Layout { kLinear, kWarped } layout = Layout::kLinear;
 };
+const char* toString(TableOptions::Layout layout);  // "linear", "warped"
+std::optional<TableOptions::Layout> layoutFromString(const std::string& name);
+// Rows of a HEIGHT table of `size` columns: options.elevations if given, else `size` (kLinear,
+// square) or half of it (kWarped, at least 2).
+size_t tableRows(const TableOptions& options, size_t size);
+
+// A warped HEIGHT table's axes. A lookup for a ray of unit y component y at distance d reads
+//   row    v = 1/2 + asinh(rowK y) / (2 asinh rowK)                   (0 = straight down)
+//   column u = clamp((d - start) / span, 0, 1)
+//   span = end - start                                   when y >= 0 or kappa = 0
+//        = smin(end - start, lambda K ln(1 + x) / x)     when y < 0,
+//          K = kappa e^(falloff y start), x = -K y, smin(a, b) = m (1 + (m/M)^8)^(-1/8) with m, M
+//          the smaller and the larger of a, b
+// with start = factorStart for f and S, inscatterStart for the glow. span is lambda times the
+// distance at which the steepest layer alone, from its density at the start, would reach the
+// table's completeness level
+// (f = max(1/255, 1 - maxOpacity)) along that ray: a downward row's columns end where its fog
+// is done, however near. rowK puts rows about 1/(falloff span) apart at the horizon, the
+// scale on which a distant point's fog changes with elevation.
+struct WarpedAxes {
+  double rowK = 1.0;
+  double falloff = 0.0, kappa = 0.0, lambda = 0.0;
+  double factorStart = 0.0, inscatterStart = 0.0, end = 0.0;
+};
+WarpedAxes warpedAxes(const Fog& fog, double cameraHeight, double rangeStart, double rangeEnd);
+double warpedRowY(const WarpedAxes& axes, double v);                  // v in [0, 1] -> y
+double warpedSpan(const WarpedAxes& axes, double y, double start);  // as above
 
 struct Table {
   size_t width = 0;   // distance samples
   size_t height = 1;  // elevation samples (1 for distance-only fogs)
   double rangeStart = 0.0, rangeEnd = 0.0;
+  TableOptions::Layout layout = TableOptions::Layout::kLinear;  // kWarped: entries at warped's axes
+  WarpedAxes warped;
   std::vector<float> inscatter;  // with fog.directional: 1 - f_dir at the same samples (else empty)
   std::vector<float> transmittanceRgb, scatteredRgb;  // kAtmospheric: T and S, 3 per sample (else empty)
-  std::vector<float> factor;  // row-major [elevation][distance]; f at d_i = start + i*(end-start)/(width-1),
-                              // dirY_j = -1 + 2j/(height-1)
+  std::vector<float> factor;  // row-major [elevation][distance]; kLinear: f at d_i = start + i*(end-start)/(width-1),
+                              // dirY_j = -1 + 2j/(height-1); kWarped: at u_i = i/(width-1), v_j = j/(height-1)
   double maxError = 0.0;      // max |lerp(table) - exact| by dense sampling, over f and inscatter (if measured)
   double errorAtDistance = 0.0;
   Stats stats;  // method, elapsedMs (table only), counters: entries, evaluations
