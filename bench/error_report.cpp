@@ -449,21 +449,24 @@ void fog(bool quick, Section& tables, Section& march) {
             1000};
   const std::vector<size_t> sizes =
       quick ? std::vector<size_t>{16, 64, 256} : std::vector<size_t>{16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
-  // One series: tables of every size for `f` (height fog's are 2-D, n x n, up to the
-  // 65 536-entry bound), timed without and measured with the error pass.
-  auto series = [&](const fg::Fog& f, const std::string& name) {
+  // One series: tables of every size for `f` (height fog's are 2-D, n x n linear or n x n/2
+  // warped, up to the 65 536-entry bound), timed without and measured with the error pass.
+  using Layout = fg::TableOptions::Layout;
+  auto series = [&](const fg::Fog& f, const std::string& name, Layout layout = Layout::kLinear,
+                    double cameraHeight = 5) {
     const bool twoD = f.type == fg::FogType::kHeight;
     for (size_t n : sizes) {
-      if (twoD && n > 256) continue;
       fg::TableOptions o;
       o.size = n;
-      o.elevations = twoD ? n : 0;
-      o.cameraHeight = 5;
+      o.layout = layout;
+      o.elevations = twoD ? fg::tableRows(o, n) : 0;
+      if (twoD && n * o.elevations > o.maxSize) continue;
+      o.cameraHeight = cameraHeight;
       o.measureError = false;
       const Timing t = timeMs(quick ? 5 : 21, [&] { (void)fg::buildTable(f, o); });
       o.measureError = true;
       auto table = fg::buildTable(f, o);
-      tables.points.push_back(pointOf(name, std::to_string(n) + (twoD ? " × " + std::to_string(n) : ""), t,
+      tables.points.push_back(pointOf(name, std::to_string(n) + (twoD ? " × " + std::to_string(o.elevations) : ""), t,
                                       table.ok() ? table.value().maxError : NAN));
       tables.points.back().group = name;
     }
@@ -488,7 +491,29 @@ void fog(bool quick, Section& tables, Section& march) {
     sun.startDistance = 12;
     f.directional = sun;
     series(f, std::string(fg::toString(t)) + " + engine terms");
+    if (t == fg::FogType::kHeight) {
+      series(fogOf(t), "HEIGHT warped", Layout::kWarped);
+      series(f, "HEIGHT + engine terms warped", Layout::kWarped);
+    }
   }
+  // Example 08's sunset (examples/08-sunset-fog.json, camera at 1.7): two layers, a start, a
+  // cap and a glow from 10 m, in both layouts.
+  fg::Fog sunset = fogOf(fg::FogType::kHeight);
+  sunset.color = {0.42, 0.36, 0.42};
+  sunset.density = 0.012;
+  sunset.heightFalloff = 0.06;
+  sunset.baseHeight = 0;
+  sunset.startDistance = 3;
+  sunset.maxOpacity = 0.97;
+  sunset.secondLayer = fg::HeightLayer{0.05, 0.9, 0};
+  fg::Directional glow;
+  glow.color = {0.2, 0.1, 0.04};
+  glow.direction = {0.02, 0.06, -1};
+  glow.g = 0.55;
+  glow.startDistance = 10;
+  sunset.directional = glow;
+  series(sunset, "HEIGHT sunset (example 08)", Layout::kLinear, 1.7);
+  series(sunset, "HEIGHT sunset (example 08) warped", Layout::kWarped, 1.7);
   march = {"fog-height-march",
            "Height fog: closed-form optical depth against ray marching",
            "the closed form tau = a e^(-b(o_y-h)) t (1-e^(-x))/x (exact; checked against 200 000-step marching in the "

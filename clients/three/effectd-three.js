@@ -287,7 +287,8 @@ export function bubbleFromAnswer(answer, { environment = null, flow = null } = {
 // ---- fog --------------------------------------------------------------------------------------
 
 // /v1/fog's table (encoding rgba16f) as a texture: u = distance over table.range, v = the ray's
-// direction y over [-1, 1] when the table has elevations. RGB = in-scattered S, A = transmittance f.
+// direction y over [-1, 1] when the table has elevations; a warped HEIGHT table (table.layout
+// "warped") has the axes of docs/using/fog.md section 4. RGB = in-scattered S, A = transmittance f.
 export function fogTexture(answer) {
   const t = answer.table;
   if (!t || t.encoding !== 'rgba16f') throw new Error('the answer needs table.encoding rgba16f');
@@ -305,6 +306,9 @@ export function applyFog(material, answer, texture = fogTexture(answer)) {
   const uniforms = {
     uFogTable: { value: texture }, uFogRange: { value: new THREE.Vector2(t.range[0], t.range[1]) },
     uFogTexels: { value: new THREE.Vector2(t.size, t.elevations || 1) }, uFogCutoff: { value: t.cutoffDistance ?? 1e38 },
+    // warped: (k, falloff, kappa, lambda) and (factorStart, end); k = 0 marks a linear table
+    uFogWarp: { value: t.axes ? new THREE.Vector4(t.axes.k, t.axes.falloff, t.axes.kappa, t.axes.lambda) : new THREE.Vector4() },
+    uFogWarpRange: { value: t.axes ? new THREE.Vector2(t.axes.factorStart, t.axes.end) : new THREE.Vector2() },
   };
   material.onBeforeCompile = (program) => {
     Object.assign(program.uniforms, uniforms);
@@ -314,14 +318,26 @@ export function applyFog(material, answer, texture = fogTexture(answer)) {
     program.fragmentShader = program.fragmentShader
       .replace('void main() {', `varying vec3 vEffectdWorld;
 uniform sampler2D uFogTable; uniform vec2 uFogRange; uniform vec2 uFogTexels; uniform float uFogCutoff;
+uniform vec4 uFogWarp; uniform vec2 uFogWarpRange;
+vec2 effectdFogUv(float d, float y) {
+  if (uFogWarp.x == 0.0) return vec2(clamp((min(d, uFogRange.y) - uFogRange.x) / (uFogRange.y - uFogRange.x), 0.0, 1.0),
+                                     uFogTexels.y > 1.0 ? (y + 1.0) * 0.5 : 0.5);
+  float start = uFogWarpRange.x, span = uFogWarpRange.y - start;
+  if (y < 0.0 && uFogWarp.z > 0.0) {  // a downward row's columns end where its fog is complete
+    float K = uFogWarp.z * exp(uFogWarp.y * y * start), x = -K * y;
+    float own = uFogWarp.w * K * (x > 1e-4 ? log(1.0 + x) / x : 1.0 - 0.5 * x);
+    float lo = min(span, own), hi = max(span, own);
+    span = hi > 0.0 ? lo * pow(1.0 + pow(lo / hi, 8.0), -0.125) : 0.0;
+  }
+  return vec2(span > 0.0 ? clamp((d - start) / span, 0.0, 1.0) : 1.0, 0.5 + asinh(uFogWarp.x * y) / (2.0 * asinh(uFogWarp.x)));
+}
 void main() {`)
       .replace('#include <fog_fragment>', `{
     vec3 ray = vEffectdWorld - cameraPosition;
     float d = length(ray);
     if (d < uFogCutoff) {
-      float u = clamp((min(d, uFogRange.y) - uFogRange.x) / (uFogRange.y - uFogRange.x), 0.0, 1.0);
-      float v = uFogTexels.y > 1.0 ? (ray.y / max(d, 1e-6) + 1.0) * 0.5 : 0.5;
-      vec4 fog = texture2D(uFogTable, vec2((u * (uFogTexels.x - 1.0) + 0.5) / uFogTexels.x, (v * (uFogTexels.y - 1.0) + 0.5) / uFogTexels.y));
+      vec2 uv = effectdFogUv(d, clamp(ray.y / max(d, 1e-6), -1.0, 1.0));
+      vec4 fog = texture2D(uFogTable, (uv * (uFogTexels - 1.0) + 0.5) / uFogTexels);
       gl_FragColor.rgb = gl_FragColor.rgb * fog.a + fog.rgb;
     }
   }`);
