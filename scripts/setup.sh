@@ -16,6 +16,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev  # the ASan+UBSan suite and the libFuzzer targets (build-fuzz/)
   iproute2           # ss: tests/binary_test.sh reads the listen backlog
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
+  redis-server       # deploy/replicas: API key quotas shared by replicas (--quota-redis)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   blender            # the second tangent oracle: Blender's own MikkTSpace (tests/mikktspace/blender_oracle.py)
   chromium           # tests/browser: a page on another origin uses effectd (CORS, PNG decode)

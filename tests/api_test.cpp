@@ -139,9 +139,9 @@ TEST(Api, NotFoundIsAProblem) {
 
 TEST(Api, WrongMethodIs405WithAllow) {
   TestServer s;
-  auto r = s.client().Get("/v1/fog");
+  auto r = s.client().Put("/v1/fog", "{}", "application/json");
   expectProblem(r, 405);
-  EXPECT_EQ(r->get_header_value("Allow"), "POST");
+  EXPECT_EQ(r->get_header_value("Allow"), "POST, GET, HEAD");
   r = s.client().Post("/healthz", "{}", "application/json");
   expectProblem(r, 405);
   EXPECT_EQ(r->get_header_value("Allow"), "GET, HEAD");

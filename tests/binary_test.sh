@@ -6,7 +6,8 @@ bin="$1"
 log=$(mktemp)
 trap 'rm -f "$log"; kill %1 2>/dev/null || true' EXIT
 
-"$bin" --help | grep -q -- "--port"
+"$bin" --help >"$log"  # whole: grep -q would leave the rest unread (SIGPIPE under pipefail)
+grep -q -- "--port" "$log"
 if "$bin" --port nope 2>/dev/null; then echo "bad flag accepted"; exit 1; fi
 
 # --heavy-threads 8: the eight slow requests below all run at once, as this test intends
@@ -20,6 +21,18 @@ port=$(grep -o '"port":[0-9]*' "$log" | head -1 | cut -d: -f2)
 grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; exit 1; }
 
 curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'
+# SIGHUP rereads the key files (none here) and the server goes on serving.
+kill -HUP "$pid"
+for _ in $(seq 100); do grep -q '"key files reread"' "$log" && break; sleep 0.02; done
+grep -q '"key files reread"' "$log" || { echo "SIGHUP: no reread"; cat "$log"; exit 1; }
+curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'
+# A key file that cannot be read stops the start, naming it (exit 2).
+set +e
+"$bin" --port 0 --api-keys /nonexistent/keys.json 2>"$log.keys"
+rc=$?
+set -e
+[ "$rc" -eq 2 ] && grep -q '/nonexistent/keys.json' "$log.keys" || { echo "bad key file: exit $rc"; cat "$log.keys"; exit 1; }
+rm -f "$log.keys"
 
 # A second effectd on a port in use is an error (cpp-httplib's default SO_REUSEPORT would let
 # it bind and silently take half the connections).

@@ -177,8 +177,9 @@ TEST(Http, CorsForConfiguredOrigins) {
   ASSERT_TRUE(pre);
   EXPECT_EQ(pre->status, 204);
   EXPECT_EQ(pre->get_header_value("Access-Control-Allow-Origin"), "https://game.example");
-  EXPECT_EQ(pre->get_header_value("Access-Control-Allow-Methods"), "POST");
+  EXPECT_EQ(pre->get_header_value("Access-Control-Allow-Methods"), "POST, GET, HEAD");
   EXPECT_NE(pre->get_header_value("Access-Control-Allow-Headers").find("Content-Type"), std::string::npos);
+  EXPECT_NE(pre->get_header_value("Access-Control-Allow-Headers").find("Authorization"), std::string::npos);  // API keys
   EXPECT_EQ(s.client().Options("/healthz")->get_header_value("Allow"), "GET, HEAD, OPTIONS");
 }
 

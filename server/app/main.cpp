@@ -11,10 +11,13 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <memory>
+#include <stdexcept>
 #include <thread>
 
 #include "contract/config.h"
 #include "app/endpoints.h"
+#include "http/access_log.h"
 #include "http/idle_trim.h"
 #include "contract/json_reader.h"
 #include "api/movie.h"
@@ -164,12 +167,20 @@ int main(int argc, char** argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);  // rereads the key files (--url-signing-key-file, --api-keys)
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
 
   effectd::IdleTrim::configureAllocator();  // freed memory kept while busy, returned when idle
 
-  effectd::Service service(config);
+  std::unique_ptr<effectd::Service> served;
+  try {
+    served = std::make_unique<effectd::Service>(config);
+  } catch (const std::runtime_error& e) {  // a key file that cannot be read or is wrong
+    std::fprintf(stderr, "effectd: %s\n", e.what());
+    return 2;
+  }
+  effectd::Service& service = *served;
   effectd::addEffectEndpoints(service);
   if (effectd::playgroundEnabled(config)) effectd::addPlayground(service, config.playgroundThree);
   int port = service.bind();
@@ -183,7 +194,12 @@ int main(int argc, char** argv) {
   std::atomic<bool> signalled{false};
   std::thread waiter([&] {
     int sig = 0;
-    sigwait(&signals, &sig);
+    while (sigwait(&signals, &sig) == 0 && sig == SIGHUP) {  // connections stay open
+      const std::string error = service.reloadAccess();
+      std::fprintf(stderr, "{\"level\":\"%s\",\"msg\":\"%s\"%s%s}\n", error.empty() ? "info" : "error",
+                   error.empty() ? "key files reread" : "key files not reread: the old keys stay",
+                   error.empty() ? "" : ",\"why\":", error.empty() ? "" : effectd::jsonEscape(error).c_str());
+    }
     signalled = true;
     std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"shutting down\",\"signal\":%d}\n", sig);
     service.stop();

@@ -45,6 +45,14 @@ std::function<bool(const std::string&, Config&)> limitField(size_t Limits::*fiel
   };
 }
 
+// A file's path, taken as given (the file is read, and its errors named, when the server starts).
+std::function<bool(const std::string&, Config&)> pathField(std::string Config::*field) {
+  return [=](const std::string& s, Config& c) {
+    c.*field = s;
+    return true;
+  };
+}
+
 // --cors-origins: a comma list of origins (scheme://host[:port]) or "*"; spaces around an
 // entry and trailing slashes are dropped.
 bool setCorsOrigins(const std::string& s, Config& c) {
@@ -92,8 +100,10 @@ const std::vector<Option>& options() {
          c.accessLog = s == "1" || s == "true";
          return true;
        }},
-      {"max-body-bytes", "EFFECTD_MAX_BODY_BYTES", "largest request body (default 16777216)",
+      {"max-body-bytes", "EFFECTD_MAX_BODY_BYTES", "largest request body, and a GET's decoded ?r= (default 16777216)",
        limitField(&Limits::maxBodyBytes, 1024, 1LL << 32)},
+      {"max-url-bytes", "EFFECTD_MAX_URL_BYTES", "longest GET path and query; longer gets 414 (default 8192)",
+       limitField(&Limits::maxUrlBytes, 256, 1LL << 20)},
       {"max-grid-cells", "EFFECTD_MAX_GRID_CELLS", "largest lightning grid, width*height (default 16777216)",
        limitField(&Limits::maxGridCells, 9, 1LL << 28)},
       {"max-growth-steps", "EFFECTD_MAX_GROWTH_STEPS", "lightning cells added per request (default 2000000)",
@@ -141,6 +151,26 @@ const std::vector<Option>& options() {
       {"response-cache-mb", "EFFECTD_RESPONSE_CACHE_MB",
        "encoded answers kept to serve repeats (LRU, by ETag); 0 = off (default 64)",
        intField(&Config::responseCacheMb, 0, 1LL << 20)},
+      {"cache-max-age", "EFFECTD_CACHE_MAX_AGE",
+       "seconds a CDN or browser may reuse a GET answer without asking again (Cache-Control: public, max-age); after "
+       "an upgrade that changes answers, caches revalidate within it (default 3600)",
+       intField(&Config::cacheMaxAgeS, 0, 31536000)},
+      {"url-signing-key-file", "EFFECTD_URL_SIGNING_KEY_FILE",
+       "file of URL signing keys, one per line (two during a rotation): every GET must then carry sig, the base64url "
+       "HMAC-SHA256 of its path and query (docs/serving.md); SIGHUP rereads it (default none)",
+       pathField(&Config::urlSigningKeyFile)},
+      {"api-keys", "EFFECTD_API_KEYS",
+       "JSON file of API keys with quotas ({\"keys\": [{\"id\", \"sha256\", \"perMinute\", \"burst\", "
+       "\"endpoints\"}]}): POSTs and unsigned GETs then need Authorization: Bearer <secret>; SIGHUP rereads it "
+       "(default none: open)",
+       pathField(&Config::apiKeysFile)},
+      {"quota-redis", "EFFECTD_QUOTA_REDIS",
+       "redis://host:port holding the API keys' quotas, so that they hold across replicas; unreachable, each process "
+       "falls back to its own buckets (default none: per process)",
+       [](const std::string& s, Config& c) {
+         c.quotaRedis = s;
+         return s.empty() || s.rfind("redis://", 0) == 0;
+       }},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
        "none)",

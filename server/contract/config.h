@@ -9,7 +9,8 @@
 namespace effectd {
 
 struct Limits {
-  size_t maxBodyBytes = 16u << 20;          // request body
+  size_t maxBodyBytes = 16u << 20;          // request body (and a GET's decoded ?r=)
+  size_t maxUrlBytes = 8192;                // a GET's path and query
   size_t maxGridCells = 4096u * 4096u;      // lightning grid width*height
   size_t maxGrowthSteps = 2'000'000;        // lightning cells added per request
   size_t maxSolverGridCells = 256u * 256u;  // dbm and charges: every step costs O(cells)
@@ -39,6 +40,10 @@ struct Config {
   int admissionQueue = 64;               // requests waiting for memory or a heavy slot; more -> 503
   int admissionTimeoutMs = 10000;        // longest wait for admission before 503
   size_t responseCacheMb = 64;           // encoded answers kept for repeats; 0 = off
+  int cacheMaxAgeS = 3600;               // Cache-Control max-age of GET answers (CDNs, browsers)
+  std::string urlSigningKeyFile;         // "" = GETs need no signature
+  std::string apiKeysFile;               // "" = no API keys: the service is open
+  std::string quotaRedis;                // redis://host:port: quotas shared by replicas; "" = per process
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
   // three.js's ES module the playground's live view imports (it draws through clients/three/).

@@ -1,4 +1,5 @@
-// One JSON line per answered request on stderr (--access-log).
+// One JSON line per answered request on stderr (--access-log): never a secret (no query
+// string, no Authorization), the API key's id when the request came with one.
 #pragma once
 
 #include <string>
@@ -11,7 +12,7 @@ struct Response;
 namespace effectd {
 
 void writeAccessLog(const httplib::Request& req, const httplib::Response& res, const std::string& requestId,
-                    double seconds);
+                    const std::string& keyId, double seconds);
 // `s` as a JSON string literal (quotes included), invalid UTF-8 replaced.
 std::string jsonEscape(const std::string& s);
 

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <ctime>
 #include <optional>
 
+#include "http/access.h"
 #include "http/access_log.h"
 #include "http/encoding.h"
 #include "http/request_state.h"
@@ -18,18 +20,15 @@
 namespace effectd {
 namespace {
 
-// A JSON body costs its text, the parsed document (16-byte values in vectors that may be
-// half empty: ~4x the text for arrays of short numbers), and the canonical text for the ETag.
-constexpr size_t kJsonBodyFactor = 6;
-constexpr size_t kBinaryBodyFactor = 2;  // the bytes and the buffers decoded from them
 // Headers a browser on another origin may read (CORS), and may send.
 // Every header a page may need to read, every X- header the service sends among them
 // (tests/api_tangents_test.cpp EveryXHeaderIsExposedToAllowedOrigins).
 constexpr const char* kExposedHeaders =
     "ETag, Server-Timing, Retry-After, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, "
     "X-Render-Passes, X-Render-Ms, X-Shader-Cache, X-Shader-Compile-Ms, X-Shader-Variants-Compiled, X-Tangents, "
-    "X-Frame-Count, X-Frame-Rate, X-Flipbook-Columns, X-Flipbook-Rows, X-Content-Type-Options";
-constexpr const char* kAllowedRequestHeaders = "Content-Type, If-None-Match, X-Request-ID";
+    "X-Frame-Count, X-Frame-Rate, X-Flipbook-Columns, X-Flipbook-Rows, X-Content-Type-Options, RateLimit, "
+    "RateLimit-Policy, WWW-Authenticate";
+constexpr const char* kAllowedRequestHeaders = "Authorization, Content-Type, If-None-Match, X-Request-ID";
 
 // The error handler: a bare status (no body from a handler) gets its problem document.
 httplib::Server::HandlerResponse answerBareStatus(const httplib::Request&, httplib::Response& res) {
@@ -216,6 +215,21 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
                  {},
                  {{"Allow", allow}}});
   }
+  const bool effect = route->json || !route->binary.empty();
+  if (effect && req.method != "POST" && req.target.size() > config_.limits.maxUrlBytes)
+    return fail({414, "uri-too-long", "URI Too Long",
+                 "the URL has " + std::to_string(req.target.size()) + " bytes, over the limit of " +
+                     std::to_string(config_.limits.maxUrlBytes) + " (--max-url-bytes): POST the body instead",
+                 {},
+                 {}});
+  if (effect) {
+    if (auto problem = access_->check(req, route->path, (long long)std::time(nullptr), tl.key)) {
+      if (req.method != "POST") problem->headers["Cache-Control"] = "no-store";
+      if (req.method == "POST") problem->headers["Connection"] = "close";  // its body stays unread
+      return fail(*problem);
+    }
+    if (tl.key) tl.keyId = tl.key->id;
+  }
   if (req.method != "POST") return false;
   unsigned long long length = 0;
   if (auto problem = lengthProblem(req, config_.limits.maxBodyBytes, length)) return fail(*problem);
@@ -271,7 +285,7 @@ void Service::finishRequest(const httplib::Request& req, const httplib::Response
   }
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tl.start).count();
   metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
-  if (config_.accessLog) writeAccessLog(req, res, tl.requestId, seconds);
+  if (config_.accessLog) writeAccessLog(req, res, tl.requestId, tl.keyId, seconds);
   const bool reserved = tl.bodyTicket.bytes() + tl.workTicket.bytes() > 0;  // GETs (/metrics) reserve none
   tl = RequestState{};  // releases the reservations: the answer has been written
   if (reserved) idleTrim_->noteFinished();  // its memory goes back once the server is idle (idle_trim.h)

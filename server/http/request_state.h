@@ -3,9 +3,11 @@
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "http/admission.h"
+#include "http/api_keys.h"
 
 namespace effectd {
 
@@ -19,6 +21,8 @@ struct RequestState {
   std::string acceptEncoding;  // taken off the request so cpp-httplib does not encode itself
   std::string corsOrigin;      // the value of Access-Control-Allow-Origin, "" = no CORS headers
   bool encoded = false;        // the answer's coding is chosen (and part of its ETag) already
+  std::optional<ApiKey> key;   // the API key the request came with (access.h)
+  std::string keyId;           // its id, for the access log
   // Held until the answer has been written (the logger runs after that).
   Admission::Ticket bodyTicket, workTicket;
 };

@@ -11,6 +11,11 @@
 
 namespace effectd {
 
+// A JSON body costs its text, the parsed document (16-byte values in vectors that may be
+// half empty: ~4x the text for arrays of short numbers), and the canonical text for the ETag.
+constexpr size_t kJsonBodyFactor = 6;
+constexpr size_t kBinaryBodyFactor = 2;  // the bytes and the buffers decoded from them
+
 struct Service::Route {
   std::string path;
   std::vector<std::string> methods;  // GET routes also answer HEAD

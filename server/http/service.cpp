@@ -5,12 +5,17 @@
 
 #include <httplib.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <ctime>
 #include <thread>
 
 #include <sys/socket.h>
 
 #include <effects/common.h>
 
+#include "contract/codec.h"
+#include "http/access.h"
 #include "http/elastic_pool.h"
 #include "http/encoding.h"
 #include "http/etag.h"
@@ -187,6 +192,7 @@ Service::Service(Config config)
       cache_(config_.responseCacheMb << 20),
       http_(std::make_unique<httplib::Server>()),
       compute_(std::make_unique<effects::ThreadPool>(effects::ThreadPool::besideCaller())),
+      access_(std::make_unique<Access>(config_)),
       idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())
@@ -194,6 +200,7 @@ Service::Service(Config config)
   schemas_ = std::make_unique<SchemaRegistry>(docs);
   installCore();
   installHttpPolicy();
+  metrics_.addSource([this] { return access_->metricsText(); });
   metrics_.addSource([this] {
     return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
            "# TYPE effectd_memory_trims_total counter\n"
@@ -261,12 +268,13 @@ void Service::addJsonEndpoint(const std::string& path, const std::string& schema
   schemas_->document(schema);  // fail at startup, not at the first request
   auto r = std::make_unique<Route>();
   r->path = path;
-  r->methods = {"POST"};
+  r->methods = {"POST", "GET", "HEAD"};
   r->schema = schema;
   r->json = std::move(endpoint);
   const Route* raw = r.get();
   routes_.push_back(std::move(r));
   http_->Post(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handlePost(*raw, req, res); });
+  http_->Get(path, [this, raw](const httplib::Request& req, httplib::Response& res) { handleGet(*raw, req, res); });
 }
 
 void Service::addBinaryAlternative(const std::string& path, const std::string& contentType, BinaryHandler handler,
@@ -305,22 +313,81 @@ void Service::addReadinessInfo(const std::string& name, std::function<std::strin
   info_.emplace_back(name, std::move(value));
 }
 
+std::string Service::reloadAccess() { return access_->reload(); }
+
 void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
+  std::map<std::string, std::string> query;
+  for (const auto& [k, v] : req.params) query[k] = v;
+  answer(route, req.body, mediaType(req.get_header_value("Content-Type")), query, req.get_header_value("If-None-Match"),
+         res);
+}
+
+void Service::handleGet(const Route& route, const httplib::Request& req, httplib::Response& res) {
+  // A URL's answer is the POST's, cacheable by any cache on the way; a problem is not.
+  auto refuse = [&](const ApiError& e) {
+    writeProblem(res, e, tl.requestId);
+    res.set_header("Cache-Control", "no-store");
+  };
+  for (const auto& [name, value] : req.params)
+    if (name != "r" && name != "exp" && name != "sig")
+      return refuse({400, "invalid-query", "Unknown query parameter",
+                     "a GET takes r (the base64url JSON body), and exp and sig when signed; not '" + name + "'",
+                     {{"?" + name, "not a parameter of GET " + route.path}}, {}});
+  if (!req.has_param("r"))
+    return refuse({400, "invalid-query", "Missing query parameter",
+                   "GET " + route.path + " needs r: the request's JSON body in base64url (RFC 4648 §5, no padding)",
+                   {{"?r", "required"}}, {}});
+  auto body = base64UrlDecode(req.get_param_value("r"));
+  if (!body)
+    return refuse({400, "invalid-query", "Malformed query parameter", "r is not base64url (RFC 4648 §5, no padding)",
+                   {{"?r", "not base64url"}}, {}});
+  if (body->size() > config_.limits.maxBodyBytes)
+    return refuse({413, "body-too-large", "Content Too Large",
+                   "r decodes to " + std::to_string(body->size()) + " bytes, over the limit of " +
+                       std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
+                   {{"?r", "too large"}}, {}});
+  try {
+    tl.bodyTicket = admission_->admit(body->size() * kJsonBodyFactor, false);
+  } catch (const ApiError& e) {
+    return refuse(e);
+  }
+  answer(route, *body, "application/json", {}, req.get_header_value("If-None-Match"), res);
+  if (res.status >= 400) {
+    res.set_header("Cache-Control", "no-store");
+  } else if (res.has_header("ETag")) {
+    // Fresh for --cache-max-age, then revalidated: the ETag names the build, so after an upgrade
+    // that changes answers a cache gets the new one. A signed URL is not kept past its exp.
+    long long maxAge = config_.cacheMaxAgeS;
+    if (req.has_param("exp") && req.has_param("sig"))
+      maxAge = std::clamp(std::atoll(req.get_param_value("exp").c_str()) - (long long)std::time(nullptr), 0LL, maxAge);
+    // An answer to an API key is that key's: a shared cache that kept it would serve it to
+    // requests without one. Open and signed URLs are public by design.
+    res.set_header("Cache-Control", std::string(tl.key ? "private" : "public") + ", max-age=" + std::to_string(maxAge));
+  } else {
+    res.set_header("Cache-Control", "no-store");  // an answer with timings in it
+  }
+}
+
+void Service::answer(const Route& route, const std::string& bodyText, const std::string& type,
+                     const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res) {
   RequestContext ctx{tl.requestId, config_, compute_.get()};
-  for (const auto& [k, v] : req.params) ctx.query[k] = v;
-  const std::string type = mediaType(req.get_header_value("Content-Type"));
+  ctx.query = query;
   // Part of what determines a binary answer; as JSON, so that no two queries read the same.
-  const std::string query = ctx.query.empty() ? std::string() : json(ctx.query).dump();
+  const std::string queryText = query.empty() ? std::string() : json(query).dump();
   const Coding coding = negotiate(tl.acceptEncoding);
-  const std::string inm = req.get_header_value("If-None-Match");
   tl.encoded = true;
   // The exact request bytes find a cached answer before any parsing.
   const std::string requestKey =
-      req.body.size() <= ResponseCache::kMaxAliasKeyBytes
-          ? route.path + "?" + query + "\n" + type + "\n" + codingName(coding) + "\n" + req.body
+      bodyText.size() <= ResponseCache::kMaxAliasKeyBytes
+          ? route.path + "?" + queryText + "\n" + type + "\n" + codingName(coding) + "\n" + bodyText
           : std::string();
+  // A key's quota is charged the request's units: one for an answer already cached.
+  auto charge = [&](size_t bytes) {
+    if (tl.key) access_->charge(*tl.key, bytes ? quotaUnits(bytes) : 1.0, res);
+  };
   try {
     if (auto hit = cache_.byRequest(requestKey)) {
+      charge(0);
       res.set_header("Server-Timing", "cache;desc=\"hit\"");
       return sendAnswer(*hit, inm, res);
     }
@@ -328,31 +395,34 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
     const bool isBinary = binary != route.binary.end();
     json body;
     Stages requestStages;  // parse, validate, etag (and write): for Server-Timing
-    if (!isBinary) parseJsonRequest(req.body, *schemas_, route.schema, body, requestStages);
+    if (!isBinary) parseJsonRequest(bodyText, *schemas_, route.schema, body, requestStages);
     // Deterministic answers: a strong validator per representation (request and coding), over
     // what determines the answer; none for a JSON request that asks for timings.
     std::string tag;
     if (isBinary || !asksForTimings(body)) {
       effects::Stopwatch hashing;
       tag = etagFor(route.path, route.etagSalt ? route.etagSalt() : "",
-                    isBinary ? type + "\n" + query + "\n" + req.body : canonicalJson(body), coding);
+                    isBinary ? type + "\n" + queryText + "\n" + bodyText : canonicalJson(body), coding);
       requestStages.emplace_back("etag", hashing.ms());
       if (etagMatches(inm, tag)) {
+        charge(0);
         res.set_header("ETag", tag);
         res.status = 304;
         return;
       }
       if (auto hit = cache_.byTag(tag)) {
+        charge(0);
         cache_.alias(requestKey, tag);
         res.set_header("Server-Timing", "cache;desc=\"hit\"");
         return sendAnswer(*hit, inm, res);
       }
     }
-    // The typed request and its cost; admission: the estimated peak is reserved until the
-    // answer has been written.
+    // The typed request and its cost; the key's quota is charged it; admission: the estimated
+    // peak is reserved until the answer has been written.
     PreparedRequest prepared;
     if (!isBinary) prepared = route.json(body, ctx);
-    const Cost cost = isBinary ? binary->second.cost(req.body, config_) : prepared.cost;
+    const Cost cost = isBinary ? binary->second.cost(bodyText, config_) : prepared.cost;
+    charge(cost.bytes);
     tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
     res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
 
@@ -360,7 +430,7 @@ void Service::handlePost(const Route& route, const httplib::Request& req, httpli
     answer->etag = tag;
     if (isBinary)
       res.set_header("Server-Timing",
-                     serverTiming(answerBinary(binary->second.handler, req.body, ctx, *answer), {}, requestStages));
+                     serverTiming(answerBinary(binary->second.handler, bodyText, ctx, *answer), {}, requestStages));
     else
       answerJson(prepared, body, *answer, res, std::move(requestStages));
     encodeAnswer(coding, *answer);

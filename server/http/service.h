@@ -36,6 +36,8 @@ struct Response;
 
 namespace effectd {
 
+class Access;
+
 // Server-Timing entries (name;dur=ms), in order.
 using Stages = std::vector<std::pair<std::string, double>>;
 
@@ -133,6 +135,8 @@ class Service {
   void setEtagSalt(const std::string& path, std::function<std::string()> salt);
   // A fact /readyz reports under "info" (e.g. which renderer is in use).
   void addReadinessInfo(const std::string& name, std::function<std::string()> value);
+  // SIGHUP: rereads the URL signing keys and the API keys (access.h). "" or why the old stay.
+  std::string reloadAccess();
 
   int bind();   // binds host:port from the config; returns the port, or -1
   bool run();   // serves until stop(); in-flight requests finish before it returns
@@ -153,6 +157,11 @@ class Service {
   void postRoute(httplib::Response& res);
   void finishRequest(const httplib::Request& req, const httplib::Response& res);
   void handlePost(const Route& route, const httplib::Request& req, httplib::Response& res);
+  // GET <endpoint>?r=<base64url of the JSON body>: the POST's answer, cacheable by URL.
+  void handleGet(const Route& route, const httplib::Request& req, httplib::Response& res);
+  // The answer to `body` of media type `type` (both methods' common path).
+  void answer(const Route& route, const std::string& body, const std::string& type,
+              const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res);
   const Route* findRoute(const std::string& path) const;
   std::string allowedOrigin(const std::string& origin) const;  // "" when not allowed
 
@@ -163,6 +172,7 @@ class Service {
   std::unique_ptr<SchemaRegistry> schemas_;
   std::unique_ptr<httplib::Server> http_;
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
+  std::unique_ptr<Access> access_;                // who may ask, and how much
   std::unique_ptr<IdleTrim> idleTrim_;
   int listenSocket_ = -1;                         // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;

@@ -273,6 +273,12 @@ function shareUrl() {
   return `${location.origin}${location.pathname}#${state.effect}/${base64url(JSON.stringify(state.request))}`;
 }
 
+// The answer itself by URL (GET <endpoint>?r=): an <img src> for a scene's preview, cacheable by
+// CDNs; a server with --url-signing-key-file needs it signed by the key's owner (docs/serving.md).
+function answerUrl() {
+  return `${location.origin}${EFFECTS[state.effect].endpoint}?r=${base64url(JSON.stringify(state.request))}`;
+}
+
 function curl() {
   const url = `${location.origin}${EFFECTS[state.effect].endpoint}`;
   if (state.glb) return `curl -sS ${url} -H 'Content-Type: model/gltf-binary' --data-binary @'${state.glb.name.replace(/'/g, '')}' -o tangents.glb`;
@@ -285,6 +291,7 @@ function curl() {
 function updateLinks() {
   history.replaceState(null, '', state.glb ? location.pathname : shareUrl());
   $('curl').textContent = curl();
+  $('copy-answer-url').disabled = Boolean(state.glb);  // a binary body has no URL form
 }
 
 async function copy(text, button) {
@@ -376,6 +383,7 @@ async function main() {
   $('copy-curl').addEventListener('click', (e) => copy(curl(), e.target));
   $('copy-json').addEventListener('click', (e) => copy(JSON.stringify(state.request, null, 1), e.target));
   $('copy-link').addEventListener('click', (e) => copy(shareUrl(), e.target));
+  $('copy-answer-url').addEventListener('click', (e) => copy(answerUrl(), e.target));
   $('glb').addEventListener('change', async (e) => {
     const file = e.target.files[0];
     if (!file) return;

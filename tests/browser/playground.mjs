@@ -187,6 +187,20 @@ try {
   await second.close();
   const out = JSON.parse(execFileSync('bash', ['-c', curl], { encoding: 'utf8' }));
   check(Array.isArray(out.polylines) && out.method === 'fast', '"copy as curl" runs as a command and answers', curl.slice(0, 200));
+  // "copy image URL": the answer by GET, the same bytes as the POST (the clipboard read from the
+  // page's own writeText).
+  const answerUrl = await page.evaluate(async () => {
+    let copied = '';
+    navigator.clipboard.writeText = async (text) => { copied = text; };
+    document.querySelector('#copy-answer-url').click();
+    await new Promise((r) => setTimeout(r, 50));
+    return copied;
+  });
+  const byUrl = await fetch(answerUrl);
+  const byPost = await fetch(`${api}/v1/lightning`, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: wanted });
+  const [urlBytes, postBytes] = [Buffer.from(await byUrl.arrayBuffer()), Buffer.from(await byPost.arrayBuffer())];
+  check(byUrl.status === 200 && urlBytes.equals(postBytes) && byUrl.headers.get('etag') === byPost.headers.get('etag'),
+        '"copy image URL" is a GET URL answering what the POST answers, same ETag', { answerUrl: answerUrl.slice(0, 120), status: byUrl.status });
 
   // A GLB upload: the bubble's own glTF, sent as model/gltf-binary, answered with tangents.
   const glb = path.join(os.tmpdir(), `effectd-playground-${process.pid}.glb`);

@@ -1,0 +1,238 @@
+#!/usr/bin/env python3
+"""Three effectd replicas behind deploy/replicas/nginx.conf with one Redis, on loopback, measured
+from a client (ctest deploy_replicas):
+
+  A. N distinct signed GET URLs, each asked 1 + M times through nginx: every replica's /metrics
+     shows each distinct answer computed once in all (hashing: one replica per answer; repeats
+     from nginx's cache);
+  B. one API key's admissions over T seconds from 4 clients, spread over the replicas, within
+     10 % of its quota (burst + perMinute/60 * T) summed over the replicas (Redis);
+  C. a replica killed mid-load: the GETs in flight and after are retried by nginx, none fails;
+  D. Redis stopped: keyed requests still answered (fail open to per-replica buckets).
+
+    deploy/replicas/test.py EFFECTD_BINARY
+"""
+import base64
+import hashlib
+import hmac
+import http.client
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SIGNING_KEY = "replicas-signing-key-0123456789"
+SECRET = "replicas-test-secret"
+PER_MINUTE, BURST = 600, 20
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def signed(body):
+    target = "/v1/fog?r=" + base64.urlsafe_b64encode(json.dumps(body).encode()).rstrip(b"=").decode()
+    sig = hmac.new(SIGNING_KEY.encode(), target.encode(), hashlib.sha256).digest()
+    return target + "&sig=" + base64.urlsafe_b64encode(sig).rstrip(b"=").decode()
+
+
+def fog(i):
+    return {"fog": {"fogType": "GL_EXP2", "density": 0.01 + 0.001 * i}, "table": {"size": 64}}
+
+
+def metric(port, pattern):
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    c.request("GET", "/metrics")
+    text = c.getresponse().read().decode()
+    m = re.search(re.escape(pattern) + r" ([0-9.e+]+)", text)
+    return float(m.group(1)) if m else 0.0
+
+
+failures = []
+
+
+def check(ok, what, detail=""):
+    print(("ok   " if ok else "FAIL ") + what + ("" if ok else f": {detail}"))
+    if not ok:
+        failures.append(what)
+    return ok
+
+
+def main():
+    binary = sys.argv[1]
+    for tool in ("nginx", "redis-server"):
+        if not shutil.which(tool):
+            print(f"{tool} missing (scripts/setup.sh installs it)")
+            return 1
+    work = tempfile.mkdtemp(prefix="effectd-replicas.")
+    procs = {}
+    try:
+        redis_port = free_port()
+        procs["redis"] = subprocess.Popen(["redis-server", "--port", str(redis_port), "--bind", "127.0.0.1", "--save", "",
+                                           "--appendonly", "no"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        open(os.path.join(work, "signing.txt"), "w").write(SIGNING_KEY + "\n")
+        json.dump({"keys": [{"id": "load", "sha256": hashlib.sha256(SECRET.encode()).hexdigest(),
+                             "perMinute": PER_MINUTE, "burst": BURST}]}, open(os.path.join(work, "keys.json"), "w"))
+        ports = []
+        for i in range(3):
+            log = open(os.path.join(work, f"effectd{i}.log"), "w+")
+            procs[f"effectd{i}"] = subprocess.Popen(
+                [binary, "--port", "0", "--threads", "8", "--access-log", "0", "--quota-redis", f"redis://127.0.0.1:{redis_port}",
+                 "--api-keys", os.path.join(work, "keys.json"), "--url-signing-key-file", os.path.join(work, "signing.txt")],
+                stderr=log)
+            for _ in range(200):
+                log.seek(0)
+                m = re.search(r'"port":(\d+)', log.read())
+                if m:
+                    ports.append(int(m.group(1)))
+                    break
+                time.sleep(0.05)
+        if not check(len(ports) == 3, "three replicas listening", ports):
+            return 1
+        lb = free_port()
+        conf = open(os.path.join(HERE, "nginx.conf")).read().replace("listen 8080;", f"listen 127.0.0.1:{lb};")
+        for i, p in enumerate(ports):
+            conf = conf.replace(f"127.0.0.1:808{i + 1}", f"127.0.0.1:{p}")
+        os.makedirs(os.path.join(work, "tmp"))
+        os.makedirs(os.path.join(work, "cache"))
+        open(os.path.join(work, "nginx.conf"), "w").write(conf)
+        user = "user root root;" if os.getuid() == 0 else ""
+        procs["nginx"] = subprocess.Popen(["nginx", "-p", work, "-c", os.path.join(work, "nginx.conf"), "-g",
+                                           f"daemon off; {user}"], stderr=open(os.path.join(work, "nginx.log"), "w"))
+        for _ in range(200):
+            try:
+                c = http.client.HTTPConnection("127.0.0.1", lb, timeout=2)
+                c.request("GET", "/healthz")
+                if c.getresponse().status == 200:
+                    break
+            except OSError:
+                time.sleep(0.05)
+
+        def get(conn, target, headers=None):
+            conn.request("GET", target, headers=headers or {})
+            r = conn.getresponse()
+            r.read()
+            return r
+
+        # A. Distinct answers computed once, repeats from the proxy.
+        n, m = 24, 3
+        conn = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
+        statuses, hits = [], 0
+        for i in range(n):
+            for k in range(1 + m):
+                r = get(conn, signed(fog(i)))
+                statuses.append(r.status)
+                hits += r.getheader("X-Cache-Status") == "HIT"
+        computed = [metric(p, "effectd_response_cache_misses_total") for p in ports]
+        check(all(s == 200 for s in statuses), f"A: {n} distinct signed URLs x {1 + m} through nginx all answered",
+              sorted(set(statuses)))
+        check(sum(computed) == n and hits == n * m,
+              f"A: each distinct answer computed once over the replicas ({computed} = {sum(computed):.0f}), "
+              f"the {n * m} repeats served by nginx's cache ({hits} hits)", (computed, hits))
+        check(sum(c > 0 for c in computed) >= 2, "A: the hash spreads distinct answers over the replicas", computed)
+
+        # B. One key's quota over the replicas, shared in Redis.
+        seconds, results, lock = 5.0, [], threading.Lock()
+        counter = iter(range(1000, 10**6))
+        start = time.time()
+
+        def client():
+            c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
+            while time.time() - start < seconds:
+                with lock:
+                    i = next(counter)
+                c.request("POST", "/v1/fog", body=json.dumps(fog(i)),
+                          headers={"Content-Type": "application/json", "Authorization": "Bearer " + SECRET})
+                r = c.getresponse()
+                r.read()
+                with lock:
+                    results.append((time.time(), r.status))
+
+        threads = [threading.Thread(target=client) for _ in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        allowed = sum(s == 200 for _, s in results)
+        limited = sum(s == 429 for _, s in results)
+        span = max(t for t, _ in results) - start
+        expected = BURST + PER_MINUTE / 60.0 * span
+        per_replica = [metric(p, 'effectd_key_requests_total{key="load",outcome="allowed"}') for p in ports]
+        print(f"     B: {len(results)} requests in {span:.2f} s: {allowed} allowed, {limited} limited; quota over "
+              f"the span {expected:.1f}; allowed per replica {per_replica}")
+        check(abs(allowed - expected) <= 0.1 * expected,
+              f"B: admissions {allowed} within 10 % of the key's quota {expected:.1f} over the replicas", allowed)
+        check(sum(per_replica) == allowed and sum(x > 0 for x in per_replica) >= 2,
+              "B: the replicas' own counts add up to it, from more than one replica", per_replica)
+        check(allowed + limited == len(results), "B: every other answer a 429", sorted(set(s for _, s in results)))
+
+        # C. A replica killed mid-load: GETs retried by nginx, no client-visible failure.
+        statuses, done = [], threading.Event()
+
+        def load():
+            c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
+            for i in range(2000, 2150):
+                try:
+                    statuses.append(get(c, signed(fog(i))).status)
+                except (OSError, http.client.HTTPException) as e:
+                    statuses.append(repr(e))
+                    c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
+            done.set()
+
+        t = threading.Thread(target=load)
+        t.start()
+        while len(statuses) < 50 and not done.is_set():
+            time.sleep(0.005)
+        procs["effectd1"].send_signal(signal.SIGKILL)
+        procs["effectd1"].wait()
+        t.join()
+        check(len(statuses) == 150 and all(s == 200 for s in statuses),
+              f"C: replica 2 killed after {50} of 150 GETs: all 150 answered 200",
+              [s for s in statuses if s != 200][:5])
+
+        # D. Redis stopped: fail open to each replica's own bucket.
+        procs["redis"].terminate()
+        procs["redis"].wait()
+        time.sleep(0.2)
+        c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
+        statuses = []
+        for i in range(3000, 3005):
+            c.request("POST", "/v1/fog", body=json.dumps(fog(i)),
+                      headers={"Content-Type": "application/json", "Authorization": "Bearer " + SECRET})
+            r = c.getresponse()
+            r.read()
+            statuses.append(r.status)
+        fallbacks = sum(metric(p, 'effectd_quota_charges_total{store="local-fallback"}') for i, p in enumerate(ports) if i != 1)
+        check(statuses == [200] * 5 and fallbacks >= 5,
+              f"D: Redis stopped: keyed requests answered from per-replica buckets ({fallbacks:.0f} local charges)",
+              statuses)
+    finally:
+        for p in procs.values():
+            if p.poll() is None:
+                p.terminate()
+        for p in procs.values():
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        if failures:
+            for name in os.listdir(work):
+                if name.endswith(".log"):
+                    print(f"--- {name}\n" + open(os.path.join(work, name)).read()[-2000:])
+        shutil.rmtree(work, ignore_errors=True)
+    print("deploy_replicas: " + ("passed" if not failures else f"{len(failures)} failed"))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

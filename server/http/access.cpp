@@ -1,0 +1,159 @@
+#include "http/access.h"
+
+#include <httplib.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace effectd {
+
+namespace {
+
+ApiError forbidden(const std::string& detail) { return {403, "forbidden", "Forbidden", detail, {}, {}}; }
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace
+
+Access::Access(const Config& config)
+    : config_(config),
+      signingOn_(!config.urlSigningKeyFile.empty()),
+      keysOn_(!config.apiKeysFile.empty()),
+      quota_(keysOn_ ? config.quotaRedis : std::string()) {
+  if (signingOn_) {
+    std::vector<std::string> keys;
+    if (auto e = UrlSigning::read(config.urlSigningKeyFile, keys); !e.empty()) throw std::runtime_error(e);
+    signing_.setKeys(std::move(keys));
+  }
+  if (keysOn_) {
+    std::vector<ApiKey> keys;
+    if (auto e = ApiKeys::read(config.apiKeysFile, keys); !e.empty()) throw std::runtime_error(e);
+    keys_.set(std::move(keys));
+  }
+}
+
+void Access::refused(const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  ++refusals_[reason];
+}
+
+std::optional<ApiError> Access::check(const httplib::Request& req, const std::string& route, long long now,
+                                      std::optional<ApiKey>& key) {
+  key.reset();
+  const bool get = req.method == "GET" || req.method == "HEAD";
+  if (get && signingOn_ && signing_.carriesSignature(req.target)) {
+    const std::string why = signing_.verify(req.target, now);
+    if (why.empty()) return std::nullopt;  // the URL's owner made it: no key needed
+    refused(why.rfind("the URL expired", 0) == 0 ? "expired" : "bad-signature");
+    return forbidden(why);
+  }
+  if (keysOn_) {
+    const std::string auth = req.get_header_value("Authorization");
+    if (auth.rfind("Bearer ", 0) != 0 || auth.size() <= 7) {
+      refused("unauthenticated");
+      return ApiError{401,
+                      "unauthenticated",
+                      "Unauthorized",
+                      std::string("an API key is required: Authorization: Bearer <secret>") +
+                          (signingOn_ && get ? ", or a signed URL" : ""),
+                      {},
+                      {{"WWW-Authenticate", "Bearer realm=\"effectd\""}}};
+    }
+    key = keys_.find(auth.substr(7));
+    if (!key) {
+      refused("unknown-key");
+      return forbidden("the API key is not known here");
+    }
+    if (!key->allows(route)) {
+      refused("endpoint-not-allowed");
+      const std::string id = key->id;
+      key.reset();
+      return forbidden("the API key '" + id + "' is not allowed on " + route);
+    }
+    return std::nullopt;
+  }
+  if (get && signingOn_) {
+    refused("missing-signature");
+    return forbidden("GET URLs must be signed here: append &sig=<base64url HMAC-SHA256 of the path and query>");
+  }
+  return std::nullopt;
+}
+
+void Access::charge(const ApiKey& key, double units, httplib::Response& res) {
+  const QuotaDecision d = quota_.charge(key, units);
+  // draft-ietf-httpapi-ratelimit-headers: the policy (quota q per window w seconds) and what is
+  // left of it now (r units, t seconds until the bucket is full).
+  const std::string policy = "\"key\";q=" + number(key.perMinute) + ";w=60";
+  const std::string state = "\"key\";r=" + number(std::max(0.0, std::floor(d.remaining))) +
+                            ";t=" + number(std::ceil(d.fullInS));
+  {
+    std::lock_guard lock(mutex_);
+    PerKey& k = perKey_[key.id];
+    ++(d.allowed ? k.allowed : k.limited);
+    if (d.allowed) k.units += units;
+  }
+  if (!d.allowed)
+    throw ApiError{429,
+                   "quota-exceeded",
+                   "Too Many Requests",
+                   "this request costs " + number(units) + " quota units (1 per MiB of its estimated peak memory); "
+                   "the key '" + key.id + "' holds " + number(std::max(0.0, std::floor(d.remaining))) + " of its " +
+                       number(key.burst) + ", refilled at " + number(key.perMinute) + " a minute",
+                   {},
+                   {{"Retry-After", number(std::max(1.0, std::ceil(d.retryAfterS)))},
+                    {"RateLimit-Policy", policy},
+                    {"RateLimit", state}}};
+  res.set_header("RateLimit-Policy", policy);
+  res.set_header("RateLimit", state);
+}
+
+std::string Access::reload() {
+  std::string error;
+  std::vector<std::string> signingKeys;
+  std::vector<ApiKey> apiKeys;
+  if (signingOn_) error = UrlSigning::read(config_.urlSigningKeyFile, signingKeys);
+  if (error.empty() && keysOn_) error = ApiKeys::read(config_.apiKeysFile, apiKeys);
+  std::lock_guard lock(mutex_);
+  if (!error.empty()) {
+    ++failedReloads_;
+    return error;
+  }
+  if (signingOn_) signing_.setKeys(std::move(signingKeys));
+  if (keysOn_) keys_.set(std::move(apiKeys));
+  ++reloads_;
+  return "";
+}
+
+std::string Access::metricsText() const {
+  std::lock_guard lock(mutex_);
+  std::string out =
+      "# HELP effectd_key_requests_total Requests made with each API key, by outcome (allowed, limited: 429).\n"
+      "# TYPE effectd_key_requests_total counter\n";
+  for (const auto& [id, k] : perKey_) {
+    out += "effectd_key_requests_total{key=\"" + id + "\",outcome=\"allowed\"} " + std::to_string(k.allowed) + "\n";
+    out += "effectd_key_requests_total{key=\"" + id + "\",outcome=\"limited\"} " + std::to_string(k.limited) + "\n";
+  }
+  out += "# HELP effectd_key_units_total Quota units charged to each API key.\n# TYPE effectd_key_units_total counter\n";
+  for (const auto& [id, k] : perKey_) out += "effectd_key_units_total{key=\"" + id + "\"} " + number(k.units) + "\n";
+  out += "# HELP effectd_access_refused_total Requests refused before their body was read, by reason.\n"
+         "# TYPE effectd_access_refused_total counter\n";
+  for (const auto& [reason, n] : refusals_)
+    out += "effectd_access_refused_total{reason=\"" + reason + "\"} " + std::to_string(n) + "\n";
+  out += "# HELP effectd_access_reloads_total Key files reread on SIGHUP, by result.\n"
+         "# TYPE effectd_access_reloads_total counter\n"
+         "effectd_access_reloads_total{result=\"ok\"} " + std::to_string(reloads_) + "\n" +
+         "effectd_access_reloads_total{result=\"kept-old\"} " + std::to_string(failedReloads_) + "\n";
+  const Quota::Counts q = quota_.counts();
+  out += "# HELP effectd_quota_charges_total Quota charges by where they were kept: Redis (shared) or this "
+         "process (local, also when Redis did not answer).\n# TYPE effectd_quota_charges_total counter\n"
+         "effectd_quota_charges_total{store=\"redis\"} " + std::to_string(q.shared) + "\n" +
+         "effectd_quota_charges_total{store=\"local-fallback\"} " + std::to_string(q.fallbacks) + "\n";
+  return out;
+}
+
+}  // namespace effectd
