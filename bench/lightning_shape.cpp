@@ -1,0 +1,148 @@
+// The fast method's (or the charges method's) bolts against DBM's by shape, over seeds: the
+// box-count curve N(s) at every scale, the mass-radius curve, branch segment lengths, branching
+// angles and tips counted two ways (bench/bolt_shape.h). Each comparison's noise level comes
+// from DBM against DBM: random half-splits of the DBM seeds, the 95th percentile of the same
+// statistic, scaled to the sample sizes compared. "meets" = the method's distance from DBM is
+// within that noise: indistinguishable at these seeds.
+//
+//   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
+//                   [--method fast|charges] [--splits 40]
+//
+// Geometry: the calibration's own (start top-centre, target bottom-centre, open grid).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <effects/lightning.h>
+
+#include "bolt_shape.h"
+
+namespace lt = effects::lightning;
+namespace sh = bench::shape;
+
+namespace {
+
+struct Sample {
+  std::vector<sh::Measures> bolts;
+  double msPerBolt = 0;
+};
+
+Sample grow(lt::Method method, int size, double eta, int seeds, uint64_t firstSeed) {
+  Sample s;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < seeds; ++k) {
+    lt::Params p;
+    p.width = p.height = size;
+    p.start = {size / 2, 1};
+    p.targets = {{size / 2, size - 2}};
+    p.method = method;
+    p.eta = eta;
+    p.seed = firstSeed + uint64_t(k);
+    lt::calibrate(p);  // what the server does for every request
+    auto bolt = lt::grow(p);
+    if (!bolt.ok()) {
+      std::fprintf(stderr, "grow failed: %s\n", bolt.error().message.c_str());
+      std::exit(1);
+    }
+    s.bolts.push_back(sh::measure(bolt.value(), size, size));
+  }
+  s.msPerBolt = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / seeds;
+  return s;
+}
+
+// One statistic between two sets of bolts.
+using Statistic = std::function<double(const std::vector<sh::Measures>&, const std::vector<sh::Measures>&)>;
+
+std::vector<std::vector<double>> curves(const std::vector<sh::Measures>& b, std::vector<double> sh::Measures::*field) {
+  std::vector<std::vector<double>> out;
+  for (const auto& m : b) out.push_back(m.*field);
+  return out;
+}
+std::vector<std::vector<double>> scalars(const std::vector<sh::Measures>& b, double sh::Measures::*field) {
+  std::vector<std::vector<double>> out;
+  for (const auto& m : b) out.push_back({m.*field});
+  return out;
+}
+std::vector<double> pooled(const std::vector<sh::Measures>& b, std::vector<double> sh::Measures::*field) {
+  std::vector<double> out;
+  for (const auto& m : b) out.insert(out.end(), (m.*field).begin(), (m.*field).end());
+  return out;
+}
+
+struct Row {
+  std::string name;
+  Statistic stat;
+  bool ks;  // a KS distance (scaled by sample size for the noise), else a Welch z
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int size = 128, fastSeeds = 40, dbmSeeds = 30, splits = 40;
+  std::vector<double> etas = {1, 2, 3};
+  lt::Method method = lt::Method::kFast;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i], v = argv[i + 1];
+    if (a == "--size") size = std::atoi(v.c_str());
+    else if (a == "--fast-seeds") fastSeeds = std::atoi(v.c_str());
+    else if (a == "--dbm-seeds") dbmSeeds = std::atoi(v.c_str());
+    else if (a == "--splits") splits = std::atoi(v.c_str());
+    else if (a == "--method") method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+    else if (a == "--eta") {
+      etas.clear();
+      std::stringstream ss(v);
+      for (std::string e; std::getline(ss, e, ',');) etas.push_back(std::atof(e.c_str()));
+    } else {
+      std::fprintf(stderr, "unknown flag %s\n", a.c_str());
+      return 2;
+    }
+  }
+  const std::vector<Row> rows = {
+      {"box counts N(s), every scale", [](auto& a, auto& b) { return sh::curveZ(curves(a, &sh::Measures::boxCounts), curves(b, &sh::Measures::boxCounts)); }, false},
+      {"mass-radius M(r)", [](auto& a, auto& b) { return sh::curveZ(curves(a, &sh::Measures::massRadius), curves(b, &sh::Measures::massRadius)); }, false},
+      {"tips: tree leaves", [](auto& a, auto& b) { return sh::curveZ(scalars(a, &sh::Measures::leafTips), scalars(b, &sh::Measures::leafTips)); }, false},
+      {"tips: one 8-neighbour", [](auto& a, auto& b) { return sh::curveZ(scalars(a, &sh::Measures::neighbourTips), scalars(b, &sh::Measures::neighbourTips)); }, false},
+      {"cells", [](auto& a, auto& b) { return sh::curveZ(scalars(a, &sh::Measures::cells), scalars(b, &sh::Measures::cells)); }, false},
+      {"segment lengths (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::segments), pooled(b, &sh::Measures::segments)); }, true},
+      {"branching angles (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::angles), pooled(b, &sh::Measures::angles)); }, true},
+  };
+  std::printf("# %s against dbm by shape, %d², start top-centre, target bottom-centre\n\n", lt::toString(method), size);
+  std::printf("%d %s and %d dbm bolts per eta; noise: 95th percentile over %d random half-splits of the dbm "
+              "bolts (KS distances scaled to the sizes compared); meets = within the noise.\n\n",
+              fastSeeds, lt::toString(method), dbmSeeds, splits);
+  std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", lt::toString(method));
+  std::mt19937 rng(49);
+  for (double eta : etas) {
+    const Sample fast = grow(method, size, eta, fastSeeds, 1000);
+    const Sample dbm = grow(lt::Method::kDbm, size, eta, dbmSeeds, 5000);
+    for (const Row& row : rows) {
+      const double d = row.stat(fast.bolts, dbm.bolts);
+      std::vector<double> noise;
+      std::vector<sh::Measures> shuffled = dbm.bolts;
+      for (int k = 0; k < splits; ++k) {
+        std::shuffle(shuffled.begin(), shuffled.end(), rng);
+        const size_t half = shuffled.size() / 2;
+        std::vector<sh::Measures> a(shuffled.begin(), shuffled.begin() + long(half)), b(shuffled.begin() + long(half), shuffled.end());
+        noise.push_back(row.stat(a, b));
+      }
+      std::sort(noise.begin(), noise.end());
+      double level = noise[std::min(noise.size() - 1, size_t(0.95 * double(noise.size())))];
+      if (row.ks)  // KS grows like sqrt(1/n1 + 1/n2): from the halves' sizes to the ones compared
+        level *= std::sqrt(1.0 / fastSeeds + 1.0 / dbmSeeds) / std::sqrt(4.0 / dbmSeeds);
+      std::printf("| %g | %s | %.3g | %.3g | %s |\n", eta, row.name.c_str(), d, level, d <= level ? "meets" : "**differs**");
+    }
+    double dFast = 0, dDbm = 0;
+    for (const auto& m : fast.bolts) dFast += sh::slope(m.boxCounts) / double(fast.bolts.size());
+    for (const auto& m : dbm.bolts) dDbm += sh::slope(m.boxCounts) / double(dbm.bolts.size());
+    std::printf("| %g | box-count slope (mean) | %.3f vs %.3f | | %.3g / %.3g ms per bolt |\n", eta, dFast, dDbm,
+                fast.msPerBolt, dbm.msPerBolt);
+  }
+  return 0;
+}
