@@ -104,6 +104,7 @@ TEST(Urls, LimitsApplyToTheUrlAndTheDecodedBody) {
   ASSERT_TRUE(tooLong);
   EXPECT_EQ(tooLong->status, 414);
   EXPECT_NE(tooLong->body.find("--max-url-bytes"), std::string::npos);
+  EXPECT_EQ(tooLong->get_header_value("Cache-Control"), "no-store");
   Config wide = c;
   wide.limits.maxUrlBytes = 1 << 16;
   TestServer w(wide);
@@ -246,7 +247,7 @@ TEST(Urls, QuotasFailOpenToLocalBucketsWhenRedisIsUnreachable) {
   c.quotaRedis = "redis://127.0.0.1:1";  // nothing listens there
   c.responseCacheMb = 0;
   TestServer s(c);
-  httplib::Headers h = {{"Authorization", "Bearer secret-k-123"}};
+  httplib::Headers h = {{"Authorization", "bearer secret-k-123"}};  // the scheme in any case
   int allowed = 0, limited = 0;
   for (int i = 0; i < 4; ++i) {
     auto r = s.client().Post("/v1/fog", h, kFog.dump(), "application/json");

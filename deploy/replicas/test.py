@@ -176,29 +176,34 @@ def main():
               "B: the replicas' own counts add up to it, from more than one replica", per_replica)
         check(allowed + limited == len(results), "B: every other answer a 429", sorted(set(s for _, s in results)))
 
-        # C. A replica killed mid-load: GETs retried by nginx, no client-visible failure.
-        statuses, done = [], threading.Event()
+        # C. A replica killed (SIGKILL) mid-load: the GETs that reach it afterwards, on nginx's
+        # kept-alive connections or new ones, are retried on the next replica; none fails. The
+        # kill falls between two of the client's requests: a response the dying replica had
+        # begun to send cannot be retried by any proxy (nginx passes a request on only while
+        # nothing has gone to the client), which this test does not pretend to cover.
+        statuses, kill_now, killed = [], threading.Event(), threading.Event()
 
         def load():
             c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
             for i in range(2000, 2150):
+                if i == 2050:
+                    kill_now.set()
+                    killed.wait(10)
                 try:
                     statuses.append(get(c, signed(fog(i))).status)
                 except (OSError, http.client.HTTPException) as e:
                     statuses.append(repr(e))
                     c = http.client.HTTPConnection("127.0.0.1", lb, timeout=30)
-            done.set()
 
         t = threading.Thread(target=load)
         t.start()
-        while len(statuses) < 50 and not done.is_set():
-            time.sleep(0.005)
+        kill_now.wait(60)
         procs["effectd1"].send_signal(signal.SIGKILL)
         procs["effectd1"].wait()
+        killed.set()
         t.join()
         check(len(statuses) == 150 and all(s == 200 for s in statuses),
-              f"C: replica 2 killed after {50} of 150 GETs: all 150 answered 200",
-              [s for s in statuses if s != 200][:5])
+              "C: replica 2 SIGKILLed after 50 of 150 GETs: all 150 answered 200", [s for s in statuses if s != 200][:5])
 
         # D. Redis stopped: fail open to each replica's own bucket.
         procs["redis"].terminate()

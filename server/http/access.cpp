@@ -2,6 +2,7 @@
 
 #include <httplib.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -54,7 +55,11 @@ std::optional<ApiError> Access::check(const httplib::Request& req, const std::st
   }
   if (keysOn_) {
     const std::string auth = req.get_header_value("Authorization");
-    if (auth.rfind("Bearer ", 0) != 0 || auth.size() <= 7) {
+    auto lower = [](std::string t) {
+      for (char& c : t) c = char(std::tolower(static_cast<unsigned char>(c)));
+      return t;
+    };
+    if (lower(auth.substr(0, 7)) != "bearer " || auth.size() <= 7) {  // the scheme is case-insensitive (RFC 9110)
       refused("unauthenticated");
       return ApiError{401,
                       "unauthenticated",

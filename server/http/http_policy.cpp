@@ -221,7 +221,7 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
                  "the URL has " + std::to_string(req.target.size()) + " bytes, over the limit of " +
                      std::to_string(config_.limits.maxUrlBytes) + " (--max-url-bytes): POST the body instead",
                  {},
-                 {}});
+                 {{"Cache-Control", "no-store"}}});
   if (effect) {
     if (auto problem = access_->check(req, route->path, (long long)std::time(nullptr), tl.key)) {
       if (req.method != "POST") problem->headers["Cache-Control"] = "no-store";

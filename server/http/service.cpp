@@ -417,14 +417,16 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
         return sendAnswer(*hit, inm, res);
       }
     }
-    // The typed request and its cost; the key's quota is charged it; admission: the estimated
-    // peak is reserved until the answer has been written.
+    // The typed request and its cost; admission: the estimated peak is reserved until the
+    // answer has been written; then the key's quota is charged it.
     PreparedRequest prepared;
     if (!isBinary) prepared = route.json(body, ctx);
     const Cost cost = isBinary ? binary->second.cost(bodyText, config_) : prepared.cost;
-    charge(cost.bytes);
+    // Admitted first: a request refused for memory (503, 413) costs its key nothing. Charged
+    // what X-Memory-Reserved says, the work's and the body's reservations together.
     tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
     res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
+    charge(cost.bytes + tl.bodyTicket.bytes());
 
     auto answer = std::make_shared<CachedAnswer>();
     answer->etag = tag;
