@@ -358,6 +358,22 @@ TEST(Fog, EngineTermsInTables) {
       ASSERT_EQ(ct.value().rangeEnd, c.cutoffDistance);
       EXPECT_LT(ct.value().factor[width - 1], 0.99) << toString(type) << " " << width;
     }
+  // The same with the range starting past 0, where start + (end - start) rounds past the end
+  // (4.0476... + (28.8218... - 4.0476...) > 28.8218...): height fog's fast rows too.
+  Fog h = make(FogType::kHeight);
+  h.density = 0.05;
+  h.heightFalloff = 0.2;
+  h.cutoffDistance = 28.82184447501209;
+  TableOptions r;
+  r.size = 16;
+  r.elevations = 3;
+  r.cameraHeight = 2;
+  r.rangeStart = 4.047608105353673;
+  r.rangeEnd = h.cutoffDistance;
+  ASSERT_GT(*r.rangeStart + (*r.rangeEnd - *r.rangeStart), *r.rangeEnd);  // the rounding this guards
+  auto rt = buildTable(h, r);
+  ASSERT_TRUE(rt.ok());
+  for (size_t j = 0; j < 3; ++j) EXPECT_LT(rt.value().factor[j * 16 + 15], 0.99) << "row " << j;
   // A glow that starts late extends the default range until it is done too.
   Fog late = make(FogType::kGlExp);
   late.density = 0.1;

@@ -90,10 +90,10 @@ Extent rowExtent(const Table& t, double y, bool glow) {
   const double start = glow ? t.warped.inscatterStart : t.warped.factorStart;
   return {start, warpedSpan(t.warped, y, start), t.warped.end};
 }
-double columnDistance(const Extent& e, const Table& t, double col) {
+double columnDistance(const Extent& e, size_t width, double col) {
   // exactly: a cutoff at the end must not round past it
-  if (col >= double(t.width - 1)) return e.span >= e.end - e.start ? e.end : e.start + e.span;
-  return e.start + e.span * col / double(t.width - 1);
+  if (col >= double(width - 1)) return e.span >= e.end - e.start ? e.end : e.start + e.span;
+  return e.start + e.span * col / double(width - 1);
 }
 
 double exact(const Fog& fog, double cameraHeight, double d, double dirY) {
@@ -111,7 +111,8 @@ bool fillHeightRow(const Fog& fog, double cameraHeight, double dirY, const Exten
   const double a = fog.density, b = fog.heightFalloff;
   const double k = b * dirY;
   const double logC = a > 0.0 ? std::log(a) - b * (cameraHeight - fog.baseHeight) : 0.0;
-  const double rangeStart = e.start, rangeEnd = e.start + e.span;
+  // The last column exactly where columnDistance puts it: start + span may round past a cutoff.
+  const double rangeStart = e.start, rangeEnd = columnDistance(e, width, double(width - 1));
   if (width < 2 || a == 0.0 || b == 0.0 || logC > 700.0 || std::fabs(k) * rangeEnd > 700.0) return false;
   if (fog.startDistance > 0.0 || fog.secondLayer || fog.convention != Convention::kEffectd) return false;
   if (k != 0.0 && std::fabs(k) < 1e-290) return false;  // -m/k would lose its precision in subnormals
@@ -146,8 +147,9 @@ bool fillAtmosphericRow(const Fog& fog, Table& t, size_t j) {
     stepIns[c] = std::exp(-(fog.inscattering[c] * dt));
   }
   bool anchored = false;
+  const Extent row = rowExtent(t, 0.0, false);
   for (size_t i = 0; i < w; ++i) {
-    const double d = columnDistance(rowExtent(t, 0.0, false), t, double(i));
+    const double d = columnDistance(row, w, double(i));
     const double beyond = d - fog.startDistance;  // the ray's part past the start
     if (!(beyond > 0.0)) {
       ext = ins = glm::dvec3(1.0);
@@ -187,9 +189,9 @@ void fill(const Fog& fog, double cameraHeight, Table& t) {
     for (size_t i = 0; i < t.width; ++i) {
       const size_t e = j * t.width + i;
       if (fog.directional)
-        t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, columnDistance(eg, t, double(i))));
+        t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, columnDistance(eg, t.width, double(i))));
       if (rowDone) continue;
-      const double d = columnDistance(ef, t, double(i));
+      const double d = columnDistance(ef, t.width, double(i));
       t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
       if (!rgb) continue;
       const glm::dvec3 tr = transmittance(fog, cameraHeight, dirY, d), sc = scattered(fog, cameraHeight, dirY, d);
@@ -249,7 +251,7 @@ double measureTableError(const Fog& fog, const Table& t, double cameraHeight, in
         return lerp0 + (lerp1 - lerp0) * fy;
       };
       auto distance = [&](const Extent& e) {
-        if (!beyond) return columnDistance(e, t, col);
+        if (!beyond) return columnDistance(e, t.width, col);
         const double last = e.start + e.span, k = double(c - cols + 1) / double(past);
         return last + (e.end - last) * k;
       };
