@@ -11,6 +11,7 @@
 // line naming the command, commit, date and machine (scripts/report.sh passes it). Every section
 // comes from this one run: the report is regenerated whole (scripts/report.sh).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -80,6 +81,17 @@ Point pointOf(std::string series, std::string setting, const Timing& t, double e
 }
 // Whether two run times are a tie: their interquartile ranges overlap.
 bool tie(const Point& a, const Point& b) { return a.q1 <= b.q3 && b.q1 <= a.q3; }
+
+// A sheet of bolts side by side, drawn after a section's table: the lightning-shape section's
+// DBM and fast bolts on the same seeds, one sheet per layout (3-D: seen along z).
+struct Sheet {
+  std::string section, id, caption;
+  int width = 0, height = 0;        // the grid's x and y extent
+  std::vector<std::string> titles;  // per panel; panels fill rows of `columns`
+  // Per panel, the tree's edges (x0, y0, x1, y1 at cell centres): branches, then main channel.
+  std::vector<std::vector<std::array<float, 4>>> branches, main;
+  int columns = 4;
+};
 
 struct Section {
   std::string id, title, reference, errorName, timeName, settingName, noteName;
@@ -269,11 +281,31 @@ void lightning(bool quick, Section& tv, Section& fd) {
     }
 }
 
+// A bolt's edges for a sheet: each node to its parent, at cell centres (3-D: seen along z).
+void sheetPanel(Sheet& sheet, const lt::Bolt& bolt, const std::string& title) {
+  std::vector<char> onMain(bolt.nodes.size(), 0);
+  for (int n : bolt.mainChannel) onMain[size_t(n)] = 1;
+  std::vector<std::array<float, 4>> branches, main;
+  for (size_t i = 0; i < bolt.nodes.size(); ++i) {
+    const lt::Node& n = bolt.nodes[i];
+    if (n.parent < 0) continue;
+    const lt::Cell a = bolt.nodes[size_t(n.parent)].cell, b = n.cell;
+    (onMain[i] && onMain[size_t(n.parent)] ? main : branches)
+        .push_back({float(a.x) + 0.5f, float(a.y) + 0.5f, float(b.x) + 0.5f, float(b.y) + 0.5f});
+  }
+  sheet.titles.push_back(title);
+  sheet.branches.push_back(std::move(branches));
+  sheet.main.push_back(std::move(main));
+}
+
 // What a player sees, against exact DBM over seeds: cells, tips and D (lt::shapeDistance: each
-// difference in standard errors of the two means), in the open layout and in a 3-wide channel
-// whose field ahead of the bolt falls far below double's range (DeepField). A bolt that fills
-// its channel scores in the hundreds.
-void lightningShape(bool quick, Section& out) {
+// difference in standard errors of the two means), in the geometries games use: the open
+// layout the calibration grows, a point target off-axis, the ground (a target region: every
+// bottom cell), a wall (example 04), a wide grid, 3-D towards a ground plane, and a 3-wide
+// channel whose field ahead of the bolt falls far below double's range (DeepField). A bolt
+// that fills its channel scores in the hundreds. Each layout also gets a sheet: the first
+// seeds' DBM bolts above the calibrated fast method's.
+void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
   out = {"lightning-shape",
          "Lightning: cells, tips and D against exact DBM, in seed-noise units",
          "exact DBM (capacitance, then MGPCG at 1e-8; DeepField below 1e-8) on the same layout over as many seeds",
@@ -283,13 +315,47 @@ void lightningShape(bool quick, Section& out) {
          "cells, tips, D (method / DBM)",
          {},
          {}};
-  const int seeds = quick ? 6 : 20;
+  const int seeds = quick ? 6 : 20, drawn = 4;
   struct Layout {
-    std::string name;
+    std::string name, id;
     lt::Params params;
+    bool tolerances = false;  // also DBM with MGPCG at loose tolerances
+  };
+  auto ground = [](lt::Params p) {  // every bottom cell (3-D: the bottom layer) a target
+    p.targets.clear();
+    p.targetRegion.assign(size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1)), 0);
+    for (int z = 0; z < std::max(p.depth, 1); ++z)
+      for (int x = 0; x < p.width; ++x) p.targetRegion[(size_t(z) * size_t(p.height) + size_t(p.height - 1)) * size_t(p.width) + size_t(x)] = 1;
+    lt::calibrate(p);
+    return p;
   };
   std::vector<Layout> layouts;
-  for (int n : quick ? std::vector<int>{32} : std::vector<int>{64, 128}) layouts.push_back({std::to_string(n) + "² open", layoutOf(n, false)});
+  for (int n : quick ? std::vector<int>{32} : std::vector<int>{64, 128})
+    layouts.push_back({std::to_string(n) + "² open", "open-" + std::to_string(n), layoutOf(n, false), true});
+  const int n = quick ? 32 : 128;
+  {
+    lt::Params p = layoutOf(n, false);
+    p.start = {n / 4, 0};
+    p.targets = {{3 * n / 4, n - 1}};
+    lt::calibrate(p);
+    layouts.push_back({std::to_string(n) + "² off-axis", "off-axis-" + std::to_string(n), p});
+  }
+  layouts.push_back({std::to_string(n) + "² ground", "ground-" + std::to_string(n), ground(layoutOf(n, false))});
+  if (!quick) {
+    lt::Params wall = layoutOf(96, false);  // examples/04-storm-over-water.json's bolt
+    wall.start = {20, 0};
+    wall.targets = {{70, 95}};
+    wall.obstacles.assign(96 * 96, 0);
+    for (int y = 40; y < 46; ++y)
+      for (int x = 30; x < 66; ++x) wall.obstacles[size_t(y) * 96 + size_t(x)] = 1;
+    lt::calibrate(wall);
+    layouts.push_back({"96² wall (example 04)", "wall-96", wall});
+    lt::Params wide = layoutOf(128, false);
+    wide.width = 256;
+    wide.start = {128, 0};
+    layouts.push_back({"256 × 128 ground", "ground-256x128", ground(wide)});
+    layouts.push_back({"32³ ground plane", "ground-32x32x32", ground(layoutOf(32, true))});
+  }
   {
     const int length = quick ? 128 : 512;
     lt::Params c = layoutOf(32, false);
@@ -297,10 +363,17 @@ void lightningShape(bool quick, Section& out) {
     c.start = {1, 0};
     c.targets = {{1, length - 1}};
     lt::calibrate(c);
-    layouts.push_back({"3 × " + std::to_string(length) + " channel", c});
+    layouts.push_back({"3 × " + std::to_string(length) + " channel", "channel", c, true});
   }
   for (const Layout& l : layouts) {
-    auto shapes = [&](lt::Params p, std::vector<double>* times) {
+    Sheet sheet;
+    sheet.section = out.id;
+    sheet.id = "lightning-shape-" + l.id;
+    sheet.caption = l.name + ": exact DBM (top row) and fast calibrated (bottom row), seeds 1 to " + std::to_string(drawn);
+    sheet.width = l.params.width;
+    sheet.height = l.params.height;
+    const bool drawSheet = l.params.width > 3;
+    auto shapes = [&](lt::Params p, std::vector<double>* times, const char* label) {
       std::vector<lt::BoltShape> v;
       for (int seed = 1; seed <= seeds; ++seed) {
         p.seed = uint64_t(seed);
@@ -308,6 +381,7 @@ void lightningShape(bool quick, Section& out) {
         if (!b.ok()) continue;
         v.push_back(lt::shapeOf(b.value(), p.width, p.height, p.depth));
         if (times) times->push_back(b.value().stats.elapsedMs);
+        if (label && drawSheet && seed <= drawn) sheetPanel(sheet, b.value(), std::string(label) + " seed " + std::to_string(seed));
       }
       return v;
     };
@@ -315,23 +389,25 @@ void lightningShape(bool quick, Section& out) {
     ref.method = lt::Method::kDbm;
     ref.tolerance = 1e-8;
     std::vector<double> refTimes;
-    const auto refShapes = shapes(ref, &refTimes);
+    const auto refShapes = shapes(ref, &refTimes, "dbm");
     std::vector<std::pair<std::string, lt::Params>> settings;
     settings.push_back({"fast calibrated", l.params});
     lt::Params paper = l.params;
     paper.axisGrowth = lt::kPaperAxisGrowth, paper.lifetime = 4;
     settings.push_back({"fast paper (lifetime 4)", paper});
-    lt::Params charges = l.params;
-    charges.method = lt::Method::kCharges;
-    settings.push_back({"charges calibrated", charges});
-    for (double tol : {1e-1, 1e-2, 1e-4}) {
+    if (!l.params.depth) {
+      lt::Params charges = l.params;
+      charges.method = lt::Method::kCharges;
+      settings.push_back({"charges calibrated", charges});
+    }
+    for (double tol : l.tolerances ? std::vector<double>{1e-1, 1e-2, 1e-4} : std::vector<double>{}) {
       lt::Params d = l.params;
       d.method = lt::Method::kDbm, d.solver = lt::Solver::kMgpcg, d.tolerance = tol;
       settings.push_back({"dbm-mgpcg tol " + fmt(tol, 1), d});
     }
     for (const auto& [name, p] : settings) {
       std::vector<double> times;
-      const auto methodShapes = shapes(p, &times);
+      const auto methodShapes = shapes(p, &times, name == "fast calibrated" ? "fast" : nullptr);
       const auto d = lt::shapeDistance(methodShapes, refShapes);
       // Fewer than two bolts on a side (failed growths) have no spread to measure against.
       const double score = methodShapes.size() < 2 || refShapes.size() < 2 ? NAN : d.worst;
@@ -347,6 +423,7 @@ void lightningShape(bool quick, Section& out) {
     out.points.push_back(pointOf("dbm exact " + l.name, "reference", spreadOf(refTimes), 0,
                                  std::to_string(refShapes.size()) + " seeds"));
     out.points.back().group = l.name;
+    if (drawSheet) sheets.push_back(std::move(sheet));
   }
 }
 
@@ -904,8 +981,41 @@ void plot(const Section& s, const fs::path& dir) {
   fs::remove(script);
 }
 
+// A sheet as one PNG: panels of bolts, white main channels and blue branches on black, y down.
+void drawSheet(const Sheet& sheet, const fs::path& dir) {
+  const fs::path data = dir / (sheet.id + ".dat"), script = dir / (sheet.id + ".gp");
+  std::ofstream d(data);
+  auto block = [&](const std::vector<std::array<float, 4>>& segments) {
+    for (const auto& e : segments) d << e[0] << " " << e[1] << " " << e[2] - e[0] << " " << e[3] - e[1] << "\n";
+    if (segments.empty()) d << "0 0 0 0\n";  // every index exists: gnuplot counts blank-line pairs
+    d << "\n\n";
+  };
+  for (size_t i = 0; i < sheet.titles.size(); ++i) block(sheet.branches[i]), block(sheet.main[i]);
+  d.close();
+  const int rows = int((sheet.titles.size() + size_t(sheet.columns) - 1) / size_t(sheet.columns));
+  const double aspect = double(sheet.height) / double(sheet.width);
+  const int panel = 240, w = panel * sheet.columns, h = int(panel * aspect * rows) + 40 * rows + 30;
+  std::ofstream g(script);
+  g << "set terminal pngcairo noenhanced background rgb 'black' size " << w << "," << h << " font 'sans,9'\n"
+    << "set output '" << (dir / (sheet.id + ".png")).string() << "'\n"
+    << "set multiplot layout " << rows << "," << sheet.columns << " title \"" << sheet.caption
+    << "\" tc rgb 'white'\n"
+    << "unset key\nunset tics\nset border lc rgb '#404040'\nset size ratio -1\nset lmargin 0.5\nset rmargin 0.5\n"
+    << "set xrange [0:" << sheet.width << "]\nset yrange [" << sheet.height << ":0]\n";
+  for (size_t i = 0; i < sheet.titles.size(); ++i)
+    g << "set title '" << sheet.titles[i] << "' tc rgb 'white'\n"
+      << "plot '" << data.string() << "' index " << 2 * i << " with vectors nohead lc rgb '#7fa8ff' lw 1, '' index "
+      << 2 * i + 1 << " with vectors nohead lc rgb 'white' lw 2\n";
+  g << "unset multiplot\n";
+  g.close();
+  const std::string cmd = "gnuplot '" + script.string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "error_report: gnuplot failed for %s\n", sheet.id.c_str());
+  fs::remove(data);
+  fs::remove(script);
+}
+
 // One section's Markdown (from "## title" to its conclusion) and its JSON entry.
-std::string sectionMarkdown(const Section& s, bool withPlot, json& entry) {
+std::string sectionMarkdown(const Section& s, bool withPlot, const std::vector<Sheet>& sheets, json& entry) {
   std::ostringstream md;
   md << "## " << s.title << "\n\nReference: " << s.reference << ".\n\n";
   if (withPlot) md << "![" << s.title << "](error-vs-time/" << s.id << ".png)\n\n";
@@ -926,6 +1036,8 @@ std::string sectionMarkdown(const Section& s, bool withPlot, json& entry) {
                    {"note", p.note}});
   }
   md << "\n**Conclusion.** " << s.conclusion << "\n\n";
+  for (const Sheet& sheet : sheets)
+    if (withPlot && sheet.section == s.id) md << "![" << sheet.caption << "](error-vs-time/" << sheet.id << ".png)\n\n";
   json front = json::object(), budgets = json::object();
   for (const std::string& group : groupsOf(s)) {
     for (const Point* p : paretoFront(s, group)) front[group].push_back(p->series + " " + p->setting);
@@ -940,7 +1052,8 @@ std::string sectionMarkdown(const Section& s, bool withPlot, json& entry) {
 }
 
 // Writes the whole report from this run's sections.
-void write(const std::vector<Section>& sections, const fs::path& out, bool quick, bool plots, const std::string& stamp) {
+void write(const std::vector<Section>& sections, const std::vector<Sheet>& sheets, const fs::path& out, bool quick, bool plots,
+           const std::string& stamp) {
   fs::create_directories(out / "error-vs-time");
   json j = json::object();
   std::string md = std::string("# Error against run time\n\n") +
@@ -953,7 +1066,9 @@ void write(const std::vector<Section>& sections, const fs::path& out, bool quick
   j["stamp"] = stamp;
   for (const Section& s : sections) {
     if (plots) plot(s, out / "error-vs-time");
-    md += sectionMarkdown(s, fs::exists(out / "error-vs-time" / (s.id + ".png")), j[s.id]);
+    for (const Sheet& sheet : sheets)
+      if (plots && sheet.section == s.id) drawSheet(sheet, out / "error-vs-time");
+    md += sectionMarkdown(s, fs::exists(out / "error-vs-time" / (s.id + ".png")), sheets, j[s.id]);
   }
   std::ofstream(out / "error-vs-time.md") << md;
   std::ofstream(out / "error-vs-time.json") << j.dump(1) << "\n";
@@ -997,7 +1112,8 @@ int main(int argc, char** argv) {
   }
   step("lightning shapes");
   sections.emplace_back();
-  lightningShape(quick, sections.back());
+  std::vector<Sheet> sheets;
+  lightningShape(quick, sections.back(), sheets);
   {
     step("lightning in 3-D");
     Section tv, fd;
@@ -1018,7 +1134,7 @@ int main(int argc, char** argv) {
   sections.emplace_back();
   thinFilm(quick, sections.back());
   conclude(sections);
-  write(sections, out, quick, plots, stamp);
+  write(sections, sheets, out, quick, plots, stamp);
   step(("wrote " + (out / "error-vs-time.md").string()).c_str());
   return 0;
 }

@@ -1,6 +1,7 @@
 // POST /v1/lightning over HTTP.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include <effects/common.h>
@@ -334,6 +335,62 @@ TEST(LightningApi, VolumeProblemsNameTheField) {
   req = request(32);
   req["obstacles"] = {{"rows", {{{"y", 3}, {"z", 1}, {"runs", {{0, 4}}}}}}};
   problem(req, 400, "/obstacles/rows/0/z");
+}
+
+// "targetRegion": the ground as one field; the answer names the struck cell, and include
+// "shape" the bolt's cells, tips, branch points and D (the library's shapeOf).
+TEST(LightningApi, TargetRegionStrikesTheGroundAndShapeDescribesTheBolt) {
+  TestServer s;
+  json req = {{"grid", {{"width", 48}, {"height", 48}}},
+              {"start", {24, 0}},
+              {"targetRegion", {{"rows", {{{"y", 47}, {"runs", {{0, 48}}}}}}}},
+              {"include", {"shape", "cells", "tree"}},
+              {"seed", 5}};
+  for (const char* method : {"fast", "dbm", "charges"}) {
+    req["method"] = method;
+    auto r = s.postJson("/v1/lightning", req);
+    ASSERT_EQ(r->status, 200) << r->body;
+    const json j = json::parse(r->body);
+    ASSERT_EQ(j["struck"].size(), 2u);
+    EXPECT_EQ(j["struck"][1], 47);
+    const size_t last = j["tree"]["mainChannel"].back();
+    EXPECT_EQ(j["cells"][2 * last], j["struck"][0]);
+    EXPECT_EQ(j["shape"]["cells"], j["cellCount"]);
+    std::vector<int> children(j["cellCount"].get<size_t>(), 0);
+    for (int parent : j["tree"]["parent"])
+      if (parent >= 0) ++children[size_t(parent)];
+    EXPECT_EQ(j["shape"]["tips"], std::count(children.begin(), children.end(), 0));
+    EXPECT_EQ(j["shape"]["branchPoints"], std::count_if(children.begin(), children.end(), [](int c) { return c >= 2; }));
+    EXPECT_GT(j["shape"]["fractalDimension"].get<double>(), 0.8);
+  }
+  json plain = request(48);  // without a region: no "struck"
+  EXPECT_FALSE(json::parse(s.postJson("/v1/lightning", plain)->body).contains("struck"));
+
+  json volume = volumeRequest();
+  volume.erase("targets");
+  volume["targetRegion"] = {{"boxes", {{0, 31, 0, 32, 1, 32}}}};
+  auto r = s.postJson("/v1/lightning", volume);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["struck"][1], 31);
+
+  auto problem = [&](json body, int status, const std::string& pointer) {
+    auto p = s.postJson("/v1/lightning", body);
+    ASSERT_EQ(p->status, status) << p->body;
+    EXPECT_EQ(json::parse(p->body)["errors"][0]["pointer"], pointer) << p->body;
+  };
+  json bad = req;
+  bad["targetRegion"] = {{"rows", {{{"y", 48}, {"runs", {{0, 48}}}}}}};
+  problem(bad, 400, "/targetRegion/rows/0/y");
+  bad["targetRegion"] = json::object();
+  problem(bad, 400, "/targetRegion");
+  bad["targetRegion"] = {{"boxes", {{0, 0, 0, 4, 4, 4}}}};
+  problem(bad, 400, "/targetRegion/boxes");
+  bad = req;
+  bad["start"] = {24, 47};
+  problem(bad, 422, "/start");
+  bad = req;
+  bad.erase("targetRegion");
+  problem(bad, 400, "");  // neither targets nor a region: the schema's anyOf
 }
 
 }  // namespace

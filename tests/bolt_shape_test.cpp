@@ -58,6 +58,12 @@ TEST(BoltShape, CombHasKnownTipsSegmentsAndRightAngles) {
   EXPECT_EQ(spineSegments, std::vector<double>(10, 4.0));  // 1-4, 5-8, ..., 37-40
   ASSERT_EQ(m.angles.size(), 9u);
   for (double a : m.angles) EXPECT_NEAR(a, 90.0, 1e-9);
+  // The library's per-response shape (include "shape") on the same comb: a tooth's root has
+  // two children (the tooth and the spine's next cell).
+  const lt::BoltShape shape = lt::shapeOf(boltOf(cells), 64, 64);
+  EXPECT_EQ(shape.tips, 10);
+  EXPECT_EQ(shape.branchPoints, 9);
+  EXPECT_EQ(shape.cells, 41 + 54);
 }
 
 TEST(BoltShape, TwoSampleStatisticsSeeDifferencesAndNotTheirAbsence) {

@@ -273,8 +273,13 @@ std::vector<Cell> turningPoints(const std::vector<Cell>& path) {
 
 }  // namespace detail
 
-std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
-                        int neighbourhood, int depth) {
+namespace {
+
+// A* from `from` to the first goal cell it settles, with the octile (Manhattan) distance to the
+// goals' bounding box [lo, hi] as the heuristic: admissible, and exact for a single goal.
+template <class IsGoal>
+std::vector<Cell> astarTo(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell lo, Cell hi,
+                          IsGoal isGoal, int neighbourhood, int depth) {
   detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
   const detail::Stencil st = detail::stencil(neighbourhood);
   const size_t n = g.cells();
@@ -284,8 +289,9 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
   };
   detail::CellMap<Visit> visits(n);  // a search on a large grid touches the cells around its path only
   const bool manhattan = st.size == 4 || st.size == 6;
+  auto gap = [](int v, int a, int b) { return double(v < a ? a - v : v > b ? v - b : 0); };
   auto h = [&](Cell c) {
-    double dx = std::abs(c.x - to.x), dy = std::abs(c.y - to.y), dz = std::abs(c.z - to.z);
+    double dx = gap(c.x, lo.x, hi.x), dy = gap(c.y, lo.y, hi.y), dz = gap(c.z, lo.z, hi.z);
     if (manhattan) return dx + dy + dz;
     if (depth == 0) return std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy);  // octile
     // 3-D octile: the largest difference straight, the middle one diagonally, the smallest
@@ -297,7 +303,8 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
   const float kStep[4] = {0.0f, 1.0f, float(std::sqrt(2.0)), float(std::sqrt(3.0))};
   using Item = std::pair<double, int32_t>;  // f, index (ties: smaller index first: deterministic)
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
-  size_t s = g.index(from), t = g.index(to);
+  const size_t s = g.index(from);
+  size_t t = n;  // the goal reached
   visits.at(s) = {0.0f, int32_t(s) + 1};  // the start is its own parent: the walk back stops there
   open.push({h(from), int32_t(s)});
   while (!open.empty()) {
@@ -306,7 +313,10 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
     const Cell c = g.cellAt(size_t(i));
     const float ci = visits.get(size_t(i)).cost;
     if (f > ci + h(c) + 1e-6) continue;  // stale entry
-    if (size_t(i) == t) break;
+    if (isGoal(size_t(i))) {
+      t = size_t(i);
+      break;
+    }
     for (int k = 0; k < st.size; ++k) {
       const Cell m{c.x + st.dx[k], c.y + st.dy[k], c.z + st.dz[k]};
       if (!g.inside(m.x, m.y, m.z) || g.blocked(m.x, m.y, m.z)) continue;
@@ -319,7 +329,7 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
       }
     }
   }
-  if (visits.get(t).parent == 0) return {};
+  if (t == n) return {};
   std::vector<Cell> path;
   for (size_t i = t;; i = size_t(visits.get(i).parent - 1)) {
     path.push_back(g.cellAt(i));
@@ -327,6 +337,28 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
   }
   std::reverse(path.begin(), path.end());
   return path;
+}
+
+}  // namespace
+
+std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
+                        int neighbourhood, int depth) {
+  const size_t t = detail::Grid{width, height, &obstacles, std::max(depth, 1)}.index(to);
+  return astarTo(width, height, obstacles, from, to, to, [t](size_t i) { return i == t; }, neighbourhood, depth);
+}
+
+std::vector<Cell> astarToRegion(int width, int height, const std::vector<uint8_t>& obstacles, Cell from,
+                                const std::vector<uint8_t>& goals, int neighbourhood, int depth) {
+  detail::Grid g{width, height, &obstacles, std::max(depth, 1)};
+  Cell lo{width, height, g.depth}, hi{-1, -1, -1};
+  for (size_t i = 0; i < goals.size() && i < g.cells(); ++i)
+    if (goals[i]) {
+      const Cell c = g.cellAt(i);
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+    }
+  if (hi.x < 0 || goals.size() != g.cells()) return {};
+  return astarTo(width, height, obstacles, from, lo, hi, [&](size_t i) { return goals[i] != 0; }, neighbourhood, depth);
 }
 
 double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c) {

@@ -11,6 +11,7 @@
 #include "deep_field.h"
 #include "grid.h"
 #include "laplace.h"
+#include "nearest.h"
 #include "potential.h"
 #include "weight_tree.h"
 
@@ -44,7 +45,9 @@ std::optional<Error> validate(const Params& p) {
   if (p.screeningRadius < 0 || p.screeningRadius > 7) return invalid("/screeningRadius", "must be in [0, 7]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
-  if (p.targets.empty()) return invalid("/targets", "needs at least one target");
+  if (p.targets.empty() && p.targetRegion.empty()) return invalid("/targets", "needs at least one target or a targetRegion");
+  if (!p.targetRegion.empty() && p.targetRegion.size() != cells)
+    return invalid("/targetRegion", p.depth ? "must have width*height*depth cells" : "must have width*height cells");
   if (p.depth == 0 && p.neighbourhood != 4 && p.neighbourhood != 8)
     return invalid("/neighbourhood", "must be 4 or 8 on a 2-D grid");
   if (p.depth && p.neighbourhood != 6 && p.neighbourhood != 26)
@@ -87,6 +90,11 @@ class Grower {
     if (radius_ > 1) near_ = detail::CellMap<uint8_t>(cells);
     for (const Cell& t : p.targets)
       if (g_.inside(t.x, t.y, t.z)) reserved_.at(g_.index(t)) = 1;
+    if (!p.targetRegion.empty()) {  // the region less the obstacles, reserved like targets
+      region_.assign(cells, 0);
+      for (size_t i = 0; i < cells; ++i)
+        if (p.targetRegion[i] && (p.obstacles.empty() || !p.obstacles[i])) region_[i] = reserved_.at(i) = 1;
+    }
   }
 
   std::optional<Error> run();
@@ -118,6 +126,10 @@ class Grower {
   std::optional<Error> growSegment(size_t k);
   std::vector<Cell> guidePath(size_t k, Cell fromCell, Cell target);
   std::unique_ptr<detail::DeepField> dbmProblem(Cell target, Solver solver) const;
+  bool inRegion(int x, int y, int z) const { return g_.inside(x, y, z) && region_[g_.index(x, y, z)]; }
+  // The segment's end is in reach of c: its target touches c, or (toRegion_) a region cell does.
+  bool reached(Cell c, Cell target) const;
+  Cell regionCellTouching(Cell c) const;
   const std::vector<Cell>& candidateCells();
   void reviveFrontier(int from, size_t segmentFirstNode);
   void weighCandidates(std::vector<double>& logPhi);
@@ -128,6 +140,10 @@ class Grower {
 
   const Params& p_;
   Grid g_;
+  std::vector<uint8_t> region_;         // Params::targetRegion less the obstacles (empty: none)
+  detail::NearestCells regionNearest_;  // kFast: eqn 5's P towards the region
+  bool toRegion_ = false;               // the segment grows to the region
+  bool towardsRegion_ = false;          // ... and its axis ends on it (P = distance to the region)
   detail::Stencil stencil_;
   Bolt& bolt_;
   detail::CellIndex nodeOf_, candidateOf_;
@@ -309,8 +325,9 @@ double Grower::fastLogStatic(const Candidate& cand) const {
   const double along = p_.depth ? (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay + (c.z - anchor_.z) * az
                                : (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
   const double G = std::floor(along <= len ? along : 2 * len - along);
-  const double P = p_.depth ? std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y), double(c.z - attractor_.z))
-                            : std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
+  const double P = towardsRegion_ ? regionNearest_.distance(c)
+                    : p_.depth    ? std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y), double(c.z - attractor_.z))
+                                  : std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
   return G * lnGrowth_ - cand.logBoundary - std::log(std::max(P, 0.5));
 }
 
@@ -439,33 +456,66 @@ double Grower::stepError(const std::vector<double>& logPhi) {
 // The path from the segment's start to its target on the grid with the bolt so far blocked,
 // except the start: empty when the target cannot be reached. Its turns guide the growth.
 std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
-  std::vector<uint8_t> withBolt;  // the first segment searches the obstacles as they are (no copy)
-  if (k > 0) {
+  // The first segment searches the obstacles as they are (no copy), unless a target region
+  // (which only its own segment may enter) lies in its way.
+  const bool copy = k > 0 || (!region_.empty() && !toRegion_);
+  std::vector<uint8_t> withBolt;
+  if (copy) {
     withBolt = p_.obstacles;
     if (withBolt.empty()) withBolt.assign(g_.cells(), 0);
     for (const Node& n : bolt_.nodes) withBolt[g_.index(n.cell)] = 1;
+    if (!toRegion_)
+      for (size_t i = 0; i < region_.size(); ++i) withBolt[i] |= region_[i];
     withBolt[g_.index(fromCell)] = 0;
   }
-  const std::vector<uint8_t>& blocked = k > 0 ? withBolt : p_.obstacles;
+  const std::vector<uint8_t>& blocked = copy ? withBolt : p_.obstacles;
   Stopwatch guideWatch;
-  std::vector<Cell> path = astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
+  std::vector<Cell> path = toRegion_ ? astarToRegion(p_.width, p_.height, blocked, fromCell, region_, p_.neighbourhood, p_.depth)
+                                     : astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
   return path;
 }
 
-// The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target at 1, on the
-// solver potential.h chooses.
+// The DBM problem of a segment: bolt so far, obstacles (and outside) at 0, target (or the
+// whole region) at 1, on the solver potential.h chooses.
 std::unique_ptr<detail::DeepField> Grower::dbmProblem(Cell target, Solver solver) const {
   size_t fixedCells = bolt_.nodes.size() + 1;
   for (uint8_t o : p_.obstacles) fixedCells += o != 0;
+  if (toRegion_)
+    for (uint8_t r : region_) fixedCells += r;
   std::unique_ptr<detail::Potential> lap =
       detail::potentialFor(p_.width, p_.height, p_.depth, solver, fixedCells, fixedCells);  // room to grow
   auto field = std::make_unique<detail::DeepField>(std::move(lap), p_.width, p_.height, p_.depth);
   for (size_t i = 0; i < g_.cells(); ++i)
     if (!p_.obstacles.empty() && p_.obstacles[i]) field->fix(g_.cellAt(i), 0.0);
   for (const Node& n : bolt_.nodes) field->fix(n.cell, 0.0);
-  field->fix(target, 1.0);
+  if (!toRegion_) field->fix(target, 1.0);
+  for (size_t i = 0; toRegion_ && i < region_.size(); ++i)
+    if (region_[i]) field->fix(g_.cellAt(i), 1.0);
   return field;
+}
+
+bool Grower::reached(Cell c, Cell target) const {
+  if (!toRegion_) return touching(c, target);
+  for (int k = 0; k < stencil_.size; ++k)
+    if (inRegion(c.x + stencil_.dx[k], c.y + stencil_.dy[k], c.z + stencil_.dz[k])) return true;
+  return false;
+}
+
+// The region cell a bolt cell strikes: of the region cells touching it, the nearest (a face
+// before an edge before a corner), the first in stencil order among equals.
+Cell Grower::regionCellTouching(Cell c) const {
+  Cell best = c;
+  int bestD = 4;
+  for (int k = 0; k < stencil_.size; ++k) {
+    const int dx = stencil_.dx[k], dy = stencil_.dy[k], dz = stencil_.dz[k];
+    const int d = dx * dx + dy * dy + dz * dz;
+    if (d < bestD && inRegion(c.x + dx, c.y + dy, c.z + dz)) {
+      best = {c.x + dx, c.y + dy, c.z + dz};
+      bestD = d;
+    }
+  }
+  return best;
 }
 
 const std::vector<Cell>& Grower::candidateCells() {
@@ -503,6 +553,7 @@ void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, si
          (touching(newest, waypoints[wp]) || detail::lineOfSight(g_, newest, waypoints[wp + 1]))) {
     anchor_ = newest;
     attractor_ = waypoints[++wp];
+    towardsRegion_ = toRegion_ && wp + 1 == waypoints.size();
     if (p_.method == Method::kFast) {
       // A new leg of the guide: without a lifetime the frontier left behind (the room before
       // a gap in a wall) would keep candidates that the new axis rewards through the wall.
@@ -517,22 +568,27 @@ void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, si
 }
 
 std::optional<Error> Grower::growSegment(size_t k) {
-  const Cell target = p_.targets[k];
+  toRegion_ = k == p_.targets.size();  // the last segment, when a region is given
+  const Cell target = toRegion_ ? Cell{} : p_.targets[k];
   const int from = k == 0 ? 0 : int(bolt_.nodes.size()) - 1;  // previous target's node
-  const std::string field = "/targets/" + std::to_string(k);
+  const std::string field = toRegion_ ? "/targetRegion" : "/targets/" + std::to_string(k);
   const Cell fromCell = bolt_.nodes[size_t(from)].cell;
 
   // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
   std::vector<Cell> path = guidePath(k, fromCell, target);
   if (path.empty())
-    return unsatisfiable(field, "target is unreachable from " + std::string(k ? "the previous target" : "start"));
+    return unsatisfiable(field, std::string(toRegion_ ? "no cell of the region" : "target") + " is reachable from " +
+                                    (k ? "the previous target" : "start"));
   const bool useGuide =
       p_.method != Method::kDbm && (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
-  std::vector<Cell> waypoints = useGuide ? detail::turningPoints(path) : std::vector<Cell>{target};
+  // Towards a region, the axis (and fast's eqn 8) aims at the region's cell the search reached.
+  std::vector<Cell> waypoints = useGuide ? detail::turningPoints(path) : std::vector<Cell>{path.back()};
   if (useGuide) bolt_.guide.insert(bolt_.guide.end(), waypoints.begin(), waypoints.end());
   size_t wp = 0;
   anchor_ = fromCell;
   attractor_ = waypoints[0];
+  towardsRegion_ = toRegion_ && waypoints.size() == 1;
+  if (toRegion_ && p_.method == Method::kFast) regionNearest_ = detail::NearestCells(p_.width, p_.height, p_.depth, region_);
   if (p_.method == Method::kDbm) laplace_ = dbmProblem(target, p_.solver);
   if (p_.measureError) reference_ = dbmProblem(target, Solver::kMgpcg);
 
@@ -543,7 +599,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
   std::vector<double> logPhi, scratch;
   size_t segmentFirstNode = bolt_.nodes.size();
   addCandidatesAround(from);
-  while (!touching(bolt_.nodes[size_t(last)].cell, target)) {
+  while (!reached(bolt_.nodes[size_t(last)].cell, target)) {
     if (size_t(step_) >= p_.maxSteps)
       return overLimit("/maxSteps", "growth step budget of " + std::to_string(p_.maxSteps) + " cells exhausted");
     ++step_;
@@ -575,8 +631,9 @@ std::optional<Error> Grower::growSegment(size_t k) {
     bolt_.stats.counters["stageSolves"] += laplace_->stageSolves();
   }
   ++step_;
-  reserved_.at(g_.index(target)) = 0;
-  addNode(target, last);
+  const Cell struck = toRegion_ ? regionCellTouching(bolt_.nodes[size_t(last)].cell) : target;
+  reserved_.at(g_.index(struck)) = 0;
+  addNode(struck, last);
   return std::nullopt;
 }
 
@@ -595,6 +652,12 @@ std::optional<Error> Grower::run() {
     for (size_t j = 0; j < k; ++j)
       if (p_.targets[j] == p_.targets[k]) return unsatisfiable(f, "repeats an earlier target");
     if (p_.targets[k] == p_.start) return unsatisfiable(f, "equals start");
+    if (!region_.empty() && region_[g_.index(p_.targets[k])]) return unsatisfiable(f, "lies in the target region");
+  }
+  if (!region_.empty()) {
+    if (region_[g_.index(p_.start)]) return unsatisfiable("/start", "lies in the target region");
+    if (std::find(region_.begin(), region_.end(), uint8_t(1)) == region_.end())
+      return unsatisfiable("/targetRegion", "has no cell outside the obstacles");
   }
   if (p_.method == Method::kFast && p_.depth) {
     Stopwatch w;
@@ -609,7 +672,7 @@ std::optional<Error> Grower::run() {
     boundaryMemo_ = detail::CellMap<float>(g_.cells());
   }
   addNode(p_.start, -1);
-  for (size_t k = 0; k < p_.targets.size(); ++k) {
+  for (size_t k = 0; k < p_.targets.size() + (region_.empty() ? 0 : 1); ++k) {
     if (auto e = growSegment(k)) return e;
     bolt_.mainChannel.clear();
   }

@@ -179,16 +179,17 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height, i
 }
 
 BoltShape shapeOf(const Bolt& bolt, int width, int height, int depth) {
-  std::vector<char> hasChild(bolt.nodes.size(), 0);
+  std::vector<int> children(bolt.nodes.size(), 0);
   std::vector<Cell> cells;
   cells.reserve(bolt.nodes.size());
   for (const Node& n : bolt.nodes) {
-    if (n.parent >= 0) hasChild[size_t(n.parent)] = 1;
+    if (n.parent >= 0) ++children[size_t(n.parent)];
     cells.push_back(n.cell);
   }
   BoltShape out;
   out.cells = double(cells.size());
-  out.tips = double(std::count(hasChild.begin(), hasChild.end(), 0));
+  out.tips = double(std::count(children.begin(), children.end(), 0));
+  out.branchPoints = double(std::count_if(children.begin(), children.end(), [](int c) { return c >= 2; }));
   out.dimension = depth ? fractalDimension(cells, width, height, depth) : fractalDimension(cells, width, height);
   return out;
 }

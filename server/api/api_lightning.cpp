@@ -1,4 +1,5 @@
 // POST /v1/lightning — grid + obstacles + start/targets -> bolt tree, polylines, quality.
+#include <algorithm>
 #include <optional>
 
 #include <effects/lightning.h>
@@ -191,7 +192,8 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   r.world = parseWorld(body);
   p.start = cellOf(body["start"], p.depth, at + "/start");
   p.targets.clear();
-  for (size_t i = 0; i < body["targets"].size(); ++i)
+  r.targetRegion = body.contains("targetRegion");
+  for (size_t i = 0; i < body.value("targets", json::array()).size(); ++i)
     p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   p.eta = body.value("eta", p.eta);
   p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
@@ -222,6 +224,13 @@ lt::Params boltParams(const LightningRequest& r, const json& body, const Config&
     p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
                                                  at + "/obstacles")
                           : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
+  if (r.targetRegion) {
+    const json& region = body["targetRegion"];
+    p.targetRegion = p.depth ? parseVolumeObstacles(region, p.width, p.height, p.depth, r.world, config, at + "/targetRegion")
+                             : parseObstacles(region, p.width, p.height, at + "/targetRegion");
+    if (std::find(p.targetRegion.begin(), p.targetRegion.end(), uint8_t(1)) == p.targetRegion.end())
+      throw fieldError(400, at + "/targetRegion", "holds no cell of the grid");
+  }
   lt::calibrate(p);  // from one look at the obstacles
   if (r.variant == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
     p.lifetime = lt::kPaperLifetime;
@@ -261,6 +270,10 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   out["mainChannelLength"] = bolt.mainChannel.size();
   out["cellCount"] = bolt.nodes.size();
   out["steps"] = bolt.nodes.back().step;
+  if (!p.targetRegion.empty()) {
+    const lt::Cell s = bolt.nodes[size_t(bolt.mainChannel.back())].cell;
+    out["struck"] = p.depth ? json::array({s.x, s.y, s.z}) : json::array({s.x, s.y});
+  }
 
   if (include.has("polylines") || include.has("timeline") || include.has("mesh") || glbFormat) {
     const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
@@ -282,11 +295,14 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   if (include.has("cells")) out["cells"] = cellsJson(bolt);
   if (include.has("tree")) out["tree"] = treeJson(bolt);
   if (include.has("guide")) out["guide"] = guideJson(bolt);
-  if (include.has("fractalDimension")) {
-    std::vector<lt::Cell> cellsOnly;
-    for (const auto& n : bolt.nodes) cellsOnly.push_back(n.cell);
-    out["fractalDimension"] = p.depth ? lt::fractalDimension(cellsOnly, p.width, p.height, p.depth)
-                                      : lt::fractalDimension(cellsOnly, p.width, p.height);
+  if (include.has("fractalDimension") || include.has("shape")) {
+    const lt::BoltShape shape = lt::shapeOf(bolt, p.width, p.height, p.depth);
+    if (include.has("fractalDimension")) out["fractalDimension"] = shape.dimension;
+    if (include.has("shape"))
+      out["shape"] = {{"cells", size_t(shape.cells)},
+                      {"tips", size_t(shape.tips)},
+                      {"branchPoints", size_t(shape.branchPoints)},
+                      {"fractalDimension", shape.dimension}};
   }
   if (include.has("error")) {
     out["error"] = {{"meanTotalVariation", bolt.stats.error.value_or(0.0)},

@@ -48,7 +48,9 @@ Cost lightningCost(const LightningRequest& r, const Config& config) {
   // dbm also keeps DeepField's per-cell state (effects/lightning/deep_field.h): a byte for the
   // cells fixed at 0, and once a stage is cut its stage number and frozen value (10 bytes).
   const bool dbm = p.method == lt::Method::kDbm;
-  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0);
+  // A target region: its flags, and at worst (every cell on its surface: a checkerboard) the
+  // k-d tree fast measures eqn 5's P with, 12 bytes per surface cell.
+  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 9 : 0);
   // dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = dbm && p.solver == lt::Solver::kCapacitance;
   const bool clamped = size_t(p.width) * size_t(p.height) > cells;  // refused by the parser

@@ -52,6 +52,7 @@ struct LightningRequest {
   effects::lightning::ShapeParams shape;
   effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
   World world;                                  // 3-D: where the grid lies ("world")
+  bool targetRegion = false;                    // "targetRegion" given (parsed by the run step)
 };
 
 struct TangentsRequest {

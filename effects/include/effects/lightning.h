@@ -10,6 +10,10 @@
 // probability p_i = Phi_i^eta / sum_j Phi_j^eta (seed 002 eqn 2), computed in log space.
 // A segment ends when the bolt touches (is a neighbour of) its target; the target joins the bolt.
 // Several targets make chain lightning: each later segment grows from the previous target.
+// A target region (the ground, a roof, a mesh's voxels) ends the strike on whichever of its
+// cells the bolt touches first: DBM holds the whole region at Phi = 1; fast and charges aim
+// at the region's cell nearest to the segment's start (by A*), and fast's P (eqn 5) is the
+// distance to the region's nearest cell.
 //
 // Methods (how Phi is obtained):
 //   kFast    seed 002 eqns 4-8: Phi_i = a^G / (B * N * P), candidates live `lifetime` steps.
@@ -32,8 +36,9 @@
 // obstacle voxels (a Barnes-Hut octree); kDbm solves the 7-point Laplacian; A* moves over the
 // same neighbourhood. kCharges is 2-D only. docs/effects.md section 1.7.
 //
-// Errors: start/target outside the grid or inside an obstacle, start == target, an
-// unreachable target -> kUnsatisfiable naming the field; exhausting the step budget ->
+// Errors: start/target outside the grid or inside an obstacle, start == target, a start or
+// target inside the target region, an unreachable target or region -> kUnsatisfiable naming
+// the field; exhausting the step budget ->
 // kLimitExceeded. Deterministic: same Params -> same Bolt, bit for bit.
 // Thread-safety: reentrant; the boundary-map cache is internally synchronised.
 #pragma once
@@ -95,7 +100,10 @@ struct Params {
   std::vector<uint8_t> obstacles;  // empty, or width*height(*depth) flags (x fastest, then y,
                                    // then z; nonzero = blocked)
   Cell start{64, 0};
-  std::vector<Cell> targets{{64, 127}};
+  std::vector<Cell> targets{{64, 127}};  // may be empty when targetRegion is given
+  std::vector<uint8_t> targetRegion;     // empty, or flags like obstacles: after the targets (if
+                                         // any) the bolt grows until it touches one of these
+                                         // cells (those inside an obstacle do not count)
   Method method = Method::kFast;
   double eta = 2.0;         // [0, 50]; seed 002: 2..3 looks like lightning
   int lifetime = 0;         // kFast: steps a candidate lives; 0 = forever (seed 002 uses 4)
@@ -148,9 +156,10 @@ double fractalDimension(const std::vector<Cell>& cells, int width, int height);
 double fractalDimension(const std::vector<Cell>& cells, int width, int height, int depth);
 
 // What a player sees of a bolt, for comparing methods over seeds: cells, tips (cells nothing
-// grew from) and the box-counting dimension D on the bolt's grid.
+// grew from), branch points (cells two or more grew from) and the box-counting dimension D on
+// the bolt's grid.
 struct BoltShape {
-  double cells = 0, tips = 0, dimension = 0;
+  double cells = 0, tips = 0, dimension = 0, branchPoints = 0;
 };
 BoltShape shapeOf(const Bolt& bolt, int width, int height, int depth = 0);
 // Two sets of bolts (a method's, a reference's; each over seeds) compared on their mean cells,
@@ -197,6 +206,10 @@ size_t voxelizationWork(int width, int height, int depth, const std::vector<doub
 // unreachable. With depth > 0, over the 26-neighbourhood (3-D octile) or the 6 (Manhattan).
 std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
                         int neighbourhood = 8, int depth = 0);
+// The same to the nearest reachable cell of a set (goals: flags like obstacles), guided by the
+// distance to the set's bounding box; empty if no cell of it is reachable.
+std::vector<Cell> astarToRegion(int width, int height, const std::vector<uint8_t>& obstacles, Cell from,
+                                const std::vector<uint8_t>& goals, int neighbourhood = 8, int depth = 0);
 
 }  // namespace effects::lightning
 
