@@ -3,23 +3,26 @@
 // effects/lightning/shape.cpp's estimators: the box counts here are grid-aligned (no minimum
 // over offsets) and every curve is kept, not just its slope.
 //
-//   boxCounts      N(s): boxes of side s = 1, 2, 4, ... up to a quarter of the grid's smaller
-//                  side that hold a bolt cell
+//   boxCounts      N(s): boxes (3-D: cubes) of side s = 1, 2, 4, ... up to a quarter of the
+//                  grid's smallest side that hold a bolt cell
 //   massRadius     M(r): bolt cells within Euclidean distance r of the start, r = 2, 4, 8, ...
 //   segments       cells between branch points, tips and the start along the tree (a segment
 //                  ends at a node with no child or more than one)
 //   angles         at each branch point, the angle (degrees) between its first two children's
 //                  directions, each taken over up to kAngleReach cells along its segment
+//   struckOffset   where the main channel ends, from below the start (x and z)
 //   tips           two ways: tree leaves (cells nothing grew from), and cells with exactly one
-//                  occupied 8-neighbour (what the eye counts as an end)
+//                  occupied 8-neighbour (3-D: 26-neighbour; what the eye counts as an end)
 // Two samples are compared by Welch's z per curve point (largest |z|) and, for pooled
 // distributions, by the Kolmogorov-Smirnov distance.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -37,37 +40,47 @@ struct Measures {
   std::vector<double> segments;    // lengths, cells
   std::vector<double> angles;      // degrees
   double leafTips = 0, neighbourTips = 0, cells = 0;
+  double struckOffset = 0;         // the main channel's end from below the start (x, z)
 };
 
-inline Measures measure(const lt::Bolt& bolt, int width, int height) {
+// depth 0: a 2-D grid.
+inline Measures measure(const lt::Bolt& bolt, int width, int height, int depth = 0) {
   Measures m;
   const auto& nodes = bolt.nodes;
   m.cells = double(nodes.size());
-  std::set<std::pair<int, int>> occupied;
-  for (const auto& n : nodes) occupied.insert({n.cell.x, n.cell.y});
-  for (int s = 1; s <= std::min(width, height) / 4; s *= 2) {
-    std::set<std::pair<int, int>> boxes;
-    for (const auto& [x, y] : occupied) boxes.insert({x / s, y / s});
+  using Key = std::tuple<int, int, int>;
+  std::set<Key> occupied;
+  for (const auto& n : nodes) occupied.insert({n.cell.x, n.cell.y, n.cell.z});
+  const int smallest = depth ? std::min({width, height, depth}) : std::min(width, height);
+  for (int s = 1; s <= smallest / 4; s *= 2) {
+    std::set<Key> boxes;
+    for (const auto& [x, y, z] : occupied) boxes.insert({x / s, y / s, z / s});
     m.boxCounts.push_back(double(boxes.size()));
   }
   if (!nodes.empty()) {
     const lt::Cell o = nodes.front().cell;
-    for (int r = 2; r <= std::max(width, height); r *= 2) {
+    for (int r = 2; r <= std::max({width, height, depth}); r *= 2) {
       double count = 0;
       for (const auto& n : nodes)
-        count += std::hypot(double(n.cell.x - o.x), double(n.cell.y - o.y)) <= double(r);
+        count += std::hypot(double(n.cell.x - o.x), double(n.cell.y - o.y), double(n.cell.z - o.z)) <= double(r);
       m.massRadius.push_back(count);
     }
+  }
+  if (!bolt.mainChannel.empty()) {
+    const lt::Cell a = nodes.front().cell, b = nodes[size_t(bolt.mainChannel.back())].cell;
+    m.struckOffset = std::hypot(double(b.x - a.x), double(b.z - a.z));
   }
   std::vector<std::vector<int>> children(nodes.size());
   for (size_t i = 0; i < nodes.size(); ++i)
     if (nodes[i].parent >= 0) children[size_t(nodes[i].parent)].push_back(int(i));
+  const int reachZ = depth ? 1 : 0;
   for (size_t i = 0; i < nodes.size(); ++i) {
     m.leafTips += children[i].empty() && i != 0;
     int neighbours = 0;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if ((dx || dy) && occupied.count({nodes[i].cell.x + dx, nodes[i].cell.y + dy})) ++neighbours;
+    for (int dz = -reachZ; dz <= reachZ; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if ((dx || dy || dz) && occupied.count({nodes[i].cell.x + dx, nodes[i].cell.y + dy, nodes[i].cell.z + dz})) ++neighbours;
     m.neighbourTips += neighbours == 1;
   }
   // Segments: from the start and from every branch point, each child's run until a node that
@@ -83,17 +96,19 @@ inline Measures measure(const lt::Bolt& bolt, int width, int height) {
   auto direction = [&](int from, int first) {  // over up to kAngleReach cells from `from`
     int at = first;
     for (int k = 1; k < kAngleReach && children[size_t(at)].size() == 1; ++k) at = children[size_t(at)].front();
-    return std::atan2(double(nodes[size_t(at)].cell.y - nodes[size_t(from)].cell.y),
-                      double(nodes[size_t(at)].cell.x - nodes[size_t(from)].cell.x));
+    const lt::Cell a = nodes[size_t(from)].cell, b = nodes[size_t(at)].cell;
+    return std::array<double, 3>{double(b.x - a.x), double(b.y - a.y), double(b.z - a.z)};
   };
   std::vector<int> starts = {0};
   while (!starts.empty() && !nodes.empty()) {
     const int from = starts.back();
     starts.pop_back();
     const auto& kids = children[size_t(from)];
-    if (kids.size() >= 2) {
-      double a = std::fabs(direction(from, kids[0]) - direction(from, kids[1])) * 180.0 / M_PI;
-      m.angles.push_back(a > 180.0 ? 360.0 - a : a);
+    if (kids.size() >= 2) {  // the angle between the first two children's directions, 0 to 180
+      const auto u = direction(from, kids[0]), v = direction(from, kids[1]);
+      const double dot = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+      const double len = std::sqrt((u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+      m.angles.push_back(std::acos(std::clamp(dot / len, -1.0, 1.0)) * 180.0 / M_PI);
     }
     for (int k : kids) {
       const auto [length, end] = walk(k);

@@ -6,9 +6,19 @@
 // within that noise: indistinguishable at these seeds.
 //
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
-//                   [--method fast|charges] [--splits 40]
+//                   [--method fast|charges] [--splits 40] [--geometry open]
 //
-// Geometry: the calibration's own (start top-centre, target bottom-centre, open grid).
+// Geometries (--size s):
+//   open      the calibration's own: start top-centre, target bottom-centre, s x s
+//   off-axis  start at s/4 on the top row, target at 3s/4 on the bottom row
+//   ground    start top-centre, every bottom cell a target (a target region)
+//   wall      examples/04-storm-over-water.json's bolt scaled to s: an off-axis strike over a
+//             wall that the A* guide leads around
+//   wide      the ground on a 2s x s grid
+//   3d        s^3 voxels (26 neighbours), start at the top face's centre, the bottom layer a
+//             target region
+// Where the strike ends on a region, the struck cell's distance from below the start is
+// compared too (KS).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -34,14 +44,52 @@ struct Sample {
   double msPerBolt = 0;
 };
 
-Sample grow(lt::Method method, int size, double eta, int seeds, uint64_t firstSeed) {
+// The layout of a geometry (above) at size s, before method, eta and seed.
+lt::Params layout(const std::string& geometry, int s) {
+  lt::Params p;
+  p.width = p.height = s;
+  p.start = {s / 2, 1};
+  p.targets = {{s / 2, s - 2}};
+  auto ground = [&] {
+    p.targets.clear();
+    p.targetRegion.assign(size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1)), 0);
+    for (int z = 0; z < std::max(p.depth, 1); ++z)
+      for (int x = 0; x < p.width; ++x)
+        p.targetRegion[(size_t(z) * size_t(p.height) + size_t(p.height - 1)) * size_t(p.width) + size_t(x)] = 1;
+  };
+  if (geometry == "off-axis") {
+    p.start = {s / 4, 1};
+    p.targets = {{3 * s / 4, s - 2}};
+  } else if (geometry == "ground") {
+    ground();
+  } else if (geometry == "wide") {
+    p.width = 2 * s;
+    p.start = {s, 1};
+    ground();
+  } else if (geometry == "3d") {
+    p.depth = s;
+    p.neighbourhood = 26;
+    p.start = {s / 2, 1, s / 2};
+    ground();
+  } else if (geometry == "wall") {  // example 04 at 96: start (20, 0), target (70, 95), wall [30, 40, 36, 6]
+    auto at = [s](int v) { return v * s / 96; };
+    p.start = {at(20), 0};
+    p.targets = {{at(70), s - 1}};
+    p.obstacles.assign(size_t(s) * size_t(s), 0);
+    for (int y = at(40); y < at(46); ++y)
+      for (int x = at(30); x < at(66); ++x) p.obstacles[size_t(y) * size_t(s) + size_t(x)] = 1;
+  } else if (geometry != "open") {
+    std::fprintf(stderr, "unknown geometry %s (open, off-axis, ground, wall, wide, 3d)\n", geometry.c_str());
+    std::exit(2);
+  }
+  return p;
+}
+
+Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed) {
   Sample s;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < seeds; ++k) {
-    lt::Params p;
-    p.width = p.height = size;
-    p.start = {size / 2, 1};
-    p.targets = {{size / 2, size - 2}};
+    lt::Params p = base;
     p.method = method;
     p.eta = eta;
     p.seed = firstSeed + uint64_t(k);
@@ -51,7 +99,7 @@ Sample grow(lt::Method method, int size, double eta, int seeds, uint64_t firstSe
       std::fprintf(stderr, "grow failed: %s\n", bolt.error().message.c_str());
       std::exit(1);
     }
-    s.bolts.push_back(sh::measure(bolt.value(), size, size));
+    s.bolts.push_back(sh::measure(bolt.value(), p.width, p.height, p.depth));
   }
   s.msPerBolt = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / seeds;
   return s;
@@ -86,6 +134,7 @@ struct Row {
 
 int main(int argc, char** argv) {
   int size = 128, fastSeeds = 40, dbmSeeds = 30, splits = 40;
+  std::string geometry = "open";
   std::vector<double> etas = {1, 2, 3};
   lt::Method method = lt::Method::kFast;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -94,6 +143,7 @@ int main(int argc, char** argv) {
     else if (a == "--fast-seeds") fastSeeds = std::atoi(v.c_str());
     else if (a == "--dbm-seeds") dbmSeeds = std::atoi(v.c_str());
     else if (a == "--splits") splits = std::atoi(v.c_str());
+    else if (a == "--geometry") geometry = v;
     else if (a == "--method") method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
     else if (a == "--eta") {
       etas.clear();
@@ -104,7 +154,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const std::vector<Row> rows = {
+  std::vector<Row> rows = {
       {"box counts N(s), every scale", [](auto& a, auto& b) { return sh::curveZ(curves(a, &sh::Measures::boxCounts), curves(b, &sh::Measures::boxCounts)); }, false},
       {"mass-radius M(r)", [](auto& a, auto& b) { return sh::curveZ(curves(a, &sh::Measures::massRadius), curves(b, &sh::Measures::massRadius)); }, false},
       {"tips: tree leaves", [](auto& a, auto& b) { return sh::curveZ(scalars(a, &sh::Measures::leafTips), scalars(b, &sh::Measures::leafTips)); }, false},
@@ -113,15 +163,24 @@ int main(int argc, char** argv) {
       {"segment lengths (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::segments), pooled(b, &sh::Measures::segments)); }, true},
       {"branching angles (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::angles), pooled(b, &sh::Measures::angles)); }, true},
   };
-  std::printf("# %s against dbm by shape, %d², start top-centre, target bottom-centre\n\n", lt::toString(method), size);
+  const lt::Params base = layout(geometry, size);
+  if (!base.targetRegion.empty())  // where on the ground the strike lands
+    rows.push_back({"struck cell's offset (KS)", [](auto& a, auto& b) {
+                      std::vector<double> x, y;
+                      for (const auto& m : a) x.push_back(m.struckOffset);
+                      for (const auto& m : b) y.push_back(m.struckOffset);
+                      return sh::ks(x, y);
+                    }, true});
+  std::printf("# %s against dbm by shape: %s, %d x %d%s\n\n", lt::toString(method), geometry.c_str(), base.width, base.height,
+              base.depth ? (" x " + std::to_string(base.depth)).c_str() : "");
   std::printf("%d %s and %d dbm bolts per eta; noise: 95th percentile over %d random half-splits of the dbm "
               "bolts (KS distances scaled to the sizes compared); meets = within the noise.\n\n",
               fastSeeds, lt::toString(method), dbmSeeds, splits);
   std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", lt::toString(method));
   std::mt19937 rng(49);
   for (double eta : etas) {
-    const Sample fast = grow(method, size, eta, fastSeeds, 1000);
-    const Sample dbm = grow(lt::Method::kDbm, size, eta, dbmSeeds, 5000);
+    const Sample fast = grow(base, method, eta, fastSeeds, 1000);
+    const Sample dbm = grow(base, lt::Method::kDbm, eta, dbmSeeds, 5000);
     for (const Row& row : rows) {
       const double d = row.stat(fast.bolts, dbm.bolts);
       std::vector<double> noise;
