@@ -90,6 +90,7 @@ struct Sheet {
   std::vector<std::string> titles;  // per panel; panels fill rows of `columns`
   // Per panel, the tree's edges (x0, y0, x1, y1 at cell centres): branches, then main channel.
   std::vector<std::vector<std::array<float, 4>>> branches, main;
+  std::vector<std::array<int, 4>> obstacles;  // x, y, width, height: runs of obstacle cells (2-D)
   int columns = 4;
 };
 
@@ -369,9 +370,20 @@ void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
     Sheet sheet;
     sheet.section = out.id;
     sheet.id = "lightning-shape-" + l.id;
-    sheet.caption = l.name + ": exact DBM (top row) and fast calibrated (bottom row), seeds 1 to " + std::to_string(drawn);
     sheet.width = l.params.width;
     sheet.height = l.params.height;
+    sheet.columns = sheet.height * 4 < sheet.width * 3 ? 2 : 4;  // wide grids: larger panels
+    sheet.caption = l.name + ": exact DBM (" + (sheet.columns == 4 ? "top row" : "top two rows") +
+                    ") and fast calibrated (below), seeds 1 to " + std::to_string(drawn);
+    if (!l.params.obstacles.empty() && !l.params.depth)  // the obstacles, as runs along rows
+      for (int y = 0; y < sheet.height; ++y)
+        for (int x = 0; x < sheet.width; ++x) {
+          if (!l.params.obstacles[size_t(y) * size_t(sheet.width) + size_t(x)]) continue;
+          int run = x;
+          while (run < sheet.width && l.params.obstacles[size_t(y) * size_t(sheet.width) + size_t(run)]) ++run;
+          sheet.obstacles.push_back({x, y, run - x, 1});
+          x = run;
+        }
     const bool drawSheet = l.params.width > 3;
     auto shapes = [&](lt::Params p, std::vector<double>* times, const char* label) {
       std::vector<lt::BoltShape> v;
@@ -994,7 +1006,7 @@ void drawSheet(const Sheet& sheet, const fs::path& dir) {
   d.close();
   const int rows = int((sheet.titles.size() + size_t(sheet.columns) - 1) / size_t(sheet.columns));
   const double aspect = double(sheet.height) / double(sheet.width);
-  const int panel = 240, w = panel * sheet.columns, h = int(panel * aspect * rows) + 40 * rows + 30;
+  const int panel = 960 / sheet.columns, w = panel * sheet.columns, h = int(panel * aspect * rows) + 40 * rows + 30;
   std::ofstream g(script);
   g << "set terminal pngcairo noenhanced background rgb 'black' size " << w << "," << h << " font 'sans,9'\n"
     << "set output '" << (dir / (sheet.id + ".png")).string() << "'\n"
@@ -1002,6 +1014,9 @@ void drawSheet(const Sheet& sheet, const fs::path& dir) {
     << "\" tc rgb 'white'\n"
     << "unset key\nunset tics\nset border lc rgb '#404040'\nset size ratio -1\nset lmargin 0.5\nset rmargin 0.5\n"
     << "set xrange [0:" << sheet.width << "]\nset yrange [" << sheet.height << ":0]\n";
+  for (const auto& o : sheet.obstacles)  // objects stay for every panel of the multiplot
+    g << "set object rect from " << o[0] << "," << o[1] << " to " << o[0] + o[2] << "," << o[1] + o[3]
+      << " fc rgb '#505050' fs solid noborder behind\n";
   for (size_t i = 0; i < sheet.titles.size(); ++i)
     g << "set title '" << sheet.titles[i] << "' tc rgb 'white'\n"
       << "plot '" << data.string() << "' index " << 2 * i << " with vectors nohead lc rgb '#7fa8ff' lw 1, '' index "
