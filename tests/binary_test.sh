@@ -2,6 +2,8 @@
 # The effectd binary end to end: flags, serving, SIGTERM with a request in flight -> the
 # request completes and the process exits 0.
 set -euo pipefail
+# shellcheck source=/dev/null
+source "$(dirname "$0")/listen.sh"
 bin="$1"
 log=$(mktemp)
 trap 'rm -f "$log"; kill %1 2>/dev/null || true' EXIT
@@ -15,9 +17,7 @@ if "$bin" --port nope 2>/dev/null; then echo "bad flag accepted"; exit 1; fi
 # past --admission-timeout-ms and get 503 before it could be in flight at SIGTERM).
 EFFECTD_THREADS=2 "$bin" --host 127.0.0.1 --port 0 --heavy-threads 8 2>"$log" &
 pid=$!
-for _ in $(seq 100); do grep -q '"listening"' "$log" && break; sleep 0.05; done
-port=$(grep -o '"port":[0-9]*' "$log" | head -1 | cut -d: -f2)
-[ -n "$port" ] || { cat "$log"; exit 1; }
+wait_for_port "$log"
 grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; exit 1; }
 
 curl -sf "http://127.0.0.1:$port/healthz" | grep -q '"ok"'

@@ -6,6 +6,8 @@
 # installs it).
 #   client_test.sh EFFECTD_BINARY
 set -euo pipefail
+# shellcheck source=/dev/null
+source "$(dirname "$0")/../listen.sh"
 bin=$1
 root=$(cd "$(dirname "$0")/../.." && pwd)
 godot=$(command -v godot3-server || true)
@@ -17,9 +19,7 @@ trap cleanup EXIT
 
 "$bin" --port 0 --access-log 0 2>"$work/log" &
 pid=$!
-for _ in $(seq 100); do grep -q '"listening"' "$work/log" && break; sleep 0.05; done
-port=$(grep -o '"port":[0-9]*' "$work/log" | head -1 | cut -d: -f2)
-[ -n "$port" ] || { cat "$work/log"; echo "FAIL no port"; exit 1; }
+wait_for_port "$work/log"
 # A copy of the project with clients/godot/README.md's snippet in it, pointed at this server.
 cp -r "$root/clients/godot" "$work/project"
 awk '/^```gdscript/{on=1; next} /^```/{if (on) exit} on' "$root/clients/godot/README.md" |

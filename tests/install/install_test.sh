@@ -6,6 +6,8 @@
 # docs/engines.md's C snippet compiled against the prefix.
 #   install_test.sh BUILD_DIR EFFECTD_BINARY
 set -euo pipefail
+# shellcheck source=/dev/null
+source "$(dirname "$0")/../listen.sh"
 build=$(cd "$1" && pwd)
 bin=$2
 here=$(cd "$(dirname "$0")" && pwd)
@@ -49,9 +51,7 @@ echo "ok   docs/engines.md's C snippet: $(LD_LIBRARY_PATH="$libdir" "$work/snipp
 
 "$bin" --port 0 --access-log 0 2>"$work/log" &
 pid=$!
-for _ in $(seq 100); do grep -q '"listening"' "$work/log" && break; sleep 0.05; done
-port=$(grep -o '"port":[0-9]*' "$work/log" | head -1 | cut -d: -f2)
-[ -n "$port" ] || { cat "$work/log"; fail "no port"; }
+wait_for_port "$work/log"
 post() { curl -s -H 'Content-Type: application/json' "http://127.0.0.1:$port$1" -d "$2"; }
 post /v1/fog '{"fog":{"fogType":"GL_EXP","density":0.05},"table":{"size":64,"range":[0,100]}}' >"$work/fog.json"
 post /v1/lightning '{"grid":{"width":48,"height":48},"start":[24,0],"targets":[[24,47]],"seed":3,"include":["cells"]}' >"$work/bolt.json"

@@ -3,6 +3,8 @@
 # ephemeral port, runs oracle.mjs against it with the real model from Debian's
 # assimp-testmodels, then gltf.mjs (binary glTF answers: Khronos validator and the oracle).
 set -euo pipefail
+# shellcheck source=/dev/null
+source "$(dirname "$0")/../listen.sh"
 bin="$1"
 here="$(cd "$(dirname "$0")" && pwd)"
 model=/usr/share/assimp/models/OBJ/spider.obj
@@ -15,8 +17,6 @@ log=$(mktemp)
 trap 'kill "$pid" 2>/dev/null || true; rm -f "$log"' EXIT
 "$bin" --host 127.0.0.1 --port 0 2>"$log" &
 pid=$!
-for _ in $(seq 100); do grep -q '"listening"' "$log" && break; sleep 0.05; done
-port=$(grep -o '"port":[0-9]*' "$log" | head -1 | cut -d: -f2)
-[ -n "$port" ] || { cat "$log"; exit 1; }
+wait_for_port "$log"
 node "$here/oracle.mjs" "http://127.0.0.1:$port" "$model"
 node "$here/gltf.mjs" "http://127.0.0.1:$port"

@@ -4,6 +4,8 @@
 # file rotated and reread on SIGHUP while a client stays connected.
 #   signing_test.sh EFFECTD_BINARY
 set -euo pipefail
+# shellcheck source=/dev/null
+source "$(dirname "$0")/../listen.sh"
 bin=$1
 root=$(cd "$(dirname "$0")/../.." && pwd)
 work=$(mktemp -d /tmp/effectd-sign.XXXXXX)
@@ -15,9 +17,7 @@ fail() { echo "FAIL $*"; exit 1; }
 printf 'first-signing-key-0123456789\n' >"$work/keys.txt"
 "$bin" --port 0 --access-log 0 --url-signing-key-file "$work/keys.txt" 2>"$work/log" &
 pid=$!
-for _ in $(seq 100); do grep -q '"listening"' "$work/log" && break; sleep 0.05; done
-port=$(grep -o '"port":[0-9]*' "$work/log" | head -1 | cut -d: -f2)
-[ -n "$port" ] || { cat "$work/log"; fail "no port"; }
+wait_for_port "$work/log"
 base="http://127.0.0.1:$port"
 status() { curl -s -o /dev/null -w '%{http_code}' "$base$1"; }
 
