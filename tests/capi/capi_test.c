@@ -1,6 +1,7 @@
 /* The C API (effects/effects.h) from C99: every family of functions on inputs with known
  * answers, the errors of hostile inputs (NULLs, NaN, huge grids, indices out of range, wrong
- * struct sizes) naming their parameter, and no leaks (the ASan suite runs it). With --print it
+ * struct sizes, and the service's hostile corpus where its cases reach C) naming their
+ * parameter, and no leaks (the ASan suite runs it). With --print it
  * prints one bolt and one fog table for tests/capi/ffi_test.sh to compare with C#.
  *   capi_test [--print] */
 #include <math.h>
@@ -106,6 +107,32 @@ static void test_fog(void) {
   CHECK(effects_fog_table_build(&fog, &o, &table, &e) != EFFECTS_OK && table == NULL, "a table past max_size");
   effects_error_free(e);
   expect_error(effects_fog_table_build(NULL, &o, &table, &e), &e, EFFECTS_INVALID_ARGUMENT, "", "NULL fog");
+
+  /* The service's hostile corpus (proto/examples/invalid/g-fog-*, fog-*), as they reach C. */
+  effects_fog_defaults(&fog);
+  fog.type = EFFECTS_FOG_GL_EXP;
+  fog.density = 1e308;
+  CHECK(effects_fog_factor(&fog, 0, 0, 10, &f, &e) == EFFECTS_OK && f >= 0 && f <= 1, "density 1e308 (g-fog-density-1e308)");
+  fog.density = -1;
+  expect_error(effects_fog_validate(&fog, &e), &e, EFFECTS_INVALID_ARGUMENT, "/density", "negative density");
+  effects_fog_defaults(&fog);
+  fog.type = EFFECTS_FOG_HEIGHT;
+  fog.height_falloff = -0.1;
+  expect_error(effects_fog_validate(&fog, &e), &e, EFFECTS_INVALID_ARGUMENT, "/heightFalloff", "negative falloff (g-fog-height-falloff-negative)");
+  effects_fog_defaults(&fog);
+  fog.type = EFFECTS_FOG_DISTANCE_GAUSSIAN;
+  fog.peak = 0;
+  expect_error(effects_fog_validate(&fog, &e), &e, EFFECTS_INVALID_ARGUMENT, "/peak", "peak 0 (g-fog-peak-zero)");
+  effects_fog_defaults(&fog);
+  fog.type = EFFECTS_FOG_GL_LINEAR;
+  fog.start = 5, fog.end = 5;
+  CHECK(effects_fog_validate(&fog, &e) == EFFECTS_INVALID_ARGUMENT, "an empty GL_LINEAR range (fog-gl-linear-empty-range)");
+  effects_error_free(e);
+  e = NULL;
+  effects_fog_defaults(&fog);
+  fog.visibility_range = -3;
+  CHECK(effects_fog_validate(&fog, &e) == EFFECTS_INVALID_ARGUMENT, "negative visibility (fog-negative-visibility)");
+  effects_error_free(e);
 }
 
 static void test_bolt(void) {
@@ -242,6 +269,24 @@ static void test_bubble(void) {
   p.level = 2;
   p.n2 = NAN;
   expect_error(effects_bubble_mesh_make(&p, &m, &e), &e, EFFECTS_INVALID_ARGUMENT, "/n2", "NaN index of refraction");
+
+  /* The service's hostile corpus (proto/examples/invalid/g-bubble-*), as they reach C. */
+  effects_bubble_params_defaults(&p);
+  p.radius = 0;
+  expect_error(effects_bubble_mesh_make(&p, &m, &e), &e, EFFECTS_INVALID_ARGUMENT, "/radius", "radius 0 (g-bubble-radius-zero)");
+  p.radius = -0.0;
+  expect_error(effects_bubble_mesh_make(&p, &m, &e), &e, EFFECTS_INVALID_ARGUMENT, "/radius", "radius -0 (g-bubble-radius-negative-zero)");
+  effects_bubble_params_defaults(&p);
+  p.n1 = 1e300;
+  expect_error(effects_bubble_mesh_make(&p, &m, &e), &e, EFFECTS_INVALID_ARGUMENT, "/n1", "n1 1e300 (g-bubble-n1-huge)");
+  effects_bubble_params_defaults(&p);
+  p.level = -1;
+  CHECK(effects_bubble_mesh_make(&p, &m, &e) != EFFECTS_OK && m == NULL, "level -1 (g-bubble-level-negative)");
+  effects_error_free(e);
+  e = NULL;
+  effects_bubble_params_defaults(&p);
+  CHECK(effects_bubble_uniforms(&p, 1e308, &top, &bottom, flow, &e) == EFFECTS_OK, "time 1e308 (g-bubble-time-1e308)");
+  CHECK(isfinite(top) && isfinite(bottom) && isfinite(flow[0]) && isfinite(flow[1]), "finite film at time 1e308");
 }
 
 int main(int argc, char** argv) {
