@@ -58,12 +58,22 @@ struct effects_bubble_mesh {
 
 namespace {
 
-effects_status fail(effects_error** error, effects_status status, std::string field, std::string message) {
-  if (error) *error = new (std::nothrow) effects_error{status, std::move(field), std::move(message)};
-  return status;
+// The error as a value; when even that cannot be allocated, OUT_OF_MEMORY with *error NULL.
+effects_status fail(effects_error** error, effects_status status, const char* field, const char* message) noexcept {
+  if (!error) return status;
+  try {
+    *error = new effects_error{status, field, message};
+    return status;
+  } catch (...) {
+    *error = nullptr;
+    return EFFECTS_OUT_OF_MEMORY;
+  }
+}
+effects_status fail(effects_error** error, effects_status status, const std::string& field, const std::string& message) noexcept {
+  return fail(error, status, field.c_str(), message.c_str());
 }
 
-effects_status fail(effects_error** error, const effects::Error& e) {
+effects_status fail(effects_error** error, const effects::Error& e) noexcept {
   const effects_status status = e.kind == effects::ErrorKind::kUnsatisfiable   ? EFFECTS_UNSATISFIABLE
                                 : e.kind == effects::ErrorKind::kLimitExceeded ? EFFECTS_LIMIT_EXCEEDED
                                                                                : EFFECTS_INVALID_ARGUMENT;
@@ -79,7 +89,7 @@ effects_status guarded(effects_error** error, F&& f) {
   } catch (const std::bad_alloc&) {
     return fail(error, EFFECTS_OUT_OF_MEMORY, "", "out of memory");
   } catch (const std::exception& e) {
-    return fail(error, EFFECTS_INTERNAL, "", e.what());
+    return fail(error, EFFECTS_INTERNAL, "", e.what());  // fail() copies it without throwing out
   } catch (...) {
     return fail(error, EFFECTS_INTERNAL, "", "unknown exception");
   }
@@ -91,13 +101,21 @@ bool sized(size_t given, size_t known) { return given >= known; }
 
 glm::dvec3 vec(const double v[3]) { return {v[0], v[1], v[2]}; }
 
+// The service's default limits (server/contract/config.h), so that untrusted parameters bound
+// the work as a request does.
+constexpr size_t kMaxGridCells = size_t(1) << 24;
+constexpr size_t kMaxSolverGridCells = 256 * 256;
+constexpr size_t kMaxSolverVolumeCells = 64 * 64 * 64;
+constexpr size_t kMaxGrowthSteps = 2'000'000;
+constexpr size_t kMaxTableEntries = size_t(1) << 24;
+
 effects_status toFog(const effects_fog* c, effects::fog::Fog& f, effects_error** error) {
   namespace fg = effects::fog;
   if (!c) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "fog is NULL");
   if (!sized(c->size, sizeof(effects_fog))) return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_fog)");
-  if (c->type < EFFECTS_FOG_X3D_LINEAR || c->type > EFFECTS_FOG_ATMOSPHERIC)
+  if (c->type < int32_t(EFFECTS_FOG_X3D_LINEAR) || c->type > int32_t(EFFECTS_FOG_ATMOSPHERIC))
     return fail(error, EFFECTS_INVALID_ARGUMENT, "/fogType", "is not an effects_fog_type");
-  if (c->convention < EFFECTS_FOG_EFFECTD || c->convention > EFFECTS_FOG_UNREAL)
+  if (c->convention < int32_t(EFFECTS_FOG_EFFECTD) || c->convention > int32_t(EFFECTS_FOG_UNREAL))
     return fail(error, EFFECTS_INVALID_ARGUMENT, "/convention", "is not an effects_fog_convention");
   f.type = fg::FogType(int(c->type));
   f.convention = fg::Convention(int(c->convention));
@@ -153,6 +171,8 @@ effects_status toBubble(const effects_bubble_params* c, effects::bubble::Params&
   return EFFECTS_OK;
 }
 
+void fillBoltDefaults(effects_bolt_params* c);
+
 char* copyString(const std::string& s) {
   char* out = static_cast<char*>(std::malloc(s.size() + 1));
   if (!out) throw std::bad_alloc();
@@ -183,8 +203,8 @@ void effects_fog_defaults(effects_fog* c) {
   const effects::fog::Directional d;
   *c = effects_fog{};
   c->size = sizeof(effects_fog);
-  c->type = effects_fog_type(int(f.type));
-  c->convention = effects_fog_convention(int(f.convention));
+  c->type = int32_t(f.type);
+  c->convention = int32_t(f.convention);
   for (int i = 0; i < 3; ++i) {
     c->color[i] = f.color[i];
     c->extinction[i] = f.extinction[i];
@@ -241,7 +261,7 @@ void effects_fog_table_options_defaults(effects_fog_table_options* c) {
   c->max_size = o.maxSize;
   c->elevations = o.elevations;
   c->camera_height = o.cameraHeight;
-  c->layout = EFFECTS_FOG_LAYOUT_LINEAR;
+  c->layout = int32_t(EFFECTS_FOG_LAYOUT_LINEAR);
 }
 
 effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog_table_options* c,
@@ -253,8 +273,16 @@ effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog
     if (!c || !table) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "options or table is NULL");
     if (!sized(c->size, sizeof(effects_fog_table_options)))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_fog_table_options)");
-    if (c->layout != EFFECTS_FOG_LAYOUT_LINEAR && c->layout != EFFECTS_FOG_LAYOUT_WARPED)
+    if (c->layout != int32_t(EFFECTS_FOG_LAYOUT_LINEAR) && c->layout != int32_t(EFFECTS_FOG_LAYOUT_WARPED))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/layout", "is not an effects_fog_layout");
+    if (c->max_size > kMaxTableEntries)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSize", "at most 2^24 entries (the contract's largest table)");
+    if (c->columns > c->max_size || c->elevations > c->max_size)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/size", "columns and elevations are each at most max_size");
+    if (!std::isfinite(c->camera_height) || !std::isfinite(c->range_start) || !std::isfinite(c->range_end) ||
+        !(c->max_error >= 0 && c->max_error <= 1))
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/table",
+                  "camera_height and the range must be finite, max_error in [0, 1]");
     effects::fog::TableOptions o;
     o.size = c->columns;
     o.maxError = c->max_error;
@@ -298,12 +326,22 @@ int effects_fog_table_axes(const effects_fog_table* t, double axes[7]) {
 
 void effects_bolt_params_defaults(effects_bolt_params* c) {
   if (!c) return;
-  const effects::lightning::Params p;
   *c = effects_bolt_params{};
+  try {
+    fillBoltDefaults(c);
+  } catch (...) {  // Params' default target could not be allocated: the size stays 0 (refused)
+  }
+}
+
+}  // extern "C"
+
+namespace {
+void fillBoltDefaults(effects_bolt_params* c) {
+  const effects::lightning::Params p;
   c->size = sizeof(effects_bolt_params);
   c->width = p.width, c->height = p.height, c->depth = 0;
   c->start[0] = p.start.x, c->start[1] = p.start.y;
-  c->method = EFFECTS_BOLT_FAST;
+  c->method = int32_t(EFFECTS_BOLT_FAST);
   c->eta = p.eta;
   c->seed = p.seed;
   c->max_steps = p.maxSteps;
@@ -311,6 +349,9 @@ void effects_bolt_params_defaults(effects_bolt_params* c) {
   c->axis_growth = p.axisGrowth;
   c->lifetime = p.lifetime;
 }
+}  // namespace
+
+extern "C" {
 
 effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bolt, effects_error** error) {
   namespace lt = effects::lightning;
@@ -319,8 +360,9 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
     if (!c || !bolt) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "params or bolt is NULL");
     if (!sized(c->size, sizeof(effects_bolt_params)))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_bolt_params)");
-    if (c->method < EFFECTS_BOLT_FAST || c->method > EFFECTS_BOLT_CHARGES)
+    if (c->method < int32_t(EFFECTS_BOLT_FAST) || c->method > int32_t(EFFECTS_BOLT_CHARGES))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/method", "is not an effects_bolt_method");
+    if (c->max_steps > kMaxGrowthSteps) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSteps", "at most 2 000 000");
     if (c->target_count > 64) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/targets", "at most 64 targets");
     if (c->target_count && !c->targets) return fail(error, EFFECTS_INVALID_ARGUMENT, "/targets", "is NULL");
     lt::Params p;
@@ -339,7 +381,11 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
     lt::Params sides = p;
     if (sides.targets.empty() && c->target_region) sides.targets.push_back(sides.start);
     if (auto e = lt::validate(sides)) return fail(error, *e);
-    if (cellsOf(p) > (size_t(1) << 30)) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/grid", "grid too large");
+    const size_t limit = p.method == lt::Method::kFast ? kMaxGridCells : p.depth ? kMaxSolverVolumeCells : kMaxSolverGridCells;
+    if (cellsOf(p) > limit)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/grid",
+                  "grid of " + std::to_string(cellsOf(p)) + " cells exceeds the limit of " + std::to_string(limit) + " for " +
+                      lt::toString(p.method));
     if (c->obstacles) p.obstacles.assign(c->obstacles, c->obstacles + cellsOf(p));
     if (c->target_region) p.targetRegion.assign(c->target_region, c->target_region + cellsOf(p));
     if (c->calibrated) {
@@ -373,7 +419,11 @@ size_t effects_bolt_main_channel(const effects_bolt* b, const int32_t** nodes) {
 }
 void effects_bolt_shape(const effects_bolt* b, double* cells, double* tips, double* branchPoints, double* dimension) {
   effects::lightning::BoltShape s;
-  if (b) s = effects::lightning::shapeOf(b->bolt, b->width, b->height, b->bolt.depth);
+  try {
+    if (b) s = effects::lightning::shapeOf(b->bolt, b->width, b->height, b->bolt.depth);
+  } catch (...) {  // out of memory for the box counts: zeros
+    s = {};
+  }
   if (cells) *cells = s.cells;
   if (tips) *tips = s.tips;
   if (branchPoints) *branchPoints = s.branchPoints;
@@ -474,14 +524,14 @@ void effects_bolt_lines_timing(const effects_bolt_lines* l, double* connect, dou
 
 // ---- tangent frames ------------------------------------------------------------------------------
 
-effects_status effects_tangents_generate(const effects_mesh_in* c, effects_tangent_mode mode, effects_tangents** out,
+effects_status effects_tangents_generate(const effects_mesh_in* c, int32_t mode, effects_tangents** out,
                                          effects_error** error) {
   namespace tg = effects::tangents;
   return guarded(error, [&] {
     if (out) *out = nullptr;
     if (!c || !out) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "mesh or result is NULL");
     if (!sized(c->size, sizeof(effects_mesh_in))) return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_mesh_in)");
-    if (mode < EFFECTS_TANGENTS_MIKKTSPACE || mode > EFFECTS_TANGENTS_PER_VERTEX)
+    if (mode < int32_t(EFFECTS_TANGENTS_MIKKTSPACE) || mode > int32_t(EFFECTS_TANGENTS_PER_VERTEX))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/mode", "is not an effects_tangent_mode");
     tg::Options o;
     if (c->vertex_count > o.maxVertices) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/positions", "too many vertices");

@@ -285,8 +285,12 @@ std::string shortNumber(double v) {
   return buf;
 }
 
-// Table entries for N distances (and M elevations, for height fog's 2D tables).
-size_t entries(bool twoD, size_t n, size_t m) { return n * (twoD ? m : 1); }
+// Table entries for N distances (and M elevations, for height fog's 2D tables); SIZE_MAX where
+// the product does not fit (any limit refuses it).
+size_t entries(bool twoD, size_t n, size_t m) {
+  if (twoD && m && n > std::numeric_limits<size_t>::max() / m) return std::numeric_limits<size_t>::max();
+  return n * (twoD ? m : 1);
+}
 
 // Measures a table's interpolation error against the exact fog at `sub`x denser sampling.
 void measure(const Fog& fog, const TableOptions& o, int sub, Table& t) {

@@ -577,8 +577,8 @@ std::optional<Error> Grower::growSegment(size_t k) {
   // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
   std::vector<Cell> path = guidePath(k, fromCell, target);
   if (path.empty())
-    return unsatisfiable(field, std::string(toRegion_ ? "no cell of the region" : "target") + " is reachable from " +
-                                    (k ? "the previous target" : "start"));
+    return unsatisfiable(field, std::string(toRegion_ ? "no cell of the region is reachable" : "target is unreachable") +
+                                    " from " + (k ? "the previous target" : "start"));
   const bool useGuide =
       p_.method != Method::kDbm && (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
   // Towards a region, the axis (and fast's eqn 8) aims at the region's cell the search reached.

@@ -48,9 +48,11 @@ Cost lightningCost(const LightningRequest& r, const Config& config) {
   // dbm also keeps DeepField's per-cell state (effects/lightning/deep_field.h): a byte for the
   // cells fixed at 0, and once a stage is cut its stage number and frozen value (10 bytes).
   const bool dbm = p.method == lt::Method::kDbm;
-  // A target region: its flags, and at worst (every cell on its surface: a checkerboard) the
-  // k-d tree fast measures eqn 5's P with, 12 bytes per surface cell.
-  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 9 : 0);
+  // A target region: three copies of its flags (the request's, the grower's, the A* guide's
+  // for targets before it) and the k-d tree fast measures eqn 5's P with, 13 bytes per surface
+  // cell; at most 6 of 7 cells lie on a region's surface (a 3-D packing that leaves every
+  // region cell a free neighbour), so 3 + 13 * 6/7 < 15 bytes per cell.
+  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 15 : 0);
   // dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = dbm && p.solver == lt::Solver::kCapacitance;
   const bool clamped = size_t(p.width) * size_t(p.height) > cells;  // refused by the parser

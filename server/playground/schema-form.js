@@ -86,7 +86,10 @@ function typesOf(s) {
 function kindOf(schemas, s) {
   const types = typesOf(s);
   if (s.enum) return 'enum';
-  if (s.oneOf || s.anyOf || types.length !== 1) return 'json';
+  // Alternatives that only say which fields are required (lightning's targets or targetRegion)
+  // constrain an object's form; they do not make it another kind of field.
+  const onlyRequired = (alternatives) => alternatives.every((a) => Object.keys(a).every((k) => k === 'required'));
+  if ((s.oneOf && !onlyRequired(s.oneOf)) || (s.anyOf && !onlyRequired(s.anyOf)) || types.length !== 1) return 'json';
   const [t] = types;
   if (t === 'boolean') return 'boolean';
   if (t === 'number' || t === 'integer') return 'number';

@@ -96,7 +96,7 @@ static void test_fog(void) {
   fog.density = NAN;
   expect_error(effects_fog_factor(&fog, 0, 0, 1, &f, &e), &e, EFFECTS_INVALID_ARGUMENT, "/density", "NaN density");
   effects_fog_defaults(&fog);
-  fog.type = (effects_fog_type)99;
+  fog.type = 99;
   expect_error(effects_fog_validate(&fog, &e), &e, EFFECTS_INVALID_ARGUMENT, "/fogType", "unknown fog type");
   effects_fog_defaults(&fog);
   fog.size = 8;
@@ -107,6 +107,18 @@ static void test_fog(void) {
   CHECK(effects_fog_table_build(&fog, &o, &table, &e) != EFFECTS_OK && table == NULL, "a table past max_size");
   effects_error_free(e);
   expect_error(effects_fog_table_build(NULL, &o, &table, &e), &e, EFFECTS_INVALID_ARGUMENT, "", "NULL fog");
+  /* Sizes whose product wraps around size_t: refused, not a short buffer written past. */
+  fog.type = EFFECTS_FOG_HEIGHT;
+  effects_fog_table_options_defaults(&o);
+  o.columns = (size_t)1 << 32;
+  expect_error(effects_fog_table_build(&fog, &o, &table, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/size", "2^32 columns");
+  o.columns = 2, o.elevations = (size_t)1 << 63;
+  expect_error(effects_fog_table_build(&fog, &o, &table, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/size", "2^63 elevations");
+  o.elevations = 0, o.max_size = (size_t)-1;
+  expect_error(effects_fog_table_build(&fog, &o, &table, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/maxSize", "an unbounded max_size");
+  effects_fog_table_options_defaults(&o);
+  o.camera_height = NAN;
+  expect_error(effects_fog_table_build(&fog, &o, &table, &e), &e, EFFECTS_INVALID_ARGUMENT, "/table", "a NaN camera height");
 
   /* The service's hostile corpus (proto/examples/invalid/g-fog-*, fog-*), as they reach C. */
   effects_fog_defaults(&fog);
@@ -195,6 +207,12 @@ static void test_bolt(void) {
   p.eta = 2;
   p.width = p.height = 65536;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/grid", "2^32 cells");
+  p.width = p.height = 1024, p.method = EFFECTS_BOLT_DBM;
+  expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/grid", "dbm on 1024^2 (O(cells) a step)");
+  p.method = EFFECTS_BOLT_FAST, p.max_steps = (size_t)-1;
+  expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/maxSteps", "an unbounded step budget");
+  effects_bolt_params_defaults(&p);
+  p.targets = target, p.target_count = 1;
   p.width = -5;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/grid", "a negative width");
   p.width = p.height = 48;
@@ -204,7 +222,7 @@ static void test_bolt(void) {
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_LIMIT_EXCEEDED, "/targets", "too many targets");
   p.target_count = 0;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/targets", "no target at all");
-  p.targets = target, p.target_count = 1, p.method = (effects_bolt_method)7;
+  p.targets = target, p.target_count = 1, p.method = 7;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/method", "unknown method");
   p.method = EFFECTS_BOLT_CHARGES, p.depth = 16, p.width = p.height = 16;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/method", "charges in 3-D");

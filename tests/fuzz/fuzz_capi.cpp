@@ -35,8 +35,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (data[14] & 2) p.target_region = region.data();
   effects_bolt* bolt = nullptr;
   effects_error* error = nullptr;
-  if (effects_bolt_grow(&p, &bolt, &error) != EFFECTS_OK) {
-    if (!error || bolt || effects_error_message(error)[0] == 0) std::abort();
+  if (const effects_status s = effects_bolt_grow(&p, &bolt, &error); s != EFFECTS_OK) {
+    if (bolt || (!error && s != EFFECTS_OUT_OF_MEMORY) || (error && effects_error_message(error)[0] == 0)) std::abort();
     effects_error_free(error);
     return 0;
   }

@@ -49,7 +49,9 @@ func run():
 			var arrays = mesh.surface_get_arrays(s)
 			var v: Vector3 = arrays[Mesh.ARRAY_VERTEX][0]
 			check(near(v.x, p.positions[0], 1e-4) and near(v.y, p.positions[1], 1e-4) and near(v.z, p.positions[2], 1e-4), "bolt vertex 0 as sent")
-			check(near(arrays[Mesh.ARRAY_COLOR][1].r, p.intensity[1], 1e-5), "bolt intensity as colour")
+			var last := int(p.intensity.size()) - 1
+			check(near(arrays[Mesh.ARRAY_COLOR][last].r, p.intensity[last], 1e-6), "bolt intensity as colour (float)")
+			check(near(arrays[Mesh.ARRAY_TEX_UV][last].x, p.uvs[2 * last], 1e-6), "bolt u along the channel, float")
 			var idx: PoolIntArray = arrays[Mesh.ARRAY_INDEX]
 			check(idx[1] == int(p.indices[2]) and idx[2] == int(p.indices[1]), "triangles wound clockwise for Godot")
 		check(r.answer.struck[1] == 47, "the bolt struck the ground row")
@@ -89,10 +91,12 @@ func run():
 		check(mesh.surface_get_array_len(0) == int(r.answer.mesh.vertexCount), "bubble vertices")
 		check(mesh.surface_get_array_index_len(0) == r.answer.mesh.indices.size(), "bubble indices")
 		var arrays = mesh.surface_get_arrays(0)
-		# Godot stores normals and tangents in 8 bits a component by default (ARRAY_COMPRESS_DEFAULT).
+		# Uncompressed: the normals are the float32s sent (Godot's default would keep 8 bits).
 		var n: Vector3 = arrays[Mesh.ARRAY_NORMAL][7]
 		var sent: Array = r.answer.mesh.normals
-		check(near(n.x, sent[21], 0.01) and near(n.y, sent[22], 0.01) and near(n.z, sent[23], 0.01), "normal 7 as sent, %s" % str(n))
+		check(near(n.x, sent[21], 1e-6) and near(n.y, sent[22], 1e-6) and near(n.z, sent[23], 1e-6), "normal 7 as sent, %s" % str(n))
+		var uv: Vector2 = arrays[Mesh.ARRAY_TEX_UV][11]
+		check(near(uv.x, r.answer.mesh.uvs[22], 1e-6) and near(uv.y, r.answer.mesh.uvs[23], 1e-6), "uv 11 as sent")
 		check(near(arrays[Mesh.ARRAY_TANGENT][3], r.answer.mesh.tangents[3], 1e-6), "tangent sign as sent")
 		print("bubble: %d vertices" % mesh.surface_get_array_len(0))
 

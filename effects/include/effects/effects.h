@@ -24,6 +24,12 @@
  *   - Determinism: the same parameters give the same result, bit for bit, as the server.
  *   - Structs with a `size` member: set it to sizeof(the struct) (the *_defaults functions
  *     do), so that a later library with a longer struct can tell an older caller's.
+ *   - Enumerations cross as int32_t (a field or parameter names its enum): any value is safe,
+ *     one outside the enum is EFFECTS_INVALID_ARGUMENT.
+ *   - Work is bounded: grids, tables and meshes have the service's default limits (below),
+ *     and a request over one is EFFECTS_LIMIT_EXCEEDED before any work.
+ *   - When even the error cannot be allocated, the status is EFFECTS_OUT_OF_MEMORY and *error
+ *     is NULL.
  */
 #ifndef EFFECTS_EFFECTS_H
 #define EFFECTS_EFFECTS_H
@@ -81,8 +87,8 @@ typedef enum effects_fog_convention { EFFECTS_FOG_EFFECTD = 0, EFFECTS_FOG_FILAM
  * none (infinity). */
 typedef struct effects_fog {
   size_t size;
-  effects_fog_type type;
-  effects_fog_convention convention;
+  int32_t type;       /* an effects_fog_type */
+  int32_t convention; /* an effects_fog_convention */
   double color[3];
   double visibility_range, start, end, density, distance_coefficient, peak, height_falloff, base_height;
   double extinction[3], inscattering[3];
@@ -105,7 +111,8 @@ effects_status effects_fog_factor(const effects_fog* fog, double origin_y, doubl
 typedef enum effects_fog_layout { EFFECTS_FOG_LAYOUT_LINEAR = 0, EFFECTS_FOG_LAYOUT_WARPED } effects_fog_layout;
 /* effects::fog::TableOptions: columns (distance samples) 0 picks the smallest number meeting
  * max_error; range_end <= range_start (both 0 by default) means the default range [0, where f
- * completes]; elevations 0: HEIGHT's default rows. */
+ * completes]; elevations 0: HEIGHT's default rows; columns x elevations at most max_size (by
+ * default 65536, the service's default; at most 2^24, the contract's largest table). */
 typedef struct effects_fog_table_options {
   size_t size;
   size_t columns;
@@ -114,7 +121,7 @@ typedef struct effects_fog_table_options {
   double range_start, range_end;
   size_t elevations;
   double camera_height;
-  effects_fog_layout layout;
+  int32_t layout; /* an effects_fog_layout */
 } effects_fog_table_options;
 void effects_fog_table_options_defaults(effects_fog_table_options* options);
 
@@ -142,7 +149,9 @@ typedef enum effects_bolt_method { EFFECTS_BOLT_FAST = 0, EFFECTS_BOLT_DBM, EFFE
 /* effects::lightning::Params, with the server's calibration applied when `calibrated` is 1
  * (the default; 0 takes axis_growth and lifetime as given). depth 0: a 2-D grid. Cells are
  * int32 triples x, y, z (z 0 in 2-D). obstacles and target_region: NULL, or one byte per cell
- * (x fastest, then y, then z; nonzero = in the set). */
+ * (x fastest, then y, then z; nonzero = in the set). Limits (the service's defaults): fast
+ * grids up to 2^24 cells, dbm and charges (every step costs O(cells)) up to 256^2 cells in 2-D
+ * and 64^3 in 3-D, max_steps up to 2 000 000, 64 targets. */
 typedef struct effects_bolt_params {
   size_t size;
   int32_t width, height, depth;
@@ -151,7 +160,7 @@ typedef struct effects_bolt_params {
   size_t target_count;
   const uint8_t* obstacles;
   const uint8_t* target_region;
-  effects_bolt_method method;
+  int32_t method; /* an effects_bolt_method */
   double eta;
   int32_t neighbourhood; /* 0: 8 in 2-D, 26 in 3-D */
   uint64_t seed;
@@ -225,8 +234,9 @@ typedef struct effects_mesh_in {
 } effects_mesh_in;
 
 typedef struct effects_tangents effects_tangents;
-effects_status effects_tangents_generate(const effects_mesh_in* mesh, effects_tangent_mode mode,
-                                         effects_tangents** result, effects_error** error);
+/* mode: an effects_tangent_mode. Up to 2 000 000 vertices and 4 000 000 triangles. */
+effects_status effects_tangents_generate(const effects_mesh_in* mesh, int32_t mode, effects_tangents** result,
+                                         effects_error** error);
 void effects_tangents_free(effects_tangents* result);
 /* Output vertices (the first vertex_count are the input's; split copies follow): tangents
  * (x, y, z, w; bitangent = w cross(N, T)), normals (3 per vertex), remap (the input vertex each

@@ -68,6 +68,10 @@ static func vec2s(flat: Array) -> PoolVector2Array:
 		out[i] = Vector2(flat[2 * i], flat[2 * i + 1])
 	return out
 
+# Surfaces are added uncompressed (compress flags 0): Godot's default keeps UVs in half floats,
+# and a bolt's u runs along the channel in cells (steps of 1 past 1024), colours, normals and
+# tangents in 8 bits.
+
 # Triangles as Godot 3 draws them: its front faces wind clockwise, glTF's (and effectd's)
 # counter-clockwise, so each triangle's last two corners swap.
 static func clockwise(indices: Array) -> PoolIntArray:
@@ -95,7 +99,7 @@ static func bolt_mesh(answer: Dictionary) -> ArrayMesh:
 			colors[i] = Color(p.intensity[i], p.intensity[i], p.intensity[i], 1.0)
 		arrays[Mesh.ARRAY_COLOR] = colors
 		arrays[Mesh.ARRAY_INDEX] = clockwise(p.indices)
-		mesh.add_surface_from_arrays(Mesh.PRIMITIVE_TRIANGLES, arrays)
+		mesh.add_surface_from_arrays(Mesh.PRIMITIVE_TRIANGLES, arrays, [], 0)  # uncompressed (below)
 	return mesh
 
 # A bubble asked with include ["mesh"] and uvOrigin "top-left" (Godot's UVs, like glTF's, have
@@ -111,7 +115,7 @@ static func bubble_mesh(answer: Dictionary) -> ArrayMesh:
 	arrays[Mesh.ARRAY_TANGENT] = PoolRealArray(m.tangents)
 	arrays[Mesh.ARRAY_INDEX] = clockwise(m.indices)
 	var mesh := ArrayMesh.new()
-	mesh.add_surface_from_arrays(Mesh.PRIMITIVE_TRIANGLES, arrays)
+	mesh.add_surface_from_arrays(Mesh.PRIMITIVE_TRIANGLES, arrays, [], 0)  # uncompressed (below)
 	return mesh
 
 # A fog answer's table (answer.table, or one of answer.regionTables) as an image: size columns
