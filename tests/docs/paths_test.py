@@ -2,7 +2,7 @@
 """Every repository path a document names exists: backticked or bare paths under the project's
 top-level folders (server/, effects/, render/, proto/, tests/, scripts/, bench/, docs/, clients/,
 examples/, fixtures/, deploy/, cmake/), with `{h,cpp}` groups expanded and a trailing `:line`
-or `#anchor` removed. A command's output prefix (`docs/x/bubble` for docs/x/bubble-*.png) counts
+or `#anchor` removed; an include name in angle brackets (`<effects/fog.h>`) is not a path. A command's output prefix (`docs/x/bubble` for docs/x/bubble-*.png) counts
 when files start with it.
 
   tests/docs/paths_test.py ROOT DOC...     exit 1 naming each path that is not there
@@ -13,7 +13,7 @@ import re
 import sys
 
 TOP = "server|effects|render|proto|tests|scripts|bench|docs|clients|examples|fixtures|deploy|cmake"
-PATH = re.compile(r"(?<![\w./-])((?:%s)/[\w./{},*-]*[\w}*])" % TOP)
+PATH = re.compile(r"(?<![\w./<-])((?:%s)/[\w./{},*-]*[\w}*])" % TOP)  # not <include/names.h>
 
 
 def expand(path):
