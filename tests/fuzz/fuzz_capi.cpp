@@ -12,11 +12,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 16) return 0;
   effects_bolt_params p;
   effects_bolt_params_defaults(&p);
-  // Grids up to 32 x 32, or 12 x 12 x 8 in 3-D: the exact methods' cost grows with the square
+  // Grids up to 24 x 24, or 10 x 10 x 6 in 3-D: the exact methods' cost grows with the square
   // of the cells (a field solve each step), and one input must stay well under the 10 s timeout
-  // under ASan (32 x 32 x 4 DBM took 1 s in Release, over 10 s under ASan).
-  p.depth = data[2] % 4 == 0 ? 3 + data[3] % 6 : 0;
-  p.width = 3 + data[0] % (p.depth ? 10 : 30), p.height = 3 + data[1] % (p.depth ? 10 : 30);
+  // under ASan (there a 32 x 32 x 4 DBM took over 10 s, 12 x 12 x 8 3 s, 32 x 32 5 s).
+  p.depth = data[2] % 4 == 0 ? 3 + data[3] % 4 : 0;
+  p.width = 3 + data[0] % (p.depth ? 8 : 22), p.height = 3 + data[1] % (p.depth ? 8 : 22);
   const int32_t depth = p.depth ? p.depth : 1;
   p.start[0] = data[4] % (p.width + 1), p.start[1] = data[5] % (p.height + 1), p.start[2] = data[6] % (depth + 1);
   int32_t target[3] = {data[7] % (p.width + 1), data[8] % (p.height + 1), data[9] % (depth + 1)};
