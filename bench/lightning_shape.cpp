@@ -8,15 +8,7 @@
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
 //                   [--method fast|charges] [--splits 40] [--geometry open]
 //
-// Geometries (--size s):
-//   open      the calibration's own: start top-centre, target bottom-centre, s x s
-//   off-axis  start at s/4 on the top row, target at 3s/4 on the bottom row
-//   ground    start top-centre, every bottom cell a target (a target region)
-//   wall      examples/04-storm-over-water.json's bolt scaled to s: an off-axis strike over a
-//             wall that the A* guide leads around
-//   wide      the ground on a 2s x s grid
-//   3d        s^3 voxels (26 neighbours), start at the top face's centre, the bottom layer a
-//             target region
+// Geometries (--size s): bench/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
 // compared too (KS).
 #include <algorithm>
@@ -33,6 +25,7 @@
 #include <effects/lightning.h>
 
 #include "bolt_shape.h"
+#include "layouts.h"
 
 namespace lt = effects::lightning;
 namespace sh = bench::shape;
@@ -43,47 +36,6 @@ struct Sample {
   std::vector<sh::Measures> bolts;
   double msPerBolt = 0;
 };
-
-// The layout of a geometry (above) at size s, before method, eta and seed.
-lt::Params layout(const std::string& geometry, int s) {
-  lt::Params p;
-  p.width = p.height = s;
-  p.start = {s / 2, 1};
-  p.targets = {{s / 2, s - 2}};
-  auto ground = [&] {
-    p.targets.clear();
-    p.targetRegion.assign(size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1)), 0);
-    for (int z = 0; z < std::max(p.depth, 1); ++z)
-      for (int x = 0; x < p.width; ++x)
-        p.targetRegion[(size_t(z) * size_t(p.height) + size_t(p.height - 1)) * size_t(p.width) + size_t(x)] = 1;
-  };
-  if (geometry == "off-axis") {
-    p.start = {s / 4, 1};
-    p.targets = {{3 * s / 4, s - 2}};
-  } else if (geometry == "ground") {
-    ground();
-  } else if (geometry == "wide") {
-    p.width = 2 * s;
-    p.start = {s, 1};
-    ground();
-  } else if (geometry == "3d") {
-    p.depth = s;
-    p.neighbourhood = 26;
-    p.start = {s / 2, 1, s / 2};
-    ground();
-  } else if (geometry == "wall") {  // example 04 at 96: start (20, 0), target (70, 95), wall [30, 40, 36, 6]
-    auto at = [s](int v) { return v * s / 96; };
-    p.start = {at(20), 0};
-    p.targets = {{at(70), s - 1}};
-    p.obstacles.assign(size_t(s) * size_t(s), 0);
-    for (int y = at(40); y < at(46); ++y)
-      for (int x = at(30); x < at(66); ++x) p.obstacles[size_t(y) * size_t(s) + size_t(x)] = 1;
-  } else if (geometry != "open") {
-    std::fprintf(stderr, "unknown geometry %s (open, off-axis, ground, wall, wide, 3d)\n", geometry.c_str());
-    std::exit(2);
-  }
-  return p;
-}
 
 Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed) {
   Sample s;
@@ -163,7 +115,7 @@ int main(int argc, char** argv) {
       {"segment lengths (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::segments), pooled(b, &sh::Measures::segments)); }, true},
       {"branching angles (KS)", [](auto& a, auto& b) { return sh::ks(pooled(a, &sh::Measures::angles), pooled(b, &sh::Measures::angles)); }, true},
   };
-  const lt::Params base = layout(geometry, size);
+  const lt::Params base = sh::layout(geometry, size);
   if (!base.targetRegion.empty())  // where on the ground the strike lands
     rows.push_back({"struck cell's offset (KS)", [](auto& a, auto& b) {
                       std::vector<double> x, y;
