@@ -15,18 +15,17 @@
 //   lnAge  log(1 + steps since a bolt cell last joined next to the candidate): what the fast
 //          method's lifetime cuts at
 //   lnLead log(1 + how far the bolt's leading cell is ahead of the candidate along the axis)
-//   lnPhiC log of the Laplace field solved on a grid F times coarser (--coarse F, default 4: a
-//          coarse cell is the bolt where a bolt cell lies in it, an obstacle where most of it
-//          is), the largest over the candidate's coarse cell and its 8 neighbours (or the nearest ring
-//          of them with a nonzero field, where the bolt fills those): the field's
-//          screening at 1/F^2 of the cells
+//   lnPhiC log of the Laplace field solved on a grid F times coarser (--coarse F, default 2),
+//          read around the candidate (bench/half_field.h, CoarseField): the field's screening at
+//          1/F^2 of the cells
 //   lnNcal log of the bolt cells within the calibrated screening radius (the calibrated law's N)
-// The laws compared: every candidate alike (the scale of the distances); the paper's eqn 8 (a = 2, N adjacent, lifetime 4); the calibrated fast
-// method (calibrate(): its base, radius and lifetime; candidates past the lifetime have q = 0);
-// eqn 8's four terms with fitted constants; and those with lnAge, then lnLead added. A law is
-// a law if its constants fitted on one geometry and eta hold at the others.
+// The laws compared: every candidate alike (the scale of the distances); the paper's eqn 8
+// (a = 2, N adjacent, lifetime 4); the calibrated fast method (calibrate(): its base, radius and
+// lifetime; candidates past the lifetime have q = 0); eqn 8's terms with fitted constants, then
+// with lnAge and lnLead; the coarse field with the neighbour counts (bench/half_field.h's law);
+// all of them. A law is a law if its constants fitted on one geometry and eta hold at the others.
 //
-//   lightning_phi_fit [--size 128] [--train 10] [--test 10] [--steps 12] [--eta 1,2,3] [--coarse 4]
+//   lightning_phi_fit [--size 128] [--train 10] [--test 10] [--steps 12] [--eta 1,2,3] [--coarse 2]
 //
 // Results and what they mean: docs/lightning-shape.md, "What a law would have to do".
 #include <algorithm>
@@ -40,13 +39,14 @@
 
 #include <effects/lightning.h>
 
+#include "half_field.h"
 #include "layouts.h"
 
 namespace lt = effects::lightning;
 
 namespace {
 
-int F = 4;  // --coarse: the coarse grid's cell, in fine cells
+int F = 2;  // --coarse: the coarse grid's cell, in fine cells
 
 enum Feature { kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC, kLnNcal, kFeatures };
 const char* const kNames[kFeatures] = {"G", "lnB", "lnP", "lnN1", "lnN4", "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal"};
@@ -63,7 +63,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
   const lt::Cell start = layout.start, target = layout.targets.at(0);
   lt::Params fast = layout;
   fast.eta = eta;
-  const int calRadius = lt::calibratedScreeningRadius(fast), radius = std::max(3, calRadius);
+  const int calRadius = lt::calibratedScreeningRadius(fast);
   std::vector<double> lnB(size_t(w) * size_t(h), NAN);
   double ax = target.x - start.x, ay = target.y - start.y;
   const double len = std::hypot(ax, ay);
@@ -95,69 +95,29 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
           lead = std::max(lead, along(node.cell.x, node.cell.y));
         }
       auto phi = lt::solveLaplace(w, h, layout.obstacles, cells, target, lt::Solver::kMgpcg, 1e-12);
-      const int cw = w / F, ch = h / F;
-      const lt::Cell coarseTarget{std::min(target.x / F, cw - 1), std::min(target.y / F, ch - 1)};
-      std::vector<uint8_t> coarseObstacles;
-      if (!layout.obstacles.empty()) {
-        coarseObstacles.assign(size_t(cw) * size_t(ch), 0);
-        for (int Y = 0; Y < ch; ++Y)
-          for (int X = 0; X < cw; ++X) {
-            int blockedCells = 0;
-            for (int y = F * Y; y < F * Y + F; ++y)
-              for (int x = F * X; x < F * X + F; ++x) blockedCells += blocked(x, y);
-            coarseObstacles[size_t(Y) * size_t(cw) + size_t(X)] = 2 * blockedCells > F * F && !(X == coarseTarget.x && Y == coarseTarget.y);
-          }
-      }
-      std::vector<lt::Cell> coarseBolt;
-      std::vector<uint8_t> inCoarseBolt(size_t(cw) * size_t(ch), 0);
-      for (const lt::Cell& c : cells) {
-        const lt::Cell C{std::min(c.x / F, cw - 1), std::min(c.y / F, ch - 1)};
-        uint8_t& seen = inCoarseBolt[size_t(C.y) * size_t(cw) + size_t(C.x)];
-        if (seen || C == coarseTarget) continue;
-        seen = 1;
-        if (!coarseObstacles.empty()) coarseObstacles[size_t(C.y) * size_t(cw) + size_t(C.x)] = 0;
-        coarseBolt.push_back(C);
-      }
-      auto coarse = lt::solveLaplace(cw, ch, coarseObstacles, coarseBolt, coarseTarget, lt::Solver::kMgpcg, 1e-12);
-      auto coarseAround = [&](int x, int y) {
-        const int X = std::min(x / F, cw - 1), Y = std::min(y / F, ch - 1);
-        double v = 0;
-        for (int r = 1; v == 0 && r < std::max(cw, ch); ++r)  // past 1 where a bushy bolt fills them
-          for (int dy = -r; dy <= r; ++dy)
-            for (int dx = -r; dx <= r; ++dx)
-              if (X + dx >= 0 && Y + dy >= 0 && X + dx < cw && Y + dy < ch)
-                v = std::max(v, coarse[size_t(Y + dy) * size_t(cw) + size_t(X + dx)]);
-        return std::log(std::max(v, 1e-300));
-      };
+      const bench::shape::CoarseField coarse(layout, cells, F);
       Step st;
       double maxLog = -INFINITY;
       std::vector<double> logw;
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
           if (stepAt[size_t(y) * size_t(w) + size_t(x)] >= 0 || blocked(x, y) || (x == target.x && y == target.y)) continue;
-          int n1 = 0, n4 = 0, n3 = 0, ncal = 0, last = -1;
-          for (int dy = -radius; dy <= radius; ++dy)
-            for (int dx = -radius; dx <= radius; ++dx) {
+          const bench::shape::Screening near = bench::shape::screening(stepAt, w, h, x, y);
+          if (near.n1 == 0) continue;  // not a candidate
+          int ncal = 0;
+          for (int dy = -calRadius; dy <= calRadius; ++dy)
+            for (int dx = -calRadius; dx <= calRadius; ++dx) {
               const int X = x + dx, Y = y + dy;
-              if (X < 0 || Y < 0 || X >= w || Y >= h) continue;
-              const int at = stepAt[size_t(Y) * size_t(w) + size_t(X)];
-              if (at < 0) continue;
-              if (std::abs(dx) <= 3 && std::abs(dy) <= 3) ++n3;
-              if (std::abs(dx) <= calRadius && std::abs(dy) <= calRadius) ++ncal;
-              if (std::abs(dx) + std::abs(dy) == 1) ++n4;
-              if (std::abs(dx) <= 1 && std::abs(dy) <= 1) {
-                ++n1;
-                last = std::max(last, at);
-              }
+              ncal += X >= 0 && Y >= 0 && X < w && Y < h && stepAt[size_t(Y) * size_t(w) + size_t(X)] >= 0;
             }
-          if (n1 == 0) continue;  // not a candidate
           double& b = lnB[size_t(y) * size_t(w) + size_t(x)];
           if (std::isnan(b)) b = std::log(lt::boundaryPotential(w, h, layout.obstacles, {x, y}));
           const double a = along(x, y);
           const double G = std::floor(a <= len ? a : 2 * len - a);
           const double P = std::max(0.5, std::hypot(double(x - target.x), double(y - target.y)));
-          st.f.push_back({G, b, std::log(P), std::log(double(n1)), std::log(1.0 + n4), std::log(double(n3)), std::log(1.0 + t - last),
-                          std::log(1.0 + std::max(0.0, lead - a)), coarseAround(x, y), std::log(double(ncal))});
+          st.f.push_back({G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4), std::log(double(near.n3)),
+                          std::log(1.0 + t - near.last), std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y),
+                          std::log(double(ncal))});
           const double lp = eta * std::log(std::max(phi[size_t(y) * size_t(w) + size_t(x)], 1e-300));
           logw.push_back(lp);
           maxLog = std::max(maxLog, lp);

@@ -6,7 +6,9 @@
 // within that noise: indistinguishable at these seeds.
 //
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
-//                   [--method fast|charges] [--splits 40] [--geometry open]
+//                   [--method fast|charges|half-field] [--splits 40] [--geometry open]
+//
+// half-field: the candidate law of bench/half_field.h (2-D layouts with one point target).
 //
 // Geometries (--size s): bench/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
@@ -25,6 +27,7 @@
 #include <effects/lightning.h>
 
 #include "bolt_shape.h"
+#include "half_field.h"
 #include "layouts.h"
 
 namespace lt = effects::lightning;
@@ -37,7 +40,8 @@ struct Sample {
   double msPerBolt = 0;
 };
 
-Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed) {
+// halfField: bench/half_field.h's law instead of the method (2-D, one point target).
+Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, bool halfField = false) {
   Sample s;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < seeds; ++k) {
@@ -46,6 +50,10 @@ Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, ui
     p.eta = eta;
     p.seed = firstSeed + uint64_t(k);
     lt::calibrate(p);  // what the server does for every request
+    if (halfField) {
+      s.bolts.push_back(sh::measure(sh::growHalfField(p), p.width, p.height));
+      continue;
+    }
     auto bolt = lt::grow(p);
     if (!bolt.ok()) {
       std::fprintf(stderr, "grow failed: %s\n", bolt.error().message.c_str());
@@ -89,6 +97,7 @@ int main(int argc, char** argv) {
   std::string geometry = "open";
   std::vector<double> etas = {1, 2, 3};
   lt::Method method = lt::Method::kFast;
+  bool halfField = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--size") size = std::atoi(v.c_str());
@@ -96,7 +105,10 @@ int main(int argc, char** argv) {
     else if (a == "--dbm-seeds") dbmSeeds = std::atoi(v.c_str());
     else if (a == "--splits") splits = std::atoi(v.c_str());
     else if (a == "--geometry") geometry = v;
-    else if (a == "--method") method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+    else if (a == "--method") {
+      method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
+      halfField = v == "half-field";
+    }
     else if (a == "--eta") {
       etas.clear();
       std::stringstream ss(v);
@@ -123,15 +135,20 @@ int main(int argc, char** argv) {
                       for (const auto& m : b) y.push_back(m.struckOffset);
                       return sh::ks(x, y);
                     }, true});
-  std::printf("# %s against dbm by shape: %s, %d x %d%s\n\n", lt::toString(method), geometry.c_str(), base.width, base.height,
+  if (halfField && (base.depth || base.targets.size() != 1 || !base.targetRegion.empty())) {
+    std::fprintf(stderr, "--method half-field: 2-D layouts with one point target (open, off-axis, wall)\n");
+    return 2;
+  }
+  const char* name = halfField ? "half-field" : lt::toString(method);
+  std::printf("# %s against dbm by shape: %s, %d x %d%s\n\n", name, geometry.c_str(), base.width, base.height,
               base.depth ? (" x " + std::to_string(base.depth)).c_str() : "");
   std::printf("%d %s and %d dbm bolts per eta; noise: 95th percentile over %d random half-splits of the dbm "
               "bolts (KS distances scaled to the sizes compared); meets = within the noise.\n\n",
-              fastSeeds, lt::toString(method), dbmSeeds, splits);
-  std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", lt::toString(method));
+              fastSeeds, name, dbmSeeds, splits);
+  std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", name);
   std::mt19937 rng(49);
   for (double eta : etas) {
-    const Sample fast = grow(base, method, eta, fastSeeds, 1000);
+    const Sample fast = grow(base, method, eta, fastSeeds, 1000, halfField);
     const Sample dbm = grow(base, lt::Method::kDbm, eta, dbmSeeds, 5000);
     for (const Row& row : rows) {
       const double d = row.stat(fast.bolts, dbm.bolts);

@@ -1,0 +1,172 @@
+// A candidate law for the fast method (issue 49, item 3), for the bench tools only: Phi_i is the
+// Laplace field solved on a grid F times coarser, times local screening by the bolt cells
+// around the candidate:
+//   log Phi_i = phi * ln PhiC(i) + n1 * ln N1 + n4 * ln(1 + N4) + n3 * ln N3
+// N1: bolt cells among the 8 neighbours, N4: among the 4 edge neighbours, N3: within 3 cells
+// (Chebyshev). bench/lightning_phi_fit.cpp fits the constants to DBM's step distribution;
+// bench/lightning_shape.cpp (--method half-field) grows bolts by it and compares their shapes.
+// 2-D, 8-neighbourhood, one point target.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <effects/lightning.h>
+
+namespace bench::shape {
+
+namespace lt = effects::lightning;
+
+// The Laplace field (bolt and obstacles 0, target 1) on a grid F times coarser than the
+// layout's: a coarse cell is the bolt where a bolt cell lies in it, an obstacle where most of it
+// is.
+struct CoarseField {
+  int F = 2, cw = 0, ch = 0;
+  std::vector<double> phi;
+
+  CoarseField(const lt::Params& layout, const std::vector<lt::Cell>& bolt, int factor) : F(factor) {
+    const int w = layout.width, h = layout.height;
+    cw = w / F;
+    ch = h / F;
+    const lt::Cell target = layout.targets.at(0);
+    const lt::Cell coarseTarget = at(target.x, target.y);
+    std::vector<uint8_t> obstacles;
+    if (!layout.obstacles.empty()) {
+      obstacles.assign(size_t(cw) * size_t(ch), 0);
+      for (int Y = 0; Y < ch; ++Y)
+        for (int X = 0; X < cw; ++X) {
+          int blocked = 0;
+          for (int y = F * Y; y < F * Y + F; ++y)
+            for (int x = F * X; x < F * X + F; ++x) blocked += layout.obstacles[size_t(y) * size_t(w) + size_t(x)] != 0;
+          obstacles[size_t(Y) * size_t(cw) + size_t(X)] = 2 * blocked > F * F && !(lt::Cell{X, Y} == coarseTarget);
+        }
+    }
+    std::vector<lt::Cell> coarseBolt;
+    std::vector<uint8_t> seen(size_t(cw) * size_t(ch), 0);
+    for (const lt::Cell& c : bolt) {
+      const lt::Cell C = at(c.x, c.y);
+      uint8_t& s = seen[size_t(C.y) * size_t(cw) + size_t(C.x)];
+      if (s || C == coarseTarget) continue;
+      s = 1;
+      if (!obstacles.empty()) obstacles[size_t(C.y) * size_t(cw) + size_t(C.x)] = 0;
+      coarseBolt.push_back(C);
+    }
+    phi = lt::solveLaplace(cw, ch, obstacles, coarseBolt, coarseTarget, lt::Solver::kMgpcg, 1e-10);
+  }
+
+  lt::Cell at(int x, int y) const { return {std::min(x / F, cw - 1), std::min(y / F, ch - 1)}; }
+
+  // log of the largest field over the fine cell's coarse cell and its 8 neighbours, or the
+  // nearest ring of them with a nonzero field where a bushy bolt fills those.
+  double logAround(int x, int y) const {
+    const lt::Cell C = at(x, y);
+    double v = 0;
+    for (int r = 1; v == 0 && r < std::max(cw, ch); ++r)
+      for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx)
+          if (C.x + dx >= 0 && C.y + dy >= 0 && C.x + dx < cw && C.y + dy < ch)
+            v = std::max(v, phi[size_t(C.y + dy) * size_t(cw) + size_t(C.x + dx)]);
+    return std::log(std::max(v, 1e-300));
+  }
+};
+
+// The bolt cells around a cell (stepAt[cell] >= 0: the step it joined at).
+struct Screening {
+  int n1 = 0, n4 = 0, n3 = 0;
+  int last = -1;  // the latest step among the 8 neighbours
+};
+inline Screening screening(const std::vector<int>& stepAt, int w, int h, int x, int y) {
+  Screening s;
+  for (int dy = -3; dy <= 3; ++dy)
+    for (int dx = -3; dx <= 3; ++dx) {
+      const int X = x + dx, Y = y + dy;
+      if (X < 0 || Y < 0 || X >= w || Y >= h) continue;
+      const int step = stepAt[size_t(Y) * size_t(w) + size_t(X)];
+      if (step < 0) continue;
+      ++s.n3;
+      if (std::abs(dx) + std::abs(dy) == 1) ++s.n4;
+      if (std::abs(dx) <= 1 && std::abs(dy) <= 1) {
+        ++s.n1;
+        s.last = std::max(s.last, step);
+      }
+    }
+  return s;
+}
+
+struct HalfFieldLaw {
+  // Fitted on the open 128^2 layout at eta 2 (docs/lightning-shape.md, "What a law would have
+  // to do"); refitted at other geometries and eta they move by at most 0.07.
+  double phi = 1.06, n1 = -0.323, n4 = -0.253, n3 = -0.341;
+  int coarse = 2;
+};
+
+// Grows a bolt from p.start until it touches p.targets[0], picking candidate i with probability
+// Phi_i^eta / sum_j Phi_j^eta under the law; each node's parent is its latest bolt neighbour.
+inline lt::Bolt growHalfField(const lt::Params& p, const HalfFieldLaw& law = {}) {
+  const int w = p.width, h = p.height;
+  const lt::Cell target = p.targets.at(0);
+  auto index = [w](int x, int y) { return size_t(y) * size_t(w) + size_t(x); };
+  auto free = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < w && y < h && (p.obstacles.empty() || !p.obstacles[index(x, y)]);
+  };
+  lt::Bolt bolt;
+  std::vector<int> stepAt(size_t(w) * size_t(h), -1), nodeAt(size_t(w) * size_t(h), -1);
+  std::vector<lt::Cell> cells, candidates;
+  std::vector<uint8_t> isCandidate(size_t(w) * size_t(h), 0);
+  auto add = [&](lt::Cell c, int parent, int step) {
+    nodeAt[index(c.x, c.y)] = int(bolt.nodes.size());
+    stepAt[index(c.x, c.y)] = step;
+    bolt.nodes.push_back({c, parent, step});
+    cells.push_back(c);
+    isCandidate[index(c.x, c.y)] = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int x = c.x + dx, y = c.y + dy;
+        if (!free(x, y) || stepAt[index(x, y)] >= 0 || isCandidate[index(x, y)] || lt::Cell{x, y} == target) continue;
+        isCandidate[index(x, y)] = 1;
+        candidates.push_back({x, y});
+      }
+  };
+  add(p.start, -1, 0);
+  std::mt19937_64 rng(p.seed);
+  std::vector<double> logw;
+  for (int step = 1; size_t(step) < p.maxSteps; ++step) {
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(), [&](lt::Cell c) { return !isCandidate[index(c.x, c.y)]; }),
+                     candidates.end());
+    if (candidates.empty()) break;
+    const CoarseField field(p, cells, law.coarse);
+    logw.assign(candidates.size(), 0.0);
+    double hi = -INFINITY;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const lt::Cell c = candidates[i];
+      const Screening s = screening(stepAt, w, h, c.x, c.y);
+      logw[i] = p.eta * (law.phi * field.logAround(c.x, c.y) + law.n1 * std::log(double(s.n1)) +
+                         law.n4 * std::log(1.0 + s.n4) + law.n3 * std::log(double(s.n3)));
+      hi = std::max(hi, logw[i]);
+    }
+    double sum = 0;
+    for (double& v : logw) sum += (v = std::exp(v - hi));
+    double u = std::uniform_real_distribution<double>(0.0, sum)(rng);
+    size_t pick = 0;
+    while (pick + 1 < logw.size() && u >= logw[pick]) u -= logw[pick++];
+    const lt::Cell c = candidates[pick];
+    int parent = -1, latest = -1;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (free(c.x + dx, c.y + dy) && stepAt[index(c.x + dx, c.y + dy)] > latest) {
+          latest = stepAt[index(c.x + dx, c.y + dy)];
+          parent = nodeAt[index(c.x + dx, c.y + dy)];
+        }
+    add(c, parent, step);
+    if (std::abs(c.x - target.x) <= 1 && std::abs(c.y - target.y) <= 1) {
+      add(target, int(bolt.nodes.size()) - 1, step + 1);
+      break;
+    }
+  }
+  return bolt;
+}
+
+}  // namespace bench::shape
