@@ -6,9 +6,11 @@
 // within that noise: indistinguishable at these seeds.
 //
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
-//                   [--method fast|charges|half-field] [--splits 40] [--geometry open]
+//                   [--method fast|charges|half-field] [--law phi,n1,n4,n3] [--splits 40]
+//                   [--geometry open]
 //
-// half-field: the candidate law of bench/half_field.h (2-D layouts with one point target).
+// half-field: the candidate law of bench/half_field.h (2-D layouts with one point target), with
+// its constants or --law phi,n1,n4,n3.
 //
 // Geometries (--size s): bench/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
@@ -41,7 +43,8 @@ struct Sample {
 };
 
 // halfField: bench/half_field.h's law instead of the method (2-D, one point target).
-Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, bool halfField = false) {
+Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, bool halfField = false,
+            const sh::HalfFieldLaw& law = {}) {
   Sample s;
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < seeds; ++k) {
@@ -51,7 +54,7 @@ Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, ui
     p.seed = firstSeed + uint64_t(k);
     lt::calibrate(p);  // what the server does for every request
     if (halfField) {
-      s.bolts.push_back(sh::measure(sh::growHalfField(p), p.width, p.height));
+      s.bolts.push_back(sh::measure(sh::growHalfField(p, law), p.width, p.height));
       continue;
     }
     auto bolt = lt::grow(p);
@@ -98,6 +101,7 @@ int main(int argc, char** argv) {
   std::vector<double> etas = {1, 2, 3};
   lt::Method method = lt::Method::kFast;
   bool halfField = false;
+  sh::HalfFieldLaw law;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--size") size = std::atoi(v.c_str());
@@ -109,6 +113,7 @@ int main(int argc, char** argv) {
       method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
       halfField = v == "half-field";
     }
+    else if (a == "--law") std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf", &law.phi, &law.n1, &law.n4, &law.n3);
     else if (a == "--eta") {
       etas.clear();
       std::stringstream ss(v);
@@ -148,7 +153,7 @@ int main(int argc, char** argv) {
   std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", name);
   std::mt19937 rng(49);
   for (double eta : etas) {
-    const Sample fast = grow(base, method, eta, fastSeeds, 1000, halfField);
+    const Sample fast = grow(base, method, eta, fastSeeds, 1000, halfField, law);
     const Sample dbm = grow(base, lt::Method::kDbm, eta, dbmSeeds, 5000);
     for (const Row& row : rows) {
       const double d = row.stat(fast.bolts, dbm.bolts);
