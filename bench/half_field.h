@@ -3,81 +3,157 @@
 // around the candidate:
 //   log Phi_i = phi * ln PhiC(i) + n1 * ln N1 + n4 * ln(1 + N4) + n3 * ln N3
 // N1: bolt cells among the 8 neighbours, N4: among the 4 edge neighbours, N3: within 3 cells
-// (Chebyshev). bench/lightning_phi_fit.cpp fits the constants to DBM's step distribution;
-// bench/lightning_shape.cpp (--method half-field) grows bolts by it and compares their shapes.
+// (Chebyshev). bench/lightning_phi_fit.cpp fits the constants to DBM's step distribution (the
+// field solved from scratch: CoarseField); bench/lightning_shape.cpp (--method half-field)
+// grows bolts by it (the field kept by DBM's incremental solver: GrowingCoarseField) and
+// compares their shapes.
 // 2-D, 8-neighbourhood, one point target.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <vector>
 
 #include <effects/lightning.h>
 
+#include "deep_field.h"  // effects/lightning, private
+#include "potential.h"
+
 namespace bench::shape {
 
 namespace lt = effects::lightning;
 
-// The Laplace field (bolt and obstacles 0, target 1) on a grid F times coarser than the
-// layout's: a coarse cell is the bolt where a bolt cell lies in it, an obstacle where most of it
-// is.
-struct CoarseField {
+// A grid F times coarser than the layout's: a coarse cell is an obstacle where most of it is
+// (never the target's), the bolt where a bolt cell lies in it (then never an obstacle).
+struct CoarseGrid {
   int F = 2, cw = 0, ch = 0;
-  std::vector<double> phi;
+  std::vector<uint8_t> obstacles;  // empty: none
+  lt::Cell target;
 
-  CoarseField(const lt::Params& layout, const std::vector<lt::Cell>& bolt, int factor) : F(factor) {
-    const int w = layout.width, h = layout.height;
-    cw = w / F;
-    ch = h / F;
-    const lt::Cell target = layout.targets.at(0);
-    const lt::Cell coarseTarget = at(target.x, target.y);
-    std::vector<uint8_t> obstacles;
-    if (!layout.obstacles.empty()) {
-      obstacles.assign(size_t(cw) * size_t(ch), 0);
-      for (int Y = 0; Y < ch; ++Y)
-        for (int X = 0; X < cw; ++X) {
-          int blocked = 0;
-          for (int y = F * Y; y < F * Y + F; ++y)
-            for (int x = F * X; x < F * X + F; ++x) blocked += layout.obstacles[size_t(y) * size_t(w) + size_t(x)] != 0;
-          obstacles[size_t(Y) * size_t(cw) + size_t(X)] = 2 * blocked > F * F && !(lt::Cell{X, Y} == coarseTarget);
-        }
-    }
+  CoarseGrid(const lt::Params& layout, int factor) : F(factor), cw(layout.width / factor), ch(layout.height / factor) {
+    target = at(layout.targets.at(0).x, layout.targets.at(0).y);
+    if (layout.obstacles.empty()) return;
+    obstacles.assign(size_t(cw) * size_t(ch), 0);
+    for (int Y = 0; Y < ch; ++Y)
+      for (int X = 0; X < cw; ++X) {
+        int blocked = 0;
+        for (int y = F * Y; y < F * Y + F; ++y)
+          for (int x = F * X; x < F * X + F; ++x)
+            blocked += layout.obstacles[size_t(y) * size_t(layout.width) + size_t(x)] != 0;
+        obstacles[index({X, Y})] = 2 * blocked > F * F && !(lt::Cell{X, Y} == target);
+      }
+  }
+  lt::Cell at(int x, int y) const { return {std::min(x / F, cw - 1), std::min(y / F, ch - 1)}; }
+  size_t index(lt::Cell C) const { return size_t(C.y) * size_t(cw) + size_t(C.x); }
+};
+
+// The Laplace field (bolt and obstacles 0, target 1) on a CoarseGrid, read around fine cells.
+struct CoarseField {
+  CoarseGrid grid;
+  std::vector<double> phi;  // per coarse cell
+
+  // Solved from scratch for a bolt (MGPCG).
+  CoarseField(const lt::Params& layout, const std::vector<lt::Cell>& bolt, int factor) : grid(layout, factor) {
+    std::vector<uint8_t> obstacles = grid.obstacles;
     std::vector<lt::Cell> coarseBolt;
-    std::vector<uint8_t> seen(size_t(cw) * size_t(ch), 0);
+    std::vector<uint8_t> seen(size_t(grid.cw) * size_t(grid.ch), 0);
     for (const lt::Cell& c : bolt) {
-      const lt::Cell C = at(c.x, c.y);
-      uint8_t& s = seen[size_t(C.y) * size_t(cw) + size_t(C.x)];
-      if (s || C == coarseTarget) continue;
+      const lt::Cell C = grid.at(c.x, c.y);
+      uint8_t& s = seen[grid.index(C)];
+      if (s || C == grid.target) continue;
       s = 1;
-      if (!obstacles.empty()) obstacles[size_t(C.y) * size_t(cw) + size_t(C.x)] = 0;
+      if (!obstacles.empty()) obstacles[grid.index(C)] = 0;
       coarseBolt.push_back(C);
     }
-    phi = lt::solveLaplace(cw, ch, obstacles, coarseBolt, coarseTarget, lt::Solver::kMgpcg, 1e-10);
-    smallest = INFINITY;
-    for (double v : phi)
-      if (v > 0) smallest = std::min(smallest, v);
-    if (std::isinf(smallest)) smallest = 1e-300;
+    phi = lt::solveLaplace(grid.cw, grid.ch, obstacles, coarseBolt, grid.target, lt::Solver::kMgpcg, 1e-10);
   }
-
-  lt::Cell at(int x, int y) const { return {std::min(x / F, cw - 1), std::min(y / F, ch - 1)}; }
+  CoarseField(const CoarseGrid& g, std::vector<double> values) : grid(g), phi(std::move(values)) {}
 
   // log of the largest field over the fine cell's coarse cell and its 8 neighbours. Where the
-  // bolt fills all nine, the candidate is screened at least as deeply as the field's smallest
-  // nonzero value, which it is given.
-  double logAround(int x, int y) const {
-    const lt::Cell C = at(x, y);
+  // bolt fills all nine, the candidate is screened at least as deeply as the smallest nonzero
+  // field read around any candidate (smallestAround), which it is given.
+  double logAround(int x, int y, double smallest) const {
     double v = 0;
+    around(x, y, [&](size_t i) { v = std::max(v, phi[i]); });
+    return std::log(v > 0 ? v : smallest);
+  }
+  double smallestAround(const std::vector<lt::Cell>& candidates) const {
+    double least = INFINITY;
+    for (const lt::Cell& c : candidates)
+      around(c.x, c.y, [&](size_t i) {
+        if (phi[i] > 0) least = std::min(least, phi[i]);
+      });
+    return std::isinf(least) ? 1e-300 : least;
+  }
+  // Calls f with the index of the fine cell's coarse cell and of each of its 8 neighbours.
+  template <class F>
+  void around(int x, int y, F&& f) const {
+    const lt::Cell C = grid.at(x, y);
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx)
-        if (C.x + dx >= 0 && C.y + dy >= 0 && C.x + dx < cw && C.y + dy < ch)
-          v = std::max(v, phi[size_t(C.y + dy) * size_t(cw) + size_t(C.x + dx)]);
-    return std::log(v > 0 ? v : smallest);
+        if (C.x + dx >= 0 && C.y + dy >= 0 && C.x + dx < grid.cw && C.y + dy < grid.ch)
+          f(grid.index({C.x + dx, C.y + dy}));
+  }
+};
+
+// The same field kept as the bolt grows, by DBM's own incremental solver on the coarse grid
+// (effects/lightning/deep_field.h over the capacitance method: a new fixed cell costs one
+// Cholesky row). Private to effects; the bench reaches it as the tests do. Gives the field
+// CoarseField gives, to the solver's tolerance.
+class GrowingCoarseField {
+ public:
+  GrowingCoarseField(const lt::Params& layout, int factor)
+      : grid_(layout, factor), state_(size_t(grid_.cw) * size_t(grid_.ch), 0) {
+    size_t fixed = 1;
+    for (uint8_t o : grid_.obstacles) fixed += o;
+    field_ = std::make_unique<lt::detail::DeepField>(
+        lt::detail::potentialFor(grid_.cw, grid_.ch, 0, lt::Solver::kCapacitance, fixed, fixed), grid_.cw, grid_.ch, 0);
+    for (size_t i = 0; i < grid_.obstacles.size(); ++i)
+      if (grid_.obstacles[i]) fix(i, kFixedZero, 0.0);
+    fix(grid_.index(grid_.target), kTarget, 1.0);
+  }
+  // A fine bolt cell joined: its coarse cell is the bolt.
+  void add(lt::Cell c) {
+    const size_t i = grid_.index(grid_.at(c.x, c.y));
+    if (state_[i] == kFree) fix(i, kFixedZero, 0.0);  // (an obstacle's or the target's stays)
+  }
+  // The field at the coarse cells around these fine cells (0 elsewhere: not solved for).
+  CoarseField solve(const std::vector<lt::Cell>& around) {
+    probes_.clear();
+    std::vector<double> phi(state_.size(), 0.0);
+    for (const lt::Cell& c : around) {
+      const lt::Cell C = grid_.at(c.x, c.y);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const lt::Cell N{C.x + dx, C.y + dy};
+          if (N.x < 0 || N.y < 0 || N.x >= grid_.cw || N.y >= grid_.ch || state_[grid_.index(N)] != kFree) continue;
+          state_[grid_.index(N)] = kProbed;
+          probes_.push_back(N);
+        }
+    }
+    field_->solve(lt::Solver::kCapacitance, 1e-10, probes_, logPhi_);
+    for (size_t k = 0; k < probes_.size(); ++k) {
+      phi[grid_.index(probes_[k])] = std::exp(logPhi_[k]);
+      state_[grid_.index(probes_[k])] = kFree;
+    }
+    phi[grid_.index(grid_.target)] = 1.0;
+    return CoarseField(grid_, std::move(phi));
   }
 
  private:
-  double smallest = 1e-300;  // the field's smallest nonzero value
+  enum : uint8_t { kFree, kFixedZero, kTarget, kProbed };
+  void fix(size_t i, uint8_t state, double value) {
+    state_[i] = state;
+    field_->fix({int(i % size_t(grid_.cw)), int(i / size_t(grid_.cw))}, value);
+  }
+  CoarseGrid grid_;
+  std::vector<uint8_t> state_;
+  std::unique_ptr<lt::detail::DeepField> field_;
+  std::vector<lt::Cell> probes_;
+  std::vector<double> logPhi_;
 };
 
 // The bolt cells around a cell (stepAt[cell] >= 0: the step it joined at).
@@ -123,13 +199,14 @@ inline lt::Bolt growHalfField(const lt::Params& p, const HalfFieldLaw& law = {})
   };
   lt::Bolt bolt;
   std::vector<int> stepAt(size_t(w) * size_t(h), -1), nodeAt(size_t(w) * size_t(h), -1);
-  std::vector<lt::Cell> cells, candidates;
+  std::vector<lt::Cell> candidates;
+  GrowingCoarseField coarse(p, law.coarse);
   std::vector<uint8_t> isCandidate(size_t(w) * size_t(h), 0);
   auto add = [&](lt::Cell c, int parent, int step) {
     nodeAt[index(c.x, c.y)] = int(bolt.nodes.size());
     stepAt[index(c.x, c.y)] = step;
     bolt.nodes.push_back({c, parent, step});
-    cells.push_back(c);
+    coarse.add(c);
     isCandidate[index(c.x, c.y)] = 0;
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
@@ -143,16 +220,18 @@ inline lt::Bolt growHalfField(const lt::Params& p, const HalfFieldLaw& law = {})
   std::mt19937_64 rng(p.seed);
   std::vector<double> logw;
   for (int step = 1; size_t(step) < p.maxSteps; ++step) {
-    candidates.erase(std::remove_if(candidates.begin(), candidates.end(), [&](lt::Cell c) { return !isCandidate[index(c.x, c.y)]; }),
-                     candidates.end());
+    candidates.erase(
+        std::remove_if(candidates.begin(), candidates.end(), [&](lt::Cell c) { return !isCandidate[index(c.x, c.y)]; }),
+        candidates.end());
     if (candidates.empty()) break;
-    const CoarseField field(p, cells, law.coarse);
+    const CoarseField field = coarse.solve(candidates);
+    const double smallest = field.smallestAround(candidates);
     logw.assign(candidates.size(), 0.0);
     double hi = -INFINITY;
     for (size_t i = 0; i < candidates.size(); ++i) {
       const lt::Cell c = candidates[i];
       const Screening s = screening(stepAt, w, h, c.x, c.y);
-      logw[i] = p.eta * (law.phi * field.logAround(c.x, c.y) + law.n1 * std::log(double(s.n1)) +
+      logw[i] = p.eta * (law.phi * field.logAround(c.x, c.y, smallest) + law.n1 * std::log(double(s.n1)) +
                          law.n4 * std::log(1.0 + s.n4) + law.n3 * std::log(double(s.n3)));
       hi = std::max(hi, logw[i]);
     }

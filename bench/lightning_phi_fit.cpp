@@ -49,7 +49,8 @@ namespace {
 int F = 2;  // --coarse: the coarse grid's cell, in fine cells
 
 enum Feature { kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC, kLnNcal, kFeatures };
-const char* const kNames[kFeatures] = {"G", "lnB", "lnP", "lnN1", "lnN4", "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal"};
+const char* const kNames[kFeatures] = {"G",    "lnB",   "lnP",    "lnN1",   "lnN4",
+                                       "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal"};
 
 struct Step {
   std::vector<std::array<double, kFeatures>> f;  // per candidate
@@ -70,7 +71,9 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
   ax /= len;
   ay /= len;
   auto along = [&](int x, int y) { return (x - start.x) * ax + (y - start.y) * ay; };
-  auto blocked = [&](int x, int y) { return !layout.obstacles.empty() && layout.obstacles[size_t(y) * size_t(w) + size_t(x)]; };
+  auto blocked = [&](int x, int y) {
+    return !layout.obstacles.empty() && layout.obstacles[size_t(y) * size_t(w) + size_t(x)];
+  };
   for (int s = 0; s < seeds; ++s) {
     lt::Params p = layout;
     p.method = lt::Method::kDbm;
@@ -99,29 +102,35 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
       Step st;
       double maxLog = -INFINITY;
       std::vector<double> logw;
+      std::vector<lt::Cell> candidates;
       for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          if (stepAt[size_t(y) * size_t(w) + size_t(x)] >= 0 || blocked(x, y) || (x == target.x && y == target.y)) continue;
-          const bench::shape::Screening near = bench::shape::screening(stepAt, w, h, x, y);
-          if (near.n1 == 0) continue;  // not a candidate
-          int ncal = 0;
-          for (int dy = -calRadius; dy <= calRadius; ++dy)
-            for (int dx = -calRadius; dx <= calRadius; ++dx) {
-              const int X = x + dx, Y = y + dy;
-              ncal += X >= 0 && Y >= 0 && X < w && Y < h && stepAt[size_t(Y) * size_t(w) + size_t(X)] >= 0;
-            }
-          double& b = lnB[size_t(y) * size_t(w) + size_t(x)];
-          if (std::isnan(b)) b = std::log(lt::boundaryPotential(w, h, layout.obstacles, {x, y}));
-          const double a = along(x, y);
-          const double G = std::floor(a <= len ? a : 2 * len - a);
-          const double P = std::max(0.5, std::hypot(double(x - target.x), double(y - target.y)));
-          st.f.push_back({G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4), std::log(double(near.n3)),
-                          std::log(1.0 + t - near.last), std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y),
-                          std::log(double(ncal))});
-          const double lp = eta * std::log(std::max(phi[size_t(y) * size_t(w) + size_t(x)], 1e-300));
-          logw.push_back(lp);
-          maxLog = std::max(maxLog, lp);
-        }
+        for (int x = 0; x < w; ++x)
+          if (stepAt[size_t(y) * size_t(w) + size_t(x)] < 0 && !blocked(x, y) && !(x == target.x && y == target.y) &&
+              bench::shape::screening(stepAt, w, h, x, y).n1 > 0)
+            candidates.push_back({x, y});
+      const double smallest = coarse.smallestAround(candidates);
+      for (const lt::Cell& c : candidates) {
+        const int x = c.x, y = c.y;
+        const bench::shape::Screening near = bench::shape::screening(stepAt, w, h, x, y);
+        int ncal = 0;
+        for (int dy = -calRadius; dy <= calRadius; ++dy)
+          for (int dx = -calRadius; dx <= calRadius; ++dx) {
+            const int X = x + dx, Y = y + dy;
+            ncal += X >= 0 && Y >= 0 && X < w && Y < h && stepAt[size_t(Y) * size_t(w) + size_t(X)] >= 0;
+          }
+        double& b = lnB[size_t(y) * size_t(w) + size_t(x)];
+        if (std::isnan(b)) b = std::log(lt::boundaryPotential(w, h, layout.obstacles, {x, y}));
+        const double a = along(x, y);
+        const double G = std::floor(a <= len ? a : 2 * len - a);
+        const double P = std::max(0.5, std::hypot(double(x - target.x), double(y - target.y)));
+        st.f.push_back({G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4),
+                        std::log(double(near.n3)), std::log(1.0 + t - near.last),
+                        std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y, smallest),
+                        std::log(double(ncal))});
+        const double lp = eta * std::log(std::max(phi[size_t(y) * size_t(w) + size_t(x)], 1e-300));
+        logw.push_back(lp);
+        maxLog = std::max(maxLog, lp);
+      }
       double sum = 0;
       for (double& v : logw) sum += (v = std::exp(v - maxLog));
       for (double v : logw) st.p.push_back(v / sum);
@@ -134,7 +143,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
 // A law: log Phi = sum_k beta[k] f_k, candidates with age > maxAge (0: none) left out.
 struct Law {
   std::string name;
-  std::vector<int> use;       // features fitted (empty: beta fixed)
+  std::vector<int> use;  // features fitted (empty: beta fixed)
   std::array<double, kFeatures> beta{};
   int maxAge = 0;
 };
@@ -246,11 +255,16 @@ int main(int argc, char** argv) {
   std::vector<double> etas{1, 2, 3};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--size") size = std::atoi(argv[i + 1]);
-    else if (a == "--train") train = std::atoi(argv[i + 1]);
-    else if (a == "--test") test = std::atoi(argv[i + 1]);
-    else if (a == "--steps") steps = std::atoi(argv[i + 1]);
-    else if (a == "--coarse") F = std::atoi(argv[i + 1]);
+    if (a == "--size")
+      size = std::atoi(argv[i + 1]);
+    else if (a == "--train")
+      train = std::atoi(argv[i + 1]);
+    else if (a == "--test")
+      test = std::atoi(argv[i + 1]);
+    else if (a == "--steps")
+      steps = std::atoi(argv[i + 1]);
+    else if (a == "--coarse")
+      F = std::atoi(argv[i + 1]);
     else if (a == "--eta") {
       etas.clear();
       std::stringstream s(argv[i + 1]);
@@ -288,8 +302,10 @@ int main(int argc, char** argv) {
     laws.push_back({"the coarse field, N and edge neighbours", {kLnN1, kLnN4, kLnN3, kLnPhiC}, {}, 0});
     laws.push_back({"all of them", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC}, {}, 0});
     std::printf("\n## eta %g: fitted on open %d^2 (%d bolts x %d steps), TV per step\n\n", eta, size, train, steps);
-    std::printf("| law | open (fit) | open (held out) | off-axis %d | wall %d | open %d | constants |\n|---|---|---|---|---|---|---|\n",
-                size, size, size / 2);
+    std::printf(
+        "| law | open (fit) | open (held out) | off-axis %d | wall %d | open %d | constants "
+        "|\n|---|---|---|---|---|---|---|\n",
+        size, size, size / 2);
     for (Law& law : laws) {
       if (!law.use.empty()) fit(law, fitSteps, eta);
       std::printf("| %s | %.3f | %.3f |", law.name.c_str(), meanTv(law, fitSteps, eta), meanTv(law, heldOut, eta));
@@ -299,11 +315,12 @@ int main(int argc, char** argv) {
     }
     // Refitted on each other geometry: do the constants move?
     for (size_t g = 0; g < others.size(); ++g)
-      for (const std::vector<int>& use : {std::vector<int>{kG, kLnB, kLnP, kLnN1, kLnN3}, std::vector<int>{kLnN1, kLnN4, kLnN3, kLnPhiC}}) {
+      for (const std::vector<int>& use :
+           {std::vector<int>{kG, kLnB, kLnP, kLnN1, kLnN3}, std::vector<int>{kLnN1, kLnN4, kLnN3, kLnPhiC}}) {
         Law law{"", use, {}, 0};
         fit(law, otherSteps[g], eta);
-        std::printf("refit on %s %d: TV %.3f, %s\n", others[g].first.c_str(), others[g].second, meanTv(law, otherSteps[g], eta),
-                    betas(law).c_str());
+        std::printf("refit on %s %d: TV %.3f, %s\n", others[g].first.c_str(), others[g].second,
+                    meanTv(law, otherSteps[g], eta), betas(law).c_str());
       }
   }
 }

@@ -40,18 +40,39 @@ TEST(HalfField, CoarseFieldHoldsItsBoundaryAndScreensBehindTheBolt) {
   for (int y = 1; y < 30; ++y) bolt.push_back({32, y});  // a channel down the middle
   const CoarseField f(p, bolt, 2);
   ASSERT_EQ(f.phi.size(), size_t(32 * 32));
-  const lt::Cell t = f.at(p.targets[0].x, p.targets[0].y), s = f.at(32, 10);
-  EXPECT_DOUBLE_EQ(f.phi[size_t(t.y) * 32 + size_t(t.x)], 1.0);
-  EXPECT_DOUBLE_EQ(f.phi[size_t(s.y) * 32 + size_t(s.x)], 0.0);
+  EXPECT_DOUBLE_EQ(f.phi[f.grid.index(f.grid.target)], 1.0);
+  EXPECT_DOUBLE_EQ(f.phi[f.grid.index(f.grid.at(32, 10))], 0.0);
   // Ahead of the channel's tip the field is larger than beside its root.
-  EXPECT_GT(f.logAround(32, 32), f.logAround(35, 3));
-  // A cell whose coarse neighbourhood the bolt fills gets the smallest nonzero field: finite.
+  EXPECT_GT(f.logAround(32, 32, 1e-300), f.logAround(35, 3, 1e-300));
+  // A cell whose coarse neighbourhood the bolt fills gets the smallest field read around the
+  // candidates: finite, and below the others'.
   std::vector<lt::Cell> block;
   for (int y = 0; y < 12; ++y)
     for (int x = 20; x < 44; ++x) block.push_back({x, y});
   const CoarseField g(p, block, 2);
-  EXPECT_TRUE(std::isfinite(g.logAround(32, 4)));
-  EXPECT_LT(g.logAround(32, 4), g.logAround(32, 40));
+  const std::vector<lt::Cell> candidates{{32, 4}, {32, 12}, {19, 6}};
+  const double smallest = g.smallestAround(candidates);
+  EXPECT_GT(smallest, 0.0);
+  EXPECT_DOUBLE_EQ(g.logAround(32, 4, smallest), std::log(smallest));
+  EXPECT_LT(g.logAround(32, 4, smallest), g.logAround(32, 12, smallest));
+}
+
+TEST(HalfField, GrowingCoarseFieldIsTheFieldSolvedFromScratch) {
+  lt::Params p = openLayout(64);
+  p.obstacles.assign(64 * 64, 0);
+  for (int y = 40; y < 42; ++y)
+    for (int x = 10; x < 40; ++x) p.obstacles[size_t(y) * 64 + size_t(x)] = 1;  // a wall, whole coarse cells
+  GrowingCoarseField growing(p, 2);
+  std::vector<lt::Cell> bolt, around;
+  for (int y = 1; y < 30; ++y) {
+    bolt.push_back({32 + y / 4, y});
+    growing.add(bolt.back());
+  }
+  for (int y = 2; y < 31; ++y) around.push_back({33 + y / 4, y});
+  const CoarseField scratch(p, bolt, 2), incremental = growing.solve(around);
+  for (const lt::Cell& c : around)
+    EXPECT_NEAR(incremental.logAround(c.x, c.y, 1e-300), scratch.logAround(c.x, c.y, 1e-300), 1e-6)
+        << c.x << "," << c.y;
 }
 
 TEST(HalfField, GrowsATreeFromTheStartToTheTargetTheSameForASeed) {
