@@ -36,7 +36,9 @@ pkg-config --exists effectd || fail "pkg-config does not find effectd"
 # shellcheck disable=SC2046
 c++ -std=c++20 -O2 "$here/consumer/consumer.cpp" -o "$work/consumer_pc" $(pkg-config --cflags --libs effectd) 2>"$work/pc.log" ||
   { cat "$work/pc.log"; fail "building with pkg-config"; }
-LD_LIBRARY_PATH="$libdir" ldd "$work/consumer_pc" | grep -q "$libdir/libeffects.so" || fail "the pkg-config build does not load the installed libeffects.so"
+# Captured first: under pipefail, grep -q's early exit can end ldd with SIGPIPE and fail the line.
+loaded=$(LD_LIBRARY_PATH="$libdir" ldd "$work/consumer_pc") || fail "ldd $work/consumer_pc"
+grep -q "$libdir/libeffects.so" <<<"$loaded" || fail "the pkg-config build does not load the installed libeffects.so"
 echo "ok   built against the prefix: find_package (static, shared) and pkg-config"
 
 # docs/engines.md's C snippet, compiled as C99 against the prefix and run.
@@ -46,8 +48,9 @@ grep -q effects_bolt_grow "$work/snippet.c" || fail "no C snippet in docs/engine
 # shellcheck disable=SC2046
 cc -std=c99 -Wall -Wextra -pedantic -Werror "$work/snippet.c" -o "$work/snippet" $(pkg-config --cflags --libs effectd) 2>"$work/snippet.log" ||
   { cat "$work/snippet.log"; fail "docs/engines.md's C snippet does not compile"; }
-LD_LIBRARY_PATH="$libdir" "$work/snippet" | grep -q "^[0-9]* cells$" || fail "docs/engines.md's C snippet did not print its cells"
-echo "ok   docs/engines.md's C snippet: $(LD_LIBRARY_PATH="$libdir" "$work/snippet")"
+printed=$(LD_LIBRARY_PATH="$libdir" "$work/snippet") || fail "docs/engines.md's C snippet failed"
+grep -q "^[0-9]* cells$" <<<"$printed" || fail "docs/engines.md's C snippet did not print its cells"
+echo "ok   docs/engines.md's C snippet: $printed"
 
 "$bin" --port 0 --access-log 0 2>"$work/log" &
 pid=$!
