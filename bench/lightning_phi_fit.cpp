@@ -102,16 +102,21 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
       Step st;
       double maxLog = -INFINITY;
       std::vector<double> logw;
-      std::vector<lt::Cell> candidates;
+      std::vector<lt::Cell> candidates;  // free cells with a bolt cell among their 8 neighbours
+      std::vector<bench::shape::Screening> screened;
       for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-          if (stepAt[size_t(y) * size_t(w) + size_t(x)] < 0 && !blocked(x, y) && !(x == target.x && y == target.y) &&
-              bench::shape::screening(stepAt, w, h, x, y).n1 > 0)
-            candidates.push_back({x, y});
+        for (int x = 0; x < w; ++x) {
+          if (stepAt[size_t(y) * size_t(w) + size_t(x)] >= 0 || blocked(x, y) || (x == target.x && y == target.y))
+            continue;
+          const bench::shape::Screening near = bench::shape::screening(stepAt, w, h, x, y);
+          if (near.n1 == 0) continue;
+          candidates.push_back({x, y});
+          screened.push_back(near);
+        }
       const double smallest = coarse.smallestAround(candidates);
-      for (const lt::Cell& c : candidates) {
-        const int x = c.x, y = c.y;
-        const bench::shape::Screening near = bench::shape::screening(stepAt, w, h, x, y);
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        const int x = candidates[i].x, y = candidates[i].y;
+        const bench::shape::Screening& near = screened[i];
         int ncal = 0;
         for (int dy = -calRadius; dy <= calRadius; ++dy)
           for (int dx = -calRadius; dx <= calRadius; ++dx) {

@@ -8,15 +8,14 @@
 #include <gtest/gtest.h>
 
 #include "half_field.h"
+#include "layouts.h"
 
 namespace bench::shape {
 namespace {
 
+// The shape bench's open layout at eta 2.
 lt::Params openLayout(int s) {
-  lt::Params p;
-  p.width = p.height = s;
-  p.start = {s / 2, 1};
-  p.targets = {{s / 2, s - 2}};
+  lt::Params p = layout("open", s);
   p.eta = 2;
   return p;
 }

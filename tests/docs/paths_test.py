@@ -2,8 +2,9 @@
 """Every repository path a document names exists: backticked or bare paths under the project's
 top-level folders (server/, effects/, render/, proto/, tests/, scripts/, bench/, docs/, clients/,
 examples/, fixtures/, deploy/, cmake/), with `{h,cpp}` groups expanded and a trailing `:line`
-or `#anchor` removed; an include name in angle brackets (`<effects/fog.h>`) is not a path. A command's output prefix (`docs/x/bubble` for docs/x/bubble-*.png) counts
-when files start with it.
+or `#anchor` removed; an include name in angle brackets (`<effects/fog.h>`) is not a path. A
+command's output prefix (`docs/x/bubble` for docs/x/bubble-*.png) counts when files start
+with it.
 
   tests/docs/paths_test.py ROOT DOC...     exit 1 naming each path that is not there
 """
