@@ -19,13 +19,22 @@
 //          read around the candidate (bench/half_field.h, CoarseField): the field's screening at
 //          1/F^2 of the cells
 //   lnNcal log of the bolt cells within the calibrated screening radius (the calibrated law's N)
+//   lnFree log of the candidate's exposure (bench/half_field.h, exposure()): the mean length 16
+//          rays travel before they meet the bolt, an obstacle or the border, capped at --reach
+//          (default 16). The field's short-range screening without a solve
+//   lnPgeo log of the distance to the target around the obstacles (half_field.h, geodesic())
+//   Ggeo   the progress towards the target around the obstacles: geodesic() at the start less
+//          at the candidate (G measured as the A* guide would)
 // The laws compared: every candidate alike (the scale of the distances); the paper's eqn 8
 // (a = 2, N adjacent, lifetime 4); the calibrated fast method (calibrate(): its base, radius and
 // lifetime; candidates past the lifetime have q = 0); eqn 8's terms with fitted constants, then
 // with lnAge and lnLead; the coarse field with the neighbour counts (bench/half_field.h's law);
-// all of them. A law is a law if its constants fitted on one geometry and eta hold at the others.
+// exposure with eqn 8's terms, with no field at all (Ggeo, lnPgeo, the counts) and with the
+// coarse field; all of them. A law is a law if its constants fitted on one geometry and eta
+// hold at the others.
 //
 //   lightning_phi_fit [--size 128] [--train 10] [--test 10] [--steps 12] [--eta 1,2,3] [--coarse 2]
+//                     [--reach 16]
 //
 // Results and what they mean: docs/lightning-shape.md, "What a law would have to do".
 #include <algorithm>
@@ -48,9 +57,13 @@ namespace {
 
 int F = 2;  // --coarse: the coarse grid's cell, in fine cells
 
-enum Feature { kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC, kLnNcal, kFeatures };
+enum Feature { kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC, kLnNcal, kLnFree, kLnPgeo, kGgeo, kFeatures };
 const char* const kNames[kFeatures] = {"G",    "lnB",   "lnP",    "lnN1",   "lnN4",
-                                       "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal"};
+                                       "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal", "lnFree", "lnPgeo", "Ggeo"};
+
+int reach = 16;  // --reach: exposure()'s cap
+
+
 
 struct Step {
   std::vector<std::array<double, kFeatures>> f;  // per candidate
@@ -66,6 +79,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
   fast.eta = eta;
   const int calRadius = lt::calibratedScreeningRadius(fast);
   std::vector<double> lnB(size_t(w) * size_t(h), NAN);
+  const std::vector<double> geo = bench::shape::geodesic(layout);
   double ax = target.x - start.x, ay = target.y - start.y;
   const double len = std::hypot(ax, ay);
   ax /= len;
@@ -123,6 +137,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
             const int X = x + dx, Y = y + dy;
             ncal += X >= 0 && Y >= 0 && X < w && Y < h && stepAt[size_t(Y) * size_t(w) + size_t(X)] >= 0;
           }
+        const double free = bench::shape::exposure(stepAt, layout.obstacles, w, h, x, y, reach);
         double& b = lnB[size_t(y) * size_t(w) + size_t(x)];
         if (std::isnan(b)) b = std::log(lt::boundaryPotential(w, h, layout.obstacles, {x, y}));
         const double a = along(x, y);
@@ -131,7 +146,9 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
         st.f.push_back({G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4),
                         std::log(double(near.n3)), std::log(1.0 + t - near.last),
                         std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y, smallest),
-                        std::log(double(ncal))});
+                        std::log(double(ncal)), std::log(free),
+                        std::log(std::max(0.5, geo[size_t(y) * size_t(w) + size_t(x)])),
+                        geo[size_t(start.y) * size_t(w) + size_t(start.x)] - geo[size_t(y) * size_t(w) + size_t(x)]});
         const double lp = eta * std::log(std::max(phi[size_t(y) * size_t(w) + size_t(x)], 1e-300));
         logw.push_back(lp);
         maxLog = std::max(maxLog, lp);
@@ -268,6 +285,8 @@ int main(int argc, char** argv) {
       test = std::atoi(argv[i + 1]);
     else if (a == "--steps")
       steps = std::atoi(argv[i + 1]);
+    else if (a == "--reach")
+      reach = std::atoi(argv[i + 1]);
     else if (a == "--coarse")
       F = std::atoi(argv[i + 1]);
     else if (a == "--eta") {
@@ -293,10 +312,10 @@ int main(int argc, char** argv) {
     std::vector<Law> laws;
     laws.push_back({"every candidate alike (the scale)", {}, {}, 0});
     Law paper{"eqn 8 as printed (a 2, N adjacent, lifetime 4)", {}, {}, lt::kPaperLifetime};
-    paper.beta = {std::log(2.0), -1, -1, -1, 0, 0, 0, 0, 0, 0};
+    paper.beta = {std::log(2.0), -1, -1, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     laws.push_back(paper);
     Law calibrated{"calibrated fast (a, radius, lifetime)", {}, {}, cal.lifetime};
-    calibrated.beta = {std::log(cal.axisGrowth), -1, -1, 0, 0, 0, 0, 0, 0, -1};
+    calibrated.beta = {std::log(cal.axisGrowth), -1, -1, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
     laws.push_back(calibrated);
     laws.push_back({"eqn 8's terms, fitted", {kG, kLnB, kLnP, kLnN1, kLnN3}, {}, 0});
     laws.push_back({"+ lnAge", {kG, kLnB, kLnP, kLnN1, kLnN3, kLnAge}, {}, 0});
@@ -305,6 +324,9 @@ int main(int argc, char** argv) {
     laws.push_back({"the coarse field and N alone", {kLnN1, kLnN3, kLnPhiC}, {}, 0});
     laws.push_back({"eqn 8's terms + edge neighbours", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3}, {}, 0});
     laws.push_back({"the coarse field, N and edge neighbours", {kLnN1, kLnN4, kLnN3, kLnPhiC}, {}, 0});
+    laws.push_back({"eqn 8's terms, edge neighbours and exposure", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
+    laws.push_back({"no field: Ggeo, lnPgeo, N and exposure", {kGgeo, kLnPgeo, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
+    laws.push_back({"the coarse field, N, edge neighbours and exposure", {kLnPhiC, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
     laws.push_back({"all of them", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC}, {}, 0});
     std::printf("\n## eta %g: fitted on open %d^2 (%d bolts x %d steps), TV per step\n\n", eta, size, train, steps);
     std::printf(
@@ -321,7 +343,8 @@ int main(int argc, char** argv) {
     // Refitted on each other geometry: do the constants move?
     for (size_t g = 0; g < others.size(); ++g)
       for (const std::vector<int>& use :
-           {std::vector<int>{kG, kLnB, kLnP, kLnN1, kLnN3}, std::vector<int>{kLnN1, kLnN4, kLnN3, kLnPhiC}}) {
+           {std::vector<int>{kG, kLnB, kLnP, kLnN1, kLnN3}, std::vector<int>{kLnN1, kLnN4, kLnN3, kLnPhiC},
+            std::vector<int>{kGgeo, kLnPgeo, kLnN1, kLnN4, kLnN3, kLnFree}}) {
         Law law{"", use, {}, 0};
         fit(law, otherSteps[g], eta);
         std::printf("refit on %s %d: TV %.3f, %s\n", others[g].first.c_str(), others[g].second,

@@ -6,11 +6,13 @@
 // within that noise: indistinguishable at these seeds.
 //
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
-//                   [--method fast|charges|half-field] [--law phi,n1,n4,n3[,F]] [--splits 40]
+//                   [--method fast|charges|half-field] [--law phi,n1,n4,n3[,F[,free,reach,g,b,p]]]
+//                   [--splits 40]
 //                   [--geometry open]
 //
 // half-field: the candidate law of bench/half_field.h (2-D layouts with one point target), with
-// its constants or --law phi,n1,n4,n3[,coarse factor].
+// its constants or --law's (HalfFieldLaw's fields in order; phi 0: no field, eqn 8's far terms
+// g, b, p around the obstacles instead).
 //
 // Geometries (--size s): bench/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
@@ -113,7 +115,9 @@ int main(int argc, char** argv) {
       method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
       halfField = v == "half-field";
     }
-    else if (a == "--law") std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf,%d", &law.phi, &law.n1, &law.n4, &law.n3, &law.coarse);
+    else if (a == "--law")
+      std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf,%d,%lf,%d,%lf,%lf,%lf", &law.phi, &law.n1, &law.n4, &law.n3, &law.coarse,
+                  &law.free, &law.reach, &law.g, &law.b, &law.p);
     else if (a == "--eta") {
       etas.clear();
       std::stringstream ss(v);
