@@ -819,6 +819,8 @@ void conclude(std::vector<Section>& sections) {
       for (const auto& p : s.points)
         if (p.setting != "reference" && std::isfinite(p.error) && (!far || p.error > far->error)) far = &p;
       if (far) c << " " << far->series << " " << far->setting << " (" << fmt(far->error, 3) << " standard errors: " << far->note << ").";
+      c << " The calibrated tables stay the fast method's default: no law measured meets DBM in every geometry. "
+           "Seven shape measures per geometry and the laws tried: docs/lightning-shape.md.";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
       if (jnd)
