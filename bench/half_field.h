@@ -1,13 +1,13 @@
-// Candidate laws for the fast method (issue 49, item 3), for the bench tools only: Phi_i is the
+// A candidate law for the fast method (issue 49, item 3), for the bench tools only: Phi_i is the
 // Laplace field solved on a grid F times coarser, times local screening by the bolt cells
 // around the candidate:
 //   log Phi_i = phi * ln PhiC(i) + n1 * ln N1 + n4 * ln(1 + N4) + n3 * ln N3 [+ free * ln E]
 // N1: bolt cells among the 8 neighbours, N4: among the 4 edge neighbours, N3: within 3 cells
-// (Chebyshev); E: the candidate's exposure(). With phi 0 there is no field: eqn 8's far terms
-// measured around the obstacles (HalfFieldLaw's g, b, p) take its place. bench/lightning_phi_fit.cpp fits the constants to DBM's step distribution (the
-// field solved from scratch: CoarseField); bench/lightning_shape.cpp (--method half-field)
-// grows bolts by it (the field kept by DBM's incremental solver: GrowingCoarseField) and
-// compares their shapes.
+// (Chebyshev: screening()); E: the candidate's exposure() (bench/exposure_law.h, where the law
+// without a field is). bench/lightning_phi_fit.cpp fits the constants to DBM's step
+// distribution (the field solved from scratch: CoarseField); bench/lightning_shape.cpp
+// (--method half-field) grows bolts by it (the field kept by DBM's incremental solver:
+// GrowingCoarseField) and compares their shapes.
 // 2-D, 8-neighbourhood, one point target.
 #pragma once
 
@@ -15,13 +15,13 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
-#include <queue>
 #include <random>
 #include <vector>
 
 #include <effects/lightning.h>
 
 #include "deep_field.h"  // effects/lightning, private
+#include "exposure_law.h"
 #include "potential.h"
 
 namespace bench::shape {
@@ -117,7 +117,6 @@ class GrowingCoarseField {
       if (grid_.obstacles[i]) fix(i, kFixedZero, 0.0);
     fix(grid_.index(grid_.target), kTarget, 1.0);
   }
-  const CoarseGrid& grid() const { return grid_; }
   // A fine bolt cell joined: its coarse cell is the bolt.
   void add(lt::Cell c) {
     const size_t i = grid_.index(grid_.at(c.x, c.y));
@@ -159,29 +158,6 @@ class GrowingCoarseField {
   std::vector<double> logPhi_;
 };
 
-// The bolt cells around a cell (stepAt[cell] >= 0: the step it joined at).
-struct Screening {
-  int n1 = 0, n4 = 0, n3 = 0;
-  int last = -1;  // the latest step among the 8 neighbours
-};
-inline Screening screening(const std::vector<int>& stepAt, int w, int h, int x, int y) {
-  Screening s;
-  for (int dy = -3; dy <= 3; ++dy)
-    for (int dx = -3; dx <= 3; ++dx) {
-      const int X = x + dx, Y = y + dy;
-      if (X < 0 || Y < 0 || X >= w || Y >= h) continue;
-      const int step = stepAt[size_t(Y) * size_t(w) + size_t(X)];
-      if (step < 0) continue;
-      ++s.n3;
-      if (std::abs(dx) + std::abs(dy) == 1) ++s.n4;
-      if (std::abs(dx) <= 1 && std::abs(dy) <= 1) {
-        ++s.n1;
-        s.last = std::max(s.last, step);
-      }
-    }
-  return s;
-}
-
 // The constants (docs/lightning-shape.md, "What a law would have to do"): phi is fitted to DBM's
 // single steps (bench/lightning_phi_fit.cpp, open 128^2, eta 2); the screening n1, n4, n3 were
 // then set by the shapes of grown bolts at that one layout and eta (single steps gave -0.32,
@@ -191,61 +167,7 @@ struct HalfFieldLaw {
   int coarse = 2;
   double free = 0;  // exponent of the candidate's exposure(); 0: not used
   int reach = 16;
-  // Without the coarse field (phi 0): eqn 8's far terms, measured around the obstacles: G, the
-  // progress towards the target (geodesic() at the start less at the cell), ln B (eqn 4) and
-  // ln P, P = geodesic() at the cell.
-  double g = 0, b = 0, p = 0;
 };
-
-// The distance to the target around the obstacles (Dijkstra over 8-neighbour steps 1 and sqrt 2).
-inline std::vector<double> geodesic(const lt::Params& layout) {
-  const int w = layout.width, h = layout.height;
-  std::vector<double> d(size_t(w) * size_t(h), INFINITY);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-  const lt::Cell t = layout.targets.at(0);
-  d[size_t(t.y) * size_t(w) + size_t(t.x)] = 0;
-  q.push({0.0, t.y * w + t.x});
-  while (!q.empty()) {
-    auto [dist, i] = q.top();
-    q.pop();
-    if (dist > d[size_t(i)]) continue;
-    const int x = i % w, y = i / w;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int X = x + dx, Y = y + dy;
-        if ((dx == 0 && dy == 0) || X < 0 || Y < 0 || X >= w || Y >= h) continue;
-        const size_t j = size_t(Y) * size_t(w) + size_t(X);
-        if (!layout.obstacles.empty() && layout.obstacles[j]) continue;
-        const double nd = dist + ((dx != 0 && dy != 0) ? M_SQRT2 : 1.0);
-        if (nd < d[j]) {
-          d[j] = nd;
-          q.push({nd, int(j)});
-        }
-      }
-  }
-  return d;
-}
-
-// How exposed a cell is: 16 rays from it, each marched cell by cell until it meets a bolt cell
-// (stepAt >= 0), an obstacle or the border; the mean length travelled, capped at reach, at least
-// 0.5. A stand-in for the field's screening by the bolt at a few cells' range, with no solve.
-inline double exposure(const std::vector<int>& stepAt, const std::vector<uint8_t>& obstacles, int w, int h, int x,
-                       int y, int reach) {
-  double free = 0;
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * M_PI * (k + 0.5) / 16, cx = std::cos(a), cy = std::sin(a);
-    int d = 1;
-    for (; d <= reach; ++d) {
-      const int X = int(std::lround(x + cx * d)), Y = int(std::lround(y + cy * d));
-      if (X < 0 || Y < 0 || X >= w || Y >= h) break;
-      const size_t i = size_t(Y) * size_t(w) + size_t(X);
-      if (stepAt[i] >= 0 || (!obstacles.empty() && obstacles[i])) break;
-    }
-    free += d - 1;
-  }
-  return std::max(0.5, free / 16);
-}
 
 // Grows a bolt from p.start until it touches p.targets[0], picking candidate i with probability
 // Phi_i^eta / sum_j Phi_j^eta under the law; each node's parent is its latest bolt neighbour.
@@ -278,32 +200,22 @@ inline lt::Bolt growHalfField(const lt::Params& p, const HalfFieldLaw& law = {})
   add(p.start, -1, 0);
   std::mt19937_64 rng(p.seed);
   std::vector<double> logw;
-  std::vector<double> lnB(size_t(w) * size_t(h), NAN), geo;
-  if (law.phi == 0) geo = geodesic(p);
+  const Rays rays(law.reach);
   for (int step = 1; size_t(step) < p.maxSteps; ++step) {
     candidates.erase(
         std::remove_if(candidates.begin(), candidates.end(), [&](lt::Cell c) { return !isCandidate[index(c.x, c.y)]; }),
         candidates.end());
     if (candidates.empty()) break;
-    const bool solve = law.phi != 0;
-    const CoarseField field = solve ? coarse.solve(candidates) : CoarseField(coarse.grid(), {});
-    const double smallest = solve ? field.smallestAround(candidates) : 0.0;
+    const CoarseField field = coarse.solve(candidates);
+    const double smallest = field.smallestAround(candidates);
     logw.assign(candidates.size(), 0.0);
     double hi = -INFINITY;
     for (size_t i = 0; i < candidates.size(); ++i) {
       const lt::Cell c = candidates[i];
       const Screening s = screening(stepAt, w, h, c.x, c.y);
-      logw[i] = p.eta * ((solve ? law.phi * field.logAround(c.x, c.y, smallest) : 0.0) +
-                         law.n1 * std::log(double(s.n1)) + law.n4 * std::log(1.0 + s.n4) +
-                         law.n3 * std::log(double(s.n3)));
-      if (!solve) {
-        double& lb = lnB[index(c.x, c.y)];
-        if (std::isnan(lb)) lb = std::log(lt::boundaryPotential(w, h, p.obstacles, c));
-        logw[i] += p.eta * (law.g * (geo[index(p.start.x, p.start.y)] - geo[index(c.x, c.y)]) + law.b * lb +
-                            law.p * std::log(std::max(0.5, geo[index(c.x, c.y)])));
-      }
-      if (law.free != 0)
-        logw[i] += p.eta * law.free * std::log(exposure(stepAt, p.obstacles, w, h, c.x, c.y, law.reach));
+      logw[i] = p.eta * (law.phi * field.logAround(c.x, c.y, smallest) + law.n1 * std::log(double(s.n1)) +
+                         law.n4 * std::log(1.0 + s.n4) + law.n3 * std::log(double(s.n3)));
+      if (law.free != 0) logw[i] += p.eta * law.free * std::log(exposure(stepAt, p.obstacles, w, h, c.x, c.y, rays));
       hi = std::max(hi, logw[i]);
     }
     double sum = 0;

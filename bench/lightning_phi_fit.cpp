@@ -19,10 +19,10 @@
 //          read around the candidate (bench/half_field.h, CoarseField): the field's screening at
 //          1/F^2 of the cells
 //   lnNcal log of the bolt cells within the calibrated screening radius (the calibrated law's N)
-//   lnFree log of the candidate's exposure (bench/half_field.h, exposure()): the mean length 16
+//   lnFree log of the candidate's exposure (bench/exposure_law.h, exposure()): the mean length 16
 //          rays travel before they meet the bolt, an obstacle or the border, capped at --reach
 //          (default 16). The field's short-range screening without a solve
-//   lnPgeo log of the distance to the target around the obstacles (half_field.h, geodesic())
+//   lnPgeo log of the distance to the target around the obstacles (exposure_law.h, geodesic())
 //   Ggeo   the progress towards the target around the obstacles: geodesic() at the start less
 //          at the candidate (G measured as the A* guide would)
 // The laws compared: every candidate alike (the scale of the distances); the paper's eqn 8
@@ -80,6 +80,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
   const int calRadius = lt::calibratedScreeningRadius(fast);
   std::vector<double> lnB(size_t(w) * size_t(h), NAN);
   const std::vector<double> geo = bench::shape::geodesic(layout);
+  const bench::shape::Rays rays(reach);
   double ax = target.x - start.x, ay = target.y - start.y;
   const double len = std::hypot(ax, ay);
   ax /= len;
@@ -137,7 +138,7 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
             const int X = x + dx, Y = y + dy;
             ncal += X >= 0 && Y >= 0 && X < w && Y < h && stepAt[size_t(Y) * size_t(w) + size_t(X)] >= 0;
           }
-        const double free = bench::shape::exposure(stepAt, layout.obstacles, w, h, x, y, reach);
+        const double free = bench::shape::exposure(stepAt, layout.obstacles, w, h, x, y, rays);
         double& b = lnB[size_t(y) * size_t(w) + size_t(x)];
         if (std::isnan(b)) b = std::log(lt::boundaryPotential(w, h, layout.obstacles, {x, y}));
         const double a = along(x, y);

@@ -6,17 +6,16 @@
 // within that noise: indistinguishable at these seeds.
 //
 //   lightning_shape [--size 128] [--fast-seeds 40] [--dbm-seeds 30] [--eta 1,2,3]
-//                   [--method fast|charges|half-field] [--law phi,n1,n4,n3[,F[,free,reach,g,b,p]]]
-//                   [--splits 40]
+//                   [--method fast|charges|half-field|exposure] [--law ...] [--splits 40]
 //                   [--geometry open]
 //
-// half-field: the candidate law of bench/half_field.h (2-D layouts with one point target), with
-// its constants or --law's (HalfFieldLaw's fields in order; phi 0: no field, eqn 8's far terms
-// g, b, p around the obstacles instead).
+// half-field and exposure: the candidate laws of bench/half_field.h and bench/exposure_law.h
+// (2-D layouts with one point target), with their constants or, after --method, --law's:
+// half-field phi,n1,n4,n3[,coarse factor[,free,reach]]; exposure g,p,n1,n4,n3,e[,reach].
 //
 // Geometries (--size s): bench/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
-// compared too (KS).
+// compared too (KS). Times are per bolt, growing only (not calibrate(), not the measures).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -31,6 +30,7 @@
 #include <effects/lightning.h>
 
 #include "bolt_shape.h"
+#include "exposure_law.h"
 #include "half_field.h"
 #include "layouts.h"
 
@@ -44,29 +44,39 @@ struct Sample {
   double msPerBolt = 0;
 };
 
-// halfField: bench/half_field.h's law instead of the method (2-D, one point target).
-Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, bool halfField = false,
-            const sh::HalfFieldLaw& law = {}) {
+// A law of the bench instead of the method (2-D, one point target).
+enum class Law { kNone, kHalfField, kExposure };
+struct Laws {
+  Law which = Law::kNone;
+  sh::HalfFieldLaw halfField;
+  sh::ExposureLaw exposure;
+};
+
+Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, const Laws& law = {}) {
   Sample s;
-  const auto t0 = std::chrono::steady_clock::now();
+  double ms = 0;  // growing only: not calibrate(), not the shape measures
   for (int k = 0; k < seeds; ++k) {
     lt::Params p = base;
     p.method = method;
     p.eta = eta;
     p.seed = firstSeed + uint64_t(k);
     lt::calibrate(p);  // what the server does for every request
-    if (halfField) {
-      s.bolts.push_back(sh::measure(sh::growHalfField(p, law), p.width, p.height));
-      continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    lt::Bolt bolt;
+    if (law.which != Law::kNone) {
+      bolt = law.which == Law::kHalfField ? sh::growHalfField(p, law.halfField) : sh::growExposureLaw(p, law.exposure);
+    } else {
+      auto grown = lt::grow(p);
+      if (!grown.ok()) {
+        std::fprintf(stderr, "grow failed: %s\n", grown.error().message.c_str());
+        std::exit(1);
+      }
+      bolt = std::move(grown.value());
     }
-    auto bolt = lt::grow(p);
-    if (!bolt.ok()) {
-      std::fprintf(stderr, "grow failed: %s\n", bolt.error().message.c_str());
-      std::exit(1);
-    }
-    s.bolts.push_back(sh::measure(bolt.value(), p.width, p.height, p.depth));
+    ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    s.bolts.push_back(sh::measure(bolt, p.width, p.height, p.depth));
   }
-  s.msPerBolt = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / seeds;
+  s.msPerBolt = ms / seeds;
   return s;
 }
 
@@ -102,8 +112,7 @@ int main(int argc, char** argv) {
   std::string geometry = "open";
   std::vector<double> etas = {1, 2, 3};
   lt::Method method = lt::Method::kFast;
-  bool halfField = false;
-  sh::HalfFieldLaw law;
+  Laws law;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--size") size = std::atoi(v.c_str());
@@ -113,11 +122,19 @@ int main(int argc, char** argv) {
     else if (a == "--geometry") geometry = v;
     else if (a == "--method") {
       method = v == "charges" ? lt::Method::kCharges : lt::Method::kFast;
-      halfField = v == "half-field";
+      law.which = v == "half-field" ? Law::kHalfField : v == "exposure" ? Law::kExposure : Law::kNone;
+    } else if (a == "--law") {
+      sh::HalfFieldLaw& f = law.halfField;
+      sh::ExposureLaw& e = law.exposure;
+      if (law.which == Law::kHalfField)
+        std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf,%d,%lf,%d", &f.phi, &f.n1, &f.n4, &f.n3, &f.coarse, &f.free, &f.reach);
+      else if (law.which == Law::kExposure)
+        std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%d", &e.g, &e.p, &e.n1, &e.n4, &e.n3, &e.e, &e.reach);
+      else {
+        std::fprintf(stderr, "--law after --method half-field or exposure\n");
+        return 2;
+      }
     }
-    else if (a == "--law")
-      std::sscanf(v.c_str(), "%lf,%lf,%lf,%lf,%d,%lf,%d,%lf,%lf,%lf", &law.phi, &law.n1, &law.n4, &law.n3, &law.coarse,
-                  &law.free, &law.reach, &law.g, &law.b, &law.p);
     else if (a == "--eta") {
       etas.clear();
       std::stringstream ss(v);
@@ -144,11 +161,13 @@ int main(int argc, char** argv) {
                       for (const auto& m : b) y.push_back(m.struckOffset);
                       return sh::ks(x, y);
                     }, true});
-  if (halfField && (base.depth || base.targets.size() != 1 || !base.targetRegion.empty())) {
-    std::fprintf(stderr, "--method half-field: 2-D layouts with one point target (open, off-axis, wall)\n");
+  if (law.which != Law::kNone && (base.depth || base.targets.size() != 1 || !base.targetRegion.empty())) {
+    std::fprintf(stderr, "--method half-field or exposure: 2-D layouts with one point target (open, off-axis, wall)\n");
     return 2;
   }
-  const char* name = halfField ? "half-field" : lt::toString(method);
+  const char* name = law.which == Law::kHalfField ? "half-field"
+                     : law.which == Law::kExposure ? "exposure"
+                                                   : lt::toString(method);
   std::printf("# %s against dbm by shape: %s, %d x %d%s\n\n", name, geometry.c_str(), base.width, base.height,
               base.depth ? (" x " + std::to_string(base.depth)).c_str() : "");
   std::printf("%d %s and %d dbm bolts per eta; noise: 95th percentile over %d random half-splits of the dbm "
@@ -157,7 +176,7 @@ int main(int argc, char** argv) {
   std::printf("| eta | measure | %s vs dbm | noise (dbm vs dbm) | |\n|---|---|---|---|---|\n", name);
   std::mt19937 rng(49);
   for (double eta : etas) {
-    const Sample fast = grow(base, method, eta, fastSeeds, 1000, halfField, law);
+    const Sample fast = grow(base, method, eta, fastSeeds, 1000, law);
     const Sample dbm = grow(base, lt::Method::kDbm, eta, dbmSeeds, 5000);
     for (const Row& row : rows) {
       const double d = row.stat(fast.bolts, dbm.bolts);
@@ -180,6 +199,9 @@ int main(int argc, char** argv) {
     for (const auto& m : dbm.bolts) dDbm += sh::slope(m.boxCounts) / double(dbm.bolts.size());
     std::printf("| %g | box-count slope (mean) | %.3f vs %.3f | | %.3g / %.3g ms per bolt |\n", eta, dFast, dDbm,
                 fast.msPerBolt, dbm.msPerBolt);
+    if (law.which != Law::kNone)  // what the law would replace, timed in the same run
+      std::printf("| %g | fast calibrated, same seeds | | | %.3g ms per bolt |\n", eta,
+                  grow(base, lt::Method::kFast, eta, fastSeeds, 1000).msPerBolt);
   }
   return 0;
 }
