@@ -958,18 +958,22 @@ void plot(const Section& s, const fs::path& dir) {
   d.close();
   std::ofstream g(script);
   const size_t curves = series.size() + exact.size();
-  // Many curves or long names: the key goes below the plot in three columns and the picture
-  // grows to hold it.
+  // Many curves or long names: the key goes below the plot in as many columns (up to 3) as the
+  // longest title lets fit (gnuplot reserves about 9 px a character at this font, and the line
+  // sample), and the picture grows to hold its rows; the plot keeps its height.
   size_t longest = 0;
   for (const auto& [name, pts] : series) longest = std::max(longest, name.size());
   for (const Point* p : exact) longest = std::max(longest, p->series.size() + p->setting.size() + 24);
   const bool many = curves > 10 || longest > 32;
-  const int height = many ? 560 + 15 * int((curves + 2) / 3) : 520;
-  g << "set terminal pngcairo noenhanced size " << (many ? 1000 : 800) << "," << height << " font 'sans,10'\n"
+  const int width = many ? 1500 : 800;
+  const size_t columns = std::clamp<size_t>(size_t(width) / (longest * 9 + 80), 1, 3);
+  const size_t rows = (curves + columns - 1) / columns;
+  const int height = many ? 560 + 18 * int(rows) : 520;
+  g << "set terminal pngcairo noenhanced size " << width << "," << height << " font 'sans,10'\n"
     << "set output '" << (dir / (s.id + ".png")).string() << "'\n"
     << "set title \"" << s.title << "\"\n"
     << "set logscale xy\nset grid\n"
-    << (many ? "set key outside below maxcols 3 maxrows " + std::to_string((curves + 2) / 3) + "\n"
+    << (many ? "set key outside below maxcols " + std::to_string(columns) + " maxrows " + std::to_string(rows) + "\n"
              : std::string("set key outside right top\n"))
     << "set xlabel \"" << s.timeName << ", log scale\"\nset ylabel \"" << wrapped(s.errorName + ", log scale", 40)
     << "\"\n"
