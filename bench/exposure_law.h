@@ -165,13 +165,14 @@ lt::Bolt growExposureLaw(const lt::Params& p, const ExposureLaw& law = {}, Check
     double weight = 0;
   };
   std::vector<Candidate> cands;
-  std::vector<int> slot(size_t(w) * size_t(h), -1), stepAt(size_t(w) * size_t(h), -1), nodeAt(size_t(w) * size_t(h), -1);
+  std::vector<int> slot(size_t(w) * size_t(h), -1), stepAt(size_t(w) * size_t(h), -1),
+      nodeAt(size_t(w) * size_t(h), -1);
   auto weigh = [&](Candidate& k) {
     const double P = geo[index(k.c.x, k.c.y)];
     const double E = std::max(0.5, double(k.free) / Rays::kRays);
-    k.weight = std::exp(p.eta * (law.g * (geoStart - P) + law.p * std::log(std::max(0.5, P)) +
-                                 law.n1 * std::log(double(k.n1)) + law.n4 * std::log(1.0 + k.n4) +
-                                 law.n3 * std::log(double(k.n3)) + law.e * std::log(E)));
+    k.weight = std::exp(p.eta *
+                        (law.g * (geoStart - P) + law.p * std::log(std::max(0.5, P)) + law.n1 * std::log(double(k.n1)) +
+                         law.n4 * std::log(1.0 + k.n4) + law.n3 * std::log(double(k.n3)) + law.e * std::log(E)));
   };
   auto blocked = [&](int X, int Y) { return !inside(X, Y) || stepAt[index(X, Y)] >= 0 || obstacle(X, Y); };
   lt::Bolt bolt;
@@ -217,7 +218,8 @@ lt::Bolt growExposureLaw(const lt::Params& p, const ExposureLaw& law = {}, Check
         k.c = {x, y};
         const Screening near = screening(stepAt, w, h, x, y);
         k.n1 = near.n1, k.n4 = near.n4, k.n3 = near.n3;
-        for (int ray = 0; ray < Rays::kRays; ++ray) k.free += k.len[size_t(ray)] = uint8_t(rays.march(ray, x, y, blocked));
+        for (int ray = 0; ray < Rays::kRays; ++ray)
+          k.free += k.len[size_t(ray)] = uint8_t(rays.march(ray, x, y, blocked));
         weigh(k);
         slot[index(x, y)] = int(cands.size());
         cands.push_back(k);

@@ -57,13 +57,26 @@ namespace {
 
 int F = 2;  // --coarse: the coarse grid's cell, in fine cells
 
-enum Feature { kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC, kLnNcal, kLnFree, kLnPgeo, kGgeo, kFeatures };
-const char* const kNames[kFeatures] = {"G",    "lnB",   "lnP",    "lnN1",   "lnN4",
-                                       "lnN3", "lnAge", "lnLead", "lnPhiC", "lnNcal", "lnFree", "lnPgeo", "Ggeo"};
+enum Feature {
+  kG,
+  kLnB,
+  kLnP,
+  kLnN1,
+  kLnN4,
+  kLnN3,
+  kLnAge,
+  kLnLead,
+  kLnPhiC,
+  kLnNcal,
+  kLnFree,
+  kLnPgeo,
+  kGgeo,
+  kFeatures
+};
+const char* const kNames[kFeatures] = {"G",      "lnB",    "lnP",    "lnN1",   "lnN4",   "lnN3", "lnAge",
+                                       "lnLead", "lnPhiC", "lnNcal", "lnFree", "lnPgeo", "Ggeo"};
 
 int reach = 16;  // --reach: exposure()'s cap
-
-
 
 struct Step {
   std::vector<std::array<double, kFeatures>> f;  // per candidate
@@ -144,12 +157,11 @@ std::vector<Step> sample(const lt::Params& layout, double eta, uint64_t firstSee
         const double a = along(x, y);
         const double G = std::floor(a <= len ? a : 2 * len - a);
         const double P = std::max(0.5, std::hypot(double(x - target.x), double(y - target.y)));
-        st.f.push_back({G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4),
-                        std::log(double(near.n3)), std::log(1.0 + t - near.last),
-                        std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y, smallest),
-                        std::log(double(ncal)), std::log(free),
-                        std::log(std::max(0.5, geo[size_t(y) * size_t(w) + size_t(x)])),
-                        geo[size_t(start.y) * size_t(w) + size_t(start.x)] - geo[size_t(y) * size_t(w) + size_t(x)]});
+        st.f.push_back(
+            {G, b, std::log(P), std::log(double(near.n1)), std::log(1.0 + near.n4), std::log(double(near.n3)),
+             std::log(1.0 + t - near.last), std::log(1.0 + std::max(0.0, lead - a)), coarse.logAround(x, y, smallest),
+             std::log(double(ncal)), std::log(free), std::log(std::max(0.5, geo[size_t(y) * size_t(w) + size_t(x)])),
+             geo[size_t(start.y) * size_t(w) + size_t(start.x)] - geo[size_t(y) * size_t(w) + size_t(x)]});
         const double lp = eta * std::log(std::max(phi[size_t(y) * size_t(w) + size_t(x)], 1e-300));
         logw.push_back(lp);
         maxLog = std::max(maxLog, lp);
@@ -325,9 +337,11 @@ int main(int argc, char** argv) {
     laws.push_back({"the coarse field and N alone", {kLnN1, kLnN3, kLnPhiC}, {}, 0});
     laws.push_back({"eqn 8's terms + edge neighbours", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3}, {}, 0});
     laws.push_back({"the coarse field, N and edge neighbours", {kLnN1, kLnN4, kLnN3, kLnPhiC}, {}, 0});
-    laws.push_back({"eqn 8's terms, edge neighbours and exposure", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
+    laws.push_back(
+        {"eqn 8's terms, edge neighbours and exposure", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
     laws.push_back({"no field: Ggeo, lnPgeo, N and exposure", {kGgeo, kLnPgeo, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
-    laws.push_back({"the coarse field, N, edge neighbours and exposure", {kLnPhiC, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
+    laws.push_back(
+        {"the coarse field, N, edge neighbours and exposure", {kLnPhiC, kLnN1, kLnN4, kLnN3, kLnFree}, {}, 0});
     laws.push_back({"all of them", {kG, kLnB, kLnP, kLnN1, kLnN4, kLnN3, kLnAge, kLnLead, kLnPhiC}, {}, 0});
     std::printf("\n## eta %g: fitted on open %d^2 (%d bolts x %d steps), TV per step\n\n", eta, size, train, steps);
     std::printf(

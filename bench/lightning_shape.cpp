@@ -52,7 +52,8 @@ struct Laws {
   sh::ExposureLaw exposure;
 };
 
-Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed, const Laws& law = {}) {
+Sample grow(const lt::Params& base, lt::Method method, double eta, int seeds, uint64_t firstSeed,
+            const Laws& law = {}) {
   Sample s;
   double ms = 0;  // growing only: not calibrate(), not the shape measures
   for (int k = 0; k < seeds; ++k) {
@@ -134,8 +135,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "--law after --method half-field or exposure\n");
         return 2;
       }
-    }
-    else if (a == "--eta") {
+    } else if (a == "--eta") {
       etas.clear();
       std::stringstream ss(v);
       for (std::string e; std::getline(ss, e, ',');) etas.push_back(std::atof(e.c_str()));
@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "--method half-field or exposure: 2-D layouts with one point target (open, off-axis, wall)\n");
     return 2;
   }
-  const char* name = law.which == Law::kHalfField ? "half-field"
+  const char* name = law.which == Law::kHalfField  ? "half-field"
                      : law.which == Law::kExposure ? "exposure"
                                                    : lt::toString(method);
   std::printf("# %s against dbm by shape: %s, %d x %d%s\n\n", name, geometry.c_str(), base.width, base.height,

@@ -52,7 +52,7 @@ TEST(ExposureLaw, ExposureIsTheMeanFreeLengthOfItsRays) {
   // At the border: 8 rays travel 16; of the 8 leaving, the two nearest the border travel 2 cells
   // along it first, the rest none: (8 * 16 + 2 * 2) / 16.
   EXPECT_DOUBLE_EQ(exposure(stepAt, none, w, h, 0, 32, Rays(16)), 8.25);
-  for (int y = 0; y < h; ++y) stepAt[size_t(y) * size_t(w) + 30] = y;  // a bolt column at x = 30
+  for (int y = 0; y < h; ++y) stepAt[size_t(y) * size_t(w) + 30] = y;      // a bolt column at x = 30
   EXPECT_DOUBLE_EQ(exposure(stepAt, none, w, h, 31, 32, Rays(16)), 8.25);  // beside the bolt: as at the border
   std::vector<uint8_t> walls(size_t(w) * size_t(h), 0);
   for (int dy = -1; dy <= 1; ++dy)
@@ -74,7 +74,7 @@ TEST(ExposureLaw, GeodesicGoesAroundTheObstacles) {
   for (int x = 0; x <= 24; ++x) p.obstacles[size_t(20) * 32 + size_t(x)] = 1;  // a wall with a gap at x >= 25
   const std::vector<double> around = geodesic(p);
   EXPECT_NEAR(around[size_t(10) * 32 + 16], octile(9, 10) + octile(9, 10), 1e-9);  // through (25, 20)
-  EXPECT_TRUE(std::isinf(around[size_t(20) * 32 + 5]));                             // in the wall
+  EXPECT_TRUE(std::isinf(around[size_t(20) * 32 + 5]));                            // in the wall
 }
 
 }  // namespace
