@@ -81,6 +81,31 @@ inline Screening screening(const std::vector<int>& stepAt, int w, int h, int x, 
   return s;
 }
 
+// The node a new bolt cell hangs from: its latest bolt neighbour (nodeAt: the node of each bolt
+// cell), -1 if none.
+inline int latestNeighbour(const std::vector<int>& stepAt, const std::vector<int>& nodeAt, int w, int h, lt::Cell c) {
+  int parent = -1, latest = -1;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = c.x + dx, y = c.y + dy;
+      if (x < 0 || y < 0 || x >= w || y >= h) continue;
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      if (stepAt[i] > latest) latest = stepAt[i], parent = nodeAt[i];
+    }
+  return parent;
+}
+
+// Index i of n with probability weight(i) / sum of the weights.
+template <class Weight>
+size_t pickWeighted(size_t n, Weight&& weight, std::mt19937_64& rng) {
+  double sum = 0;
+  for (size_t i = 0; i < n; ++i) sum += weight(i);
+  double u = std::uniform_real_distribution<double>(0.0, sum)(rng);
+  size_t pick = 0;
+  while (pick + 1 < n && u >= weight(pick)) u -= weight(pick++);
+  return pick;
+}
+
 // 16 rays from a cell, a_k = 2 pi (k + 1/2) / 16: ray k's d-th cell (d = 1 .. reach) is the
 // cell plus offset(k, d) = (lround(cos a_k d), lround(sin a_k d)). through() lists the (k, d)
 // whose cell is a given offset, so a new bolt cell finds the rays it cuts.
@@ -230,20 +255,10 @@ lt::Bolt growExposureLaw(const lt::Params& p, const ExposureLaw& law = {}, Check
   for (int step = 1; size_t(step) < p.maxSteps && !cands.empty(); ++step) {
     if constexpr (!std::is_same_v<std::decay_t<Check>, std::nullptr_t>)
       for (const Candidate& k : cands) check(stepAt, k.c, std::max(0.5, double(k.free) / Rays::kRays));
-    double sum = 0;
-    for (const Candidate& k : cands) sum += k.weight;
-    double u = std::uniform_real_distribution<double>(0.0, sum)(rng);
-    size_t pick = 0;
-    while (pick + 1 < cands.size() && u >= cands[pick].weight) u -= cands[pick++].weight;
-    const lt::Cell c = cands[pick].c;
-    int parent = -1, latest = -1;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if (inside(c.x + dx, c.y + dy) && stepAt[index(c.x + dx, c.y + dy)] > latest) {
-          latest = stepAt[index(c.x + dx, c.y + dy)];
-          parent = nodeAt[index(c.x + dx, c.y + dy)];
-        }
-    add(c, parent, step);
+    const lt::Cell c = cands[pickWeighted(
+                                 cands.size(), [&](size_t i) { return cands[i].weight; }, rng)]
+                           .c;
+    add(c, latestNeighbour(stepAt, nodeAt, w, h, c), step);
     if (std::abs(c.x - target.x) <= 1 && std::abs(c.y - target.y) <= 1) {
       add(target, int(bolt.nodes.size()) - 1, step + 1);
       break;

@@ -218,20 +218,10 @@ inline lt::Bolt growHalfField(const lt::Params& p, const HalfFieldLaw& law = {})
       if (law.free != 0) logw[i] += p.eta * law.free * std::log(exposure(stepAt, p.obstacles, w, h, c.x, c.y, rays));
       hi = std::max(hi, logw[i]);
     }
-    double sum = 0;
-    for (double& v : logw) sum += (v = std::exp(v - hi));
-    double u = std::uniform_real_distribution<double>(0.0, sum)(rng);
-    size_t pick = 0;
-    while (pick + 1 < logw.size() && u >= logw[pick]) u -= logw[pick++];
-    const lt::Cell c = candidates[pick];
-    int parent = -1, latest = -1;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if (free(c.x + dx, c.y + dy) && stepAt[index(c.x + dx, c.y + dy)] > latest) {
-          latest = stepAt[index(c.x + dx, c.y + dy)];
-          parent = nodeAt[index(c.x + dx, c.y + dy)];
-        }
-    add(c, parent, step);
+    for (double& v : logw) v = std::exp(v - hi);
+    const lt::Cell c = candidates[pickWeighted(
+        logw.size(), [&](size_t i) { return logw[i]; }, rng)];
+    add(c, latestNeighbour(stepAt, nodeAt, w, h, c), step);
     if (std::abs(c.x - target.x) <= 1 && std::abs(c.y - target.y) <= 1) {
       add(target, int(bolt.nodes.size()) - 1, step + 1);
       break;

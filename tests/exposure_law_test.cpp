@@ -13,12 +13,6 @@
 namespace bench::shape {
 namespace {
 
-lt::Params openLayout(int s) {
-  lt::Params p = layout("open", s);
-  p.eta = 2;
-  return p;
-}
-
 TEST(ExposureLaw, GrowsATreeFromTheStartToTheTargetTheSameForASeed) {
   expectGrowsATree(openLayout(48), [](const lt::Params& p) { return growExposureLaw(p); });
   lt::Params wall = layout("wall", 64);

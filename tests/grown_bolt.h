@@ -1,4 +1,5 @@
-// What every bolt a bench law grows must be (tests/half_field_test.cpp, exposure_law_test.cpp).
+// What every bolt a bench law grows must be, and the layout the tests grow them in
+// (tests/half_field_test.cpp, exposure_law_test.cpp).
 #pragma once
 
 #include <algorithm>
@@ -11,9 +12,18 @@
 
 #include <effects/lightning.h>
 
+#include "layouts.h"
+
 namespace bench::shape {
 
 namespace lt = effects::lightning;
+
+// The shape bench's open layout at eta 2.
+inline lt::Params openLayout(int s) {
+  lt::Params p = layout("open", s);
+  p.eta = 2;
+  return p;
+}
 
 // A bolt grown by a bench law in layout p is a tree of 8-neighbour steps from the start to the
 // target, each cell once, the same for a seed and not for another.

@@ -8,17 +8,9 @@
 
 #include "grown_bolt.h"
 #include "half_field.h"
-#include "layouts.h"
 
 namespace bench::shape {
 namespace {
-
-// The shape bench's open layout at eta 2.
-lt::Params openLayout(int s) {
-  lt::Params p = layout("open", s);
-  p.eta = 2;
-  return p;
-}
 
 TEST(HalfField, ScreeningCountsTheBoltAroundACell) {
   const int w = 32, h = 32;
