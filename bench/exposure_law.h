@@ -122,7 +122,6 @@ class Rays {
       }
     }
   }
-  int reach() const { return reach_; }
   lt::Cell offset(int k, int d) const { return offset_[size_t(k) * size_t(reach_) + size_t(d - 1)]; }
   const std::vector<std::pair<uint8_t, uint8_t>>& through(int dx, int dy) const { return through_[slot(dx, dy)]; }
   // How many cells ray k travels from (x, y) before one is blocked(X, Y) (at most reach).
