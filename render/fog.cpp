@@ -24,7 +24,7 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
   std::vector<size_t> order(f.regions.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return fog::volume(f.regions[a]) < fog::volume(f.regions[b]); });
+                   [&](size_t a, size_t b) { return fog::logVolume(f.regions[a]) < fog::logVolume(f.regions[b]); });
   const detail::FogVariant variant = detail::fogVariant(f);
   std::vector<double> types, params, colors, lo, hi, engine, layer2, sun, sunColor, inscatter;
   auto add = [&](const fog::Fog& g) {
@@ -66,7 +66,8 @@ std::vector<FogShader::Uniform> fogUniforms(const Fog& f, const glm::dvec3& eye)
     glm::dvec4 b = r.shape == fog::Region::Shape::kBox ? glm::dvec4(r.max, 0) : glm::dvec4(r.radius, 0, 0, 0);
     for (int k = 0; k < 4; ++k) lo.push_back(a[k]), hi.push_back(b[k]);
   }
-  const std::string slots = "[" + std::to_string(types.size()) + "]", regions = "[" + std::to_string(order.size()) + "]";
+  const std::string slots = "[" + std::to_string(types.size()) + "]",
+                    regions = "[" + std::to_string(order.size()) + "]";
   std::vector<FogShader::Uniform> out = {{"uFogCamera", "vec3", {eye.x, eye.y, eye.z}},
                                          {"uFogType", "int" + slots, types},
                                          {"uFogParams", "vec4" + slots, params},
@@ -147,9 +148,10 @@ FogVariant fogVariant(const Fog& f) {
 // fogged colour with its glow, per slot.
 std::string engineConventionsGlsl(const FogVariant& v) {
   std::ostringstream s;
-  const std::string glowStart = "  vec4 sun = uFogSun[slot], sc = uFogSunColor[slot];\n"
-                                "  float c = d > 0.0 ? clamp(dot(ray / d, sun.xyz), -1.0, 1.0) : 0.0;\n"
-                                "  float lobe = c > 0.0 ? pow(c, sun.w - 2.0) : 0.0;\n";
+  const std::string glowStart =
+      "  vec4 sun = uFogSun[slot], sc = uFogSunColor[slot];\n"
+      "  float c = d > 0.0 ? clamp(dot(ray / d, sun.xyz), -1.0, 1.0) : 0.0;\n"
+      "  float lobe = c > 0.0 ? pow(c, sun.w - 2.0) : 0.0;\n";
   if (v.filament) {
     s << "vec3 fogFilament(int slot, vec3 world, vec3 rgb) {  // Filament's surface fog\n"
          "  vec4 q = uFogParams[slot], e = uFogEngine[slot];\n"
@@ -159,7 +161,8 @@ std::string engineConventionsGlsl(const FogVariant& v) {
          "  float mean = exp(min(q.x - q.y * (uFogCamera.y - q.z) + (abs(fh) > 0.00125 ? fogLogG(fh) : 0.0), 80.0));\n"
          "  vec3 c0 = mix(uFogColor[slot], rgb, max(exp(-mean * max(d - e.x, 0.0)), e.z));\n";
     if (v.directional)
-      s << glowStart << "  if (dot(sc.rgb, sc.rgb) > 0.0) c0 += (1.0 - exp(-mean * max(d - sc.w, 0.0))) * sc.rgb * lobe;\n";
+      s << glowStart
+        << "  if (dot(sc.rgb, sc.rgb) > 0.0) c0 += (1.0 - exp(-mean * max(d - sc.w, 0.0))) * sc.rgb * lobe;\n";
     s << "  return c0;\n}\n";
   }
   if (v.unreal) {
@@ -181,17 +184,20 @@ std::string engineConventionsGlsl(const FogVariant& v) {
          "  vec3 v = world - uFogCamera;\n  v.y += uFogCamera.y - observer;\n"
          "  float d = length(v), rayLength = d, rise = v.y;\n"
          "  float origin[2];\n"
-         "  for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(clamp(-falloff[i] * (observer - q[i].z), -125.0, 126.0));\n"
+         "  for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(clamp(-falloff[i] * (observer - q[i].z), -125.0, "
+         "126.0));\n"
          "  if (e.x > 0.0 && d > 0.0) {  // the ray from the start distance on\n"
          "    float t = e.x / d;\n    float startY = observer + t * v.y;\n"
          "    rayLength = (1.0 - t) * d;\n    rise = v.y - t * v.y;\n"
-         "    for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(-max(-127.0, falloff[i] * (startY - q[i].z)));\n"
+         "    for (int i = 0; i < 2; ++i) origin[i] = density[i] * exp2(-max(-127.0, falloff[i] * (startY - "
+         "q[i].z)));\n"
          "  }\n"
          "  float perUnit = fogUnrealLine(falloff[0], rise, origin[0]) + fogUnrealLine(falloff[1], rise, origin[1]);\n"
          "  if (e.y > 0.0 && d > e.y) return rgb;\n"
          "  vec3 c0 = mix(uFogColor[slot], rgb, max(clamp(exp2(-perUnit * rayLength), 0.0, 1.0), e.z));\n";
     if (v.directional)
-      s << "  vec3 ray = v;\n" << glowStart
+      s << "  vec3 ray = v;\n"
+        << glowStart
         << "  if (dot(sc.rgb, sc.rgb) > 0.0)\n"
            "    c0 += (1.0 - clamp(exp2(-perUnit * max(rayLength - sc.w, 0.0)), 0.0, 1.0)) * sc.rgb * lobe;\n";
     s << "  return c0;\n}\n";
@@ -218,10 +224,13 @@ std::string fogGlsl(const FogVariant& v) {
     s << "uniform vec4 uFogEngine[" << slots << "];  // startDistance, cutoffDistance (0: none), 1 - maxOpacity"
       << (v.filament || v.unreal ? ", convention (0 effectd, 1 filament, 2 unreal)" : "") << "\n";
   if (v.secondLayer) s << "uniform vec4 uFogLayer2[" << slots << "];  // HEIGHT's second layer: log a, b, h, a > 0\n";
-  if (has(T::kAtmospheric)) s << "uniform vec3 uFogInscatter[" << slots << "];  // ATMOSPHERIC: inscattering per channel\n";
+  if (has(T::kAtmospheric))
+    s << "uniform vec3 uFogInscatter[" << slots << "];  // ATMOSPHERIC: inscattering per channel\n";
   if (v.directional)
-    s << "uniform vec4 uFogSun[" << slots << "];       // unit direction to the sun; w: HG g in (-1, 1), or 2 + exponent\n"
-      << "uniform vec4 uFogSunColor[" << slots << "];  // rgb (0: no glow in this slot); w: the glow's start distance\n";
+    s << "uniform vec4 uFogSun[" << slots
+      << "];       // unit direction to the sun; w: HG g in (-1, 1), or 2 + exponent\n"
+      << "uniform vec4 uFogSunColor[" << slots
+      << "];  // rgb (0: no glow in this slot); w: the glow's start distance\n";
   // With a start distance (the fog's or the glow's) the mode is evaluated over the ray's part
   // [s, d], s a parameter; with that or a second layer, height fog sums layers along it
   // (fogHeightTau); otherwise the one-layer form below it.
@@ -240,9 +249,10 @@ std::string fogGlsl(const FogVariant& v) {
          "  if (q.y == 0.0) return exp(min(q.x + log(t), 80.0));\n"
          "  return exp(min(q.x - q.y * (y0 - q.z) + log(t) + fogLogG(q.y * dirY * t), 80.0));\n"
          "}\n";
-  s << (startParam   ? "float fogMode(int slot, vec3 ray, float d, float start) {\n"
-        : v.engine() ? "float fogMode(int slot, vec3 ray, float d) {\n"
-                     : "float fogFactor(int slot, vec3 world) {\n  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n")
+  s << (startParam ? "float fogMode(int slot, vec3 ray, float d, float start) {\n"
+        : v.engine()
+            ? "float fogMode(int slot, vec3 ray, float d) {\n"
+            : "float fogFactor(int slot, vec3 world) {\n  vec3 ray = world - uFogCamera;\n  float d = length(ray);\n")
     << "  vec4 q = uFogParams[slot];\n  int type = uFogType[slot];\n";
   if (layered)
     s << "  float dirY = d > 0.0 ? ray.y / d : 0.0;\n"
@@ -279,7 +289,8 @@ std::string fogGlsl(const FogVariant& v) {
   if (v.engine()) {  // fog.h's order: start (fogMode), maxOpacity, cutoff (fog::engineLimits)
     const std::string start = startParam ? ", float start" : "", startArg = startParam ? ", start" : "";
     const std::string mode = "fogMode(slot, ray, d" + startArg + ")";
-    s << "float fogLimited(int slot, vec3 ray, float d" << start << ") {\n"
+    s << "float fogLimited(int slot, vec3 ray, float d" << start
+      << ") {\n"
          "  vec4 e = uFogEngine[slot];\n";
     if (v.cutoff) s << "  if (e.y > 0.0 && d > e.y) return 1.0;\n";
     s << (v.opacity ? "  return max(" + mode + ", e.z);\n" : "  return " + mode + ";\n") << "}\n"
@@ -295,7 +306,8 @@ std::string fogGlsl(const FogVariant& v) {
          "  float w = 1.0 - fogLimited(slot, ray, d, max(uFogEngine[slot].x, sc.w));\n"
          "  float c = clamp(dot(ray / d, sun.xyz), -1.0, 1.0);\n"
          "  float g = sun.w;\n"
-         "  float den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);\n"
+         "  float den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * "
+         "(1.0 + c);\n"
          "  float lobe = g < 1.5 ? (1.0 - g) * (1.0 + g) / (den * sqrt(den)) : (c > 0.0 ? pow(c, g - 2.0) : 0.0);\n"
          "  return w * sc.rgb * lobe;\n"
          "}\n";
@@ -325,7 +337,8 @@ std::string fogGlsl(const FogVariant& v) {
   if (v.filament) s << "  if (uFogEngine[slot].w == 1.0) return fogFilament(slot, world, rgb);\n";
   if (v.unreal) s << "  if (uFogEngine[slot].w == 2.0) return fogUnreal(slot, world, rgb);\n";
   if (has(T::kAtmospheric))
-    s << "  if (uFogType[slot] == " << int(T::kAtmospheric) << ") return fogAtmospheric(slot, world, rgb)" << glow << ";\n";
+    s << "  if (uFogType[slot] == " << int(T::kAtmospheric) << ") return fogAtmospheric(slot, world, rgb)" << glow
+      << ";\n";
   s << "  return mix(uFogColor[slot], rgb, fogFactor(slot, world))" << glow << ";\n}\n";
   return s.str();
 }

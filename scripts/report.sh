@@ -18,10 +18,10 @@ if [ $quick = 1 ]; then
   out=build/report-quick
   mkdir -p "$out"
   build/bench/error_report --quick --out "$out" --stamp "$(stamp "scripts/report.sh --quick")"
-  python3 scripts/stability-report.py build/server/effectd --quick --check --no-sweep --out "$out/stability.md"
+  python3 scripts/stability-report.py build/server/effectd --quick --check --no-sweep --mutations --out "$out/stability.md"
   echo "report.sh: wrote $out"
 else
   build/bench/error_report --out docs --stamp "$(stamp "scripts/report.sh")"
-  python3 scripts/stability-report.py build/server/effectd --check --out docs/stability.md --command "scripts/report.sh"
+  python3 scripts/stability-report.py build/server/effectd --check --mutations --out docs/stability.md --command "scripts/report.sh"
   echo "report.sh: wrote docs/error-vs-time.md, docs/error-vs-time.json, docs/error-vs-time/, docs/stability.md"
 fi

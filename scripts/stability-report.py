@@ -4,13 +4,19 @@ effectd, each with a check that can fail (a closed form computed here, an invari
 requests, or the exact 4xx it must get), and docs/stability.md written from what they saw.
 A row is "right" only when its check passes; --check exits 1 when one does not.
 
-    scripts/stability-report.py build/server/effectd [--quick] [--check] [--no-sweep]
+    scripts/stability-report.py build/server/effectd [--quick] [--check] [--no-sweep] [--mutations]
                                 [--sweep-requests N] [--out docs/stability.md]
 
---quick runs the smaller sizes of the heavy cases (the test suite runs it with --check);
-the report (scripts/report.sh) runs the full sizes and the property sweep.
+--quick runs the smaller sizes of the heavy cases (the test suite runs it with --check and
+--mutations); the report (scripts/report.sh) runs the full sizes and the property sweep.
+--mutations shows that every check can fail: each row also has a mutation, a plausible wrong
+answer made from the real ones (a fog factor 1 % off or the naive overflow's 1, a bolt cell moved
+off its tree, a mesh vertex nudged, a tangent frame flipped, a 4xx naming another field, ...),
+fed to the same check, which must reject it ("caught"); with --check a mutation that is NOT
+caught fails the run like a failed row.
 """
 import argparse
+import copy
 import datetime
 import json
 import math
@@ -29,19 +35,117 @@ QUAD = {"positions": [0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0], "uvs": [0, 0, 1, 0, 1
 
 
 # ---- closed forms (docs/effects.md section 2), computed here, not read from the server ---------
-def height_f(a, b, h, oy, dy, t):
-    """exp(-tau), tau = a e^(-b(oy-h)) t g(b dy t), g(x) = (1 - e^-x)/x, in log space."""
+def height_f(a, b, h, oy, dy, t, near_level=0.0):
+    """exp(-tau), tau = a e^(-b(oy-h)) t g(b dy t), g(x) = (1 - e^-x)/x, in log space: a·t, b·dy·t
+    and g never formed as products that could overflow (a = 1e300 with t = 1e300, t = 1e200).
+    near_level > 0 is Filament's guard (docs/effects.md §2.4 F2): g = 1 where |b dy t| <= it."""
     if t == 0 or a == 0:
         return 1.0
-    x = b * dy * t
-    if abs(x) < 1e-12:
-        lg = -x / 2
-    elif x > 0:
-        lg = math.log(-math.expm1(-x) / x)
+    ltau = math.log(a) + math.log(t) - b * (oy - h)
+    if b != 0 and dy != 0:
+        lx = math.log(b) + math.log(abs(dy)) + math.log(t)  # ln |x|
+        if lx > 709 and dy < 0:
+            return 0.0  # e^|x| overflows: tau = infinity
+        x = math.copysign(math.exp(lx), dy)
+        if abs(x) <= near_level:
+            pass
+        elif abs(x) < 1e-12:
+            ltau += -x / 2
+        elif x > 0:
+            ltau += math.log(-math.expm1(-x)) - lx
+        elif x > -700:
+            ltau += math.log(math.expm1(-x)) - lx
+        else:
+            ltau += -x - lx
+    return 0.0 if ltau > 709 else math.exp(-math.exp(ltau))
+
+
+def exp_neg(*factors):
+    """e^(-product of factors), the product taken as a sum of logs: 1e300·1e-300, (1e-200·1e200)²
+    or 5e-324·(1e162)² never overflow or underflow on the way."""
+    if any(x == 0 for x in factors):
+        return 1.0
+    lp = sum(math.log(x) for x in factors)
+    return 0.0 if lp > 709 else math.exp(-math.exp(lp))
+
+
+def one_minus_exp_neg(*factors):
+    """1 - e^(-product), as -expm1 (exact for products of 1e-298)."""
+    if any(x == 0 for x in factors):
+        return 0.0
+    lp = sum(math.log(x) for x in factors)
+    return 1.0 if lp > 709 else -math.expm1(-math.exp(lp))
+
+
+def ray(frm, to):
+    """(length, unit direction) from frm to to: half the difference (no overflow for coordinates of
+    ±1e300) and math.hypot (no square formed: 1e-300 and 1e200 come out as themselves)."""
+    half = [0.5 * q - 0.5 * p for p, q in zip(frm, to)]
+    h = math.hypot(*half)
+    return (0.0, (0.0, 0.0, 0.0)) if h == 0 else (2 * h, tuple(x / h for x in half))
+
+
+def fog_model(f, camera, point):
+    """(f, transmittance, fog colour) of docs/effects.md §2 for an object at point seen from camera:
+    the closed forms written out here, not the server's code. Transmittance and fog colour are
+    those `samples` carry for ATMOSPHERIC or with `directional` (colour = object·T + fog colour)."""
+    if any(k in f for k in ("startDistance", "maxOpacity", "cutoffDistance", "secondLayer")):
+        raise ValueError("fog_model has no engine terms")
+    d, u = ray(camera, point)
+    color = f.get("color", [1, 1, 1])
+    t, conv = f.get("fogType", "LINEAR"), f.get("convention", "effectd")
+    if t in ("LINEAR", "EXPONENTIAL"):
+        v = f.get("visibilityRange", 0)
+        factor = 1.0 if v == 0 else 0.0 if d >= v else (v - d) / v if t == "LINEAR" else math.exp(-(d / (v - d)))
+    elif t == "GL_LINEAR":
+        s, e = f.get("start", 0), f.get("end", 1)
+        factor = min(1.0, max(0.0, (e - d) / (e - s)))
+    elif t == "GL_EXP":
+        factor = exp_neg(f.get("density", 1), d)
+    elif t == "GL_EXP2":
+        factor = exp_neg(f.get("density", 1), d, f.get("density", 1), d)
+    elif t in ("DISTANCE_EXP2", "DISTANCE_GAUSSIAN"):
+        factor = exp_neg(f.get("distanceCoefficient", 0.07), d, d)
+        factor *= f.get("peak", 1 / math.sqrt(2 * math.pi)) if t == "DISTANCE_GAUSSIAN" else 1
+    elif t == "HEIGHT" and conv == "effectd":
+        factor = height_f(f.get("density", 1), f.get("heightFalloff", 0.1), f.get("baseHeight", 0), camera[1], u[1], d)
+    elif t == "HEIGHT" and conv == "filament":  # m·d, m the whole ray's mean density (F2: sigma(c_y) near level)
+        factor = height_f(f.get("density", 1), f.get("heightFalloff", 0.1), f.get("baseHeight", 0), camera[1], u[1], d,
+                          near_level=0.00125)
+    elif t == "ATMOSPHERIC":
+        tr = [exp_neg(b, d) for b in f.get("extinction", [0, 0, 0])]
+        return (sum(tr) / 3, tr, [c * one_minus_exp_neg(b, d) for c, b in zip(color, f.get("inscattering", [0, 0, 0]))])
     else:
-        lg = -x + math.log(-math.expm1(x)) - math.log(-x)
-    ltau = math.log(a * t) - b * (oy - h) + lg
-    return 0.0 if ltau > 700 else math.exp(-math.exp(ltau))
+        raise ValueError(f"fog_model: {t} in convention {conv}")
+    sun = f.get("directional")
+    if sun is None:
+        return factor, None, None
+    if sun.get("startDistance", 0) != 0:
+        raise ValueError("fog_model: directional.startDistance")
+    cos = sum(a * b for a, b in zip(u, ray([0, 0, 0], sun.get("direction", [0, 0, -1]))[1])) if d > 0 else 0.0
+    g = sun.get("g", 0.7)
+    lobe = (max(cos, 0.0) ** sun["exponent"] if "exponent" in sun else (1 - g * g) / (1 + g * g - 2 * g * cos) ** 1.5)
+    glow = [c * lobe for c in sun.get("color", [1, 0.8, 0.6])]
+    return factor, [factor] * 3, [(1 - factor) * (c + s) for c, s in zip(color, glow)]
+
+
+def region_of(regions, p):
+    """The innermost region holding p (closed sets; the smallest volume, compared as logs so that
+    radii of 1e-200 and 1e200 compare; the earlier on ties), -1 for none."""
+    best, best_lv = -1, math.inf
+    for i, r in enumerate(regions):
+        if "sphere" in r:
+            inside = ray(r["sphere"]["center"], p)[0] <= r["sphere"]["radius"]
+            rad = r["sphere"]["radius"]
+            lv = math.log(4 / 3 * math.pi) + 3 * math.log(rad) if rad > 0 else -math.inf
+        else:
+            lo, hi = r["box"]["min"], r["box"]["max"]
+            inside = all(a <= x <= b for a, x, b in zip(lo, p, hi))
+            ext = [0.5 * b - 0.5 * a for a, b in zip(lo, hi)]
+            lv = sum(math.log(e) + math.log(2) if e > 0 else -math.inf for e in ext)
+        if inside and (best < 0 or lv < best_lv):
+            best, best_lv = i, lv
+    return best
 
 
 def distances(table):
@@ -91,9 +195,62 @@ def scaled(mesh, k):
     return {**mesh, "positions": [v * k for v in mesh["positions"]]}
 
 
+# ---- mutations: a plausible wrong answer made from the real ones (--mutations) -------------------
+def mutation(text, change):
+    """(text, fn): fn(answers) returns a deep copy of the answers that change(copy) edited in place."""
+    def fn(answers):
+        wrong = copy.deepcopy(answers)
+        change(wrong)
+        return wrong
+    return text, fn
+
+
+def with_mutation(check, text, change):
+    """A check's own default mutation (a row may still name another)."""
+    check.mutation = mutation(text, change)
+    return check
+
+
+def off_values(values):
+    """The farthest value in (1e-30, 1) made 1 % smaller; where there is none, the first 0 read as 1
+    (the naive overflow: d² = ∞ or 0 taken for no fog), else the last 1 read as 0."""
+    inside = [i for i, v in enumerate(values) if 1e-30 < v < 1]
+    if inside:
+        values[inside[-1]] *= 0.99
+    elif 0 in values:
+        values[values.index(0)] = 1.0
+    else:
+        values[-1] = 0.0
+
+
+OFF_FACTOR = "the farthest f in (0, 1) ×0.99, or a 0 read as 1 (the naive overflow)"
+
+
+def off_samples(answers, key="factor"):
+    samples = answers[0][1]["samples"]
+    values = [x[key] for x in samples]
+    off_values(values)
+    for x, v in zip(samples, values):
+        x[key] = v
+
+
+def parent_pointer(answers):
+    err = answers[0][1]["errors"][0]
+    err["pointer"] = err["pointer"].rsplit("/", 1)[0] or "/"
+
+
 # ---- checks: each takes the answers (one per request) and returns (ok, observed) ---------------
 def ok_status(status, answers):
     return all(s == status for s, _ in answers)
+
+
+def near(o, e, tol=2e-6, rel=1e-5):
+    """|o − e| within tol, and within rel relative where e is above 1e-30 (so that e^−50 ×1.01 fails)."""
+    return abs(o - e) <= tol and (e <= 1e-30 or abs(o / e - 1) <= rel)
+
+
+def rel_worst(observed, expected):
+    return max((abs(o / e - 1) for o, e in zip(observed, expected) if e > 1e-30), default=0.0)
 
 
 def problem(status, pointer):
@@ -101,7 +258,7 @@ def problem(status, pointer):
         s, a = answers[0]
         got = (a.get("errors") or [{}])[0].get("pointer") if isinstance(a, dict) else None
         return s == status and got == pointer, f"{s} at {got}: {(a.get('errors') or [{}])[0].get('message', '')}"
-    return check
+    return with_mutation(check, f"the {status} naming the parent of {pointer}", parent_pointer)
 
 
 def fog_table(expected_f, tol=2e-6):
@@ -117,20 +274,11 @@ def fog_table(expected_f, tol=2e-6):
             exp = [expected_f(d, -1 + 2 * e / (rows - 1)) for e in range(rows) for d in ds]
         else:
             exp = [expected_f(d) for d in ds]
-        err = worst(f, exp)
-        return err <= tol, f"{len(f)} factors in [{min(f):.4g}, {max(f):.4g}]; max |f − closed form| {err:.2g}"
-    return check
-
-
-def fog_samples(expected):
-    def check(answers):
-        s, a = answers[0]
-        if s != 200:
-            return False, f"status {s}"
-        f = [x["factor"] for x in a["samples"]]
-        err = worst(f, expected)
-        return err <= 2e-6, f"f = {', '.join(f'{x:.4g}' for x in f)}; max |f − closed form| {err:.2g}"
-    return check
+        err, rerr = worst(f, exp), rel_worst(f, exp)
+        ok = len(f) == len(exp) and all(near(o, e, tol) for o, e in zip(f, exp))
+        return ok, (f"{len(f)} factors in [{min(f):.4g}, {max(f):.4g}]; max |f − closed form| {err:.2g} "
+                    f"(relative {rerr:.2g} above 1e-30)")
+    return with_mutation(check, OFF_FACTOR, lambda answers: off_values(answers[0][1]["table"]["factor"]))
 
 
 def fog_transmittance(coefficients):
@@ -140,10 +288,48 @@ def fog_transmittance(coefficients):
             return False, f"status {s}"
         t = a["table"]
         tr, ds = t["transmittance"], distances(t)
-        exp = [math.exp(-min(700.0, c * d)) if c * d < 700 else 0.0 for d in ds for c in coefficients]
-        err = worst(tr, exp)
-        return err <= 2e-6, f"T per channel in [{min(tr):.4g}, {max(tr):.4g}]; max |T − e^(−β·d)| {err:.2g}"
-    return check
+        exp = [exp_neg(c, d) for d in ds for c in coefficients]
+        err, rerr = worst(tr, exp), rel_worst(tr, exp)
+        ok = len(tr) == len(exp) and all(near(o, e) for o, e in zip(tr, exp))
+        return ok, (f"T per channel in [{min(tr):.4g}, {max(tr):.4g}]; max |T − e^(−β·d)| {err:.2g} "
+                    f"(relative {rerr:.2g} above 1e-30)")
+    return with_mutation(check, "the farthest T in (0, 1) ×0.99",
+                         lambda answers: off_values(answers[0][1]["table"]["transmittance"]))
+
+
+def fog_points(case, f, points, must, camera=(0, 0, 0), regions=None, mutated=None):
+    """A row of `samples`: each point's region, f, and (ATMOSPHERIC or directional) transmittance and
+    fog colour against fog_model's closed forms, within 2e-6 and 1e-5 relative above 1e-30."""
+    body = fog(f, samples={"camera": list(camera), "points": points}, include=["samples"])
+    if regions:
+        body["regions"] = regions
+    want = []
+    for p in points:
+        r = region_of(regions or [], p)
+        want.append((r,) + fog_model(body["fog"] if r < 0 else regions[r]["fog"], camera, p))
+
+    def check(answers):
+        s, a = answers[0]
+        if s != 200:
+            return False, f"status {s}: {(a.get('errors') or [{}])[0].get('message', '')}"
+        got = a["samples"]
+        bad, errs, rels = [], [0.0], [0.0]
+        for i, (x, (r, fe, te, ce)) in enumerate(zip(got, want)):
+            pairs = [(x["factor"], fe)]
+            if te is not None:
+                pairs += list(zip(x.get("transmittance") or [math.nan] * 3, te))
+                pairs += list(zip(x.get("fogColor") or [math.nan] * 3, ce))
+            errs += [abs(o - e) for o, e in pairs]
+            rels += [abs(o / e - 1) for o, e in pairs if e > 1e-30]
+            if x["region"] != r or not all(near(o, e) for o, e in pairs):
+                bad.append(f"point {i}: region {x['region']} (want {r}), f {x['factor']:.6g} (want {fe:.6g})")
+        fs, rs = ", ".join(f"{x['factor']:.4g}" for x in got), ", ".join(str(x["region"]) for x in got)
+        seen = (f"f = {fs}" + (f"; regions {rs}" if regions else "")
+                + ("; T and fog colour too" if want[0][2] is not None else "")
+                + f"; max |Δ| {max(errs):.2g}, relative {max(rels):.2g}")
+        ok = len(got) == len(want) and not bad
+        return ok, seen if ok else seen + "; " + "; ".join(bad[:3])
+    return ("fog", case, "fog", body, with_mutation(check, OFF_FACTOR, off_samples), must) + ((mutated,) if mutated else ())
 
 
 def cells_of(a):
@@ -152,24 +338,49 @@ def cells_of(a):
 
 
 def tree_problems(body, a, cells):
-    """Every cell inside the grid, none twice, each a neighbour of its parent (2-D or 3-D)."""
-    grid, parent = a["grid"], a["tree"]["parent"]
+    """Every cell inside the grid, none twice, each a neighbour of its parent (2-D or 3-D), the
+    tree rooted at the start with parents grown before their children, and the main channel the
+    parent chain from the root to a target."""
+    grid, tree = a["grid"], a["tree"]
+    parent = tree["parent"]
     hood = body.get("neighbourhood", 26 if len(grid) == 3 else 8)
     problems = []
+    if len(parent) != len(cells) or not cells or list(cells[0]) != list(body["start"]) or parent[0] != -1:
+        problems.append("not a tree rooted at the start")
+        return problems
     if any(not all(0 <= c[k] < grid[k] for k in range(len(grid))) for c in cells):
         problems.append("a cell outside the grid")
     if len(set(cells)) != len(cells):
         problems.append("a cell twice")
     for i, q in enumerate(parent[1:], 1):
+        if not 0 <= q < i:
+            problems.append(f"cell {i}'s parent {q} grew after it")
+            break
         d = [abs(cells[i][k] - cells[q][k]) for k in range(len(grid))]
         if max(d) != 1 or (hood in (4, 6) and sum(d) != 1):
             problems.append(f"cell {i} is not a neighbour of its parent")
             break
+    main = tree.get("mainChannel")
+    if main is not None and (main[0] != 0 or any(parent[m] != p for p, m in zip(main, main[1:]))
+                             or list(cells[main[-1]]) not in [list(t) for t in body["targets"]]):
+        problems.append("the main channel is not the parent chain from the start to a target")
     return problems
 
 
+def cell_off(answers):
+    """The bolt's last cell moved 3 cells along x: off its parent (or out of the grid)."""
+    a = answers[0][1]
+    c = a["cells"]
+    i = len(c) - len(a["grid"])
+    c[i] += 3 if c[i] + 3 < a["grid"][0] else -3
+
+
+CELL_OFF = "the last cell moved 3 cells along x, off its tree"
+
+
 def bolt_ok(body, pred=None):
-    """Inside the grid, each cell next to its parent, the target reached; then pred(answer)."""
+    """Inside the grid, a tree rooted at the start, each cell next to its parent, the target reached;
+    then pred(answer)."""
     def check(answers):
         s, a = answers[0]
         if s != 200:
@@ -181,7 +392,13 @@ def bolt_ok(body, pred=None):
         seen = "; ".join(problems) or f"{len(cells)} cells, a connected tree, the target reached"
         ok2, seen2 = pred(a) if pred else (True, "")
         return not problems and ok2, seen + ("; " + seen2 if seen2 else "")
-    return check
+    return with_mutation(check, CELL_OFF, cell_off)
+
+
+def scale_cells(answers, runs, pick, k):
+    for run, (_, a) in zip(runs, answers):
+        if pick(run):
+            a["stats"]["counters"]["cells"] *= k
 
 
 def per_row(lengths_seeds, tol=0.12, filled=None):
@@ -199,7 +416,9 @@ def per_row(lengths_seeds, tol=0.12, filled=None):
         stages = max(a["stats"]["counters"].get("deepestStage", 0) for _, a in answers)
         return ok, (f"cells per row {short:.3f} at length {min(means)}, {long_:.3f} at {max(means)} (ratio {ratio:.3f}; "
                     f"deepest stage {stages:g})")
-    return check
+    longest = max(L for L, _ in lengths_seeds)
+    return with_mutation(check, "the longest bolts 25 % fuller (the far field lost: growth fills behind the tip)",
+                         lambda answers: scale_cells(answers, lengths_seeds, lambda r: r[0] == longest, 1.25))
 
 
 def same_fill(runs):
@@ -217,32 +436,100 @@ def same_fill(runs):
             ok = ok and abs(tiny / zero - 1) <= 0.05
             seen.append(f"length {length}: {zero:.3f} at η 0, {tiny:.3f} at η 1e-6")
         return ok, "; ".join(seen)
-    return check
+    return with_mutation(check, "the η 1e-6 bolts 10 % thinner (underflowed candidates never drawn)",
+                         lambda answers: scale_cells(answers, runs, lambda r: r[1] == 1e-6, 0.9))
 
 
-def tangents_equal_at_scales(scales):
+FLT_MIN = 1.1754943508222875e-38
+
+
+def frame_problems(body, a):
+    """MikkTSpace's frame, written out (docs/effects.md §4): at every corner of a triangle with no two
+    coincident corners and a UV area above FLT_MIN, the tangent points along ∂p/∂u projected into
+    the normal's plane (positive dot product) and w = sign(UV area); a vertex no such triangle
+    reaches (and no such triangle's corner at the same position) has the fallback frame: (1, 0, 0)
+    projected into the normal's plane, w = −1."""
+    mesh = body["mesh"]
+    pos, uvs = mesh["positions"], mesh["uvs"]
+    t, n = a.get("tangents"), a.get("normals")
+    if not t or not n:
+        return ["the answer has no tangents or no normals"]
+    nv, nin = len(t) // 4, len(pos) // 3
+    remap = a.get("remap") or (list(range(nin)) if nv == nin else None)
+    idx = a.get("indices") or (mesh["indices"] if nv == nin else None)
+    if remap is None or idx is None:
+        return ["split vertices with no remap or indices to check them by"]
+    P = [tuple(pos[3 * remap[k]:3 * remap[k] + 3]) for k in range(nv)]
+    U = [tuple(uvs[2 * remap[k]:2 * remap[k] + 2]) for k in range(nv)]
+    healthy, healthy_at = set(), set()
+    for c in range(0, len(idx), 3):
+        tri = idx[c:c + 3]
+        p0, p1, p2 = (P[k] for k in tri)
+        if p0 == p1 or p1 == p2 or p0 == p2:
+            continue
+        d1, d2 = [b - a for a, b in zip(p0, p1)], [b - a for a, b in zip(p0, p2)]
+        t21, t31 = [b - a for a, b in zip(U[tri[0]], U[tri[1]])], [b - a for a, b in zip(U[tri[0]], U[tri[2]])]
+        area = t21[0] * t31[1] - t21[1] * t31[0]
+        os_ = [t31[1] * x - t21[1] * y for x, y in zip(d1, d2)]  # = area·∂p/∂u (the reference's eq 18)
+        if abs(area) <= FLT_MIN or not any(os_):
+            continue
+        sign = 1.0 if area > 0 else -1.0
+        for k in tri:
+            nk = n[3 * k:3 * k + 3]
+            dot_n = sum(x * y for x, y in zip(nk, os_))
+            proj = [sign * (x - dot_n * y) for x, y in zip(os_, nk)]
+            if math.hypot(*proj) <= 1e-6 * math.hypot(*os_):
+                continue
+            healthy.add(k)
+            healthy_at.add(P[k])
+            tk = t[4 * k:4 * k + 4]
+            if sum(x * y for x, y in zip(tk, proj)) <= 0:
+                return [f"vertex {k}: the tangent points against ∂p/∂u"]
+            if tk[3] != sign:
+                return [f"vertex {k}: w = {tk[3]:g}, the UV area's sign is {sign:g}"]
+    for k in range(nv):
+        nk = n[3 * k:3 * k + 3]
+        if k in healthy or P[k] in healthy_at or abs(nk[0]) > 0.9:
+            continue
+        e = [1 - nk[0] * nk[0], -nk[0] * nk[1], -nk[0] * nk[2]]
+        le = math.hypot(*e)
+        if max(abs(x - y / le) for x, y in zip(t[4 * k:4 * k + 3], e)) > 1e-5 or t[4 * k + 3] != -1:
+            return [f"vertex {k}: {t[4 * k:4 * k + 4]}, not the fallback frame"]
+    return []
+
+
+def flip_frame(answers):
+    """The first frame flipped: t → −t (still unit and ⟂ n)."""
+    t = answers[-1][1]["tangents"]
+    t[0:3] = [-x for x in t[0:3]]
+
+
+def tangents_equal_at_scales(body, scales):
     def check(answers):
         if not ok_status(200, answers):
             return False, "statuses " + ", ".join(str(s) for s, _ in answers)
         ref = answers[0][1]["tangents"]
         err = max(worst(a["tangents"], ref) for _, a in answers[1:])
-        probs = [p for _, a in answers for p in check_tangents({}, a, None)]
-        return err <= 1e-6 and not probs, f"max |t(scale) − t(1)| {err:.2g} at scales {', '.join(f'{k:g}' for k in scales)}"
-    return check
+        probs = [p for (_, a), k in zip(answers, [1] + scales) for p in check_tangents({}, a, None) +
+                 frame_problems({"mesh": scaled(body["mesh"], k)}, a)]
+        return err <= 1e-6 and not probs, (f"max |t(scale) − t(1)| {err:.2g} at scales {', '.join(f'{k:g}' for k in scales)}"
+                                           + ("; " + probs[0] if probs else "; MikkTSpace's frames at every scale"))
+    return with_mutation(check, "the first frame flipped at the largest scale", flip_frame)
 
 
-def unit_frames(pred=None):
+def unit_frames(body, pred=None):
+    """check_tangents (unit, ⟂ n, w = ±1) and frame_problems (the direction and handedness)."""
     def check(answers):
         s, a = answers[0]
         if s != 200:
             return False, f"status {s}"
-        probs = check_tangents({}, a, None)
-        seen = f"{len(a['tangents']) // 4} unit tangents ⟂ normals" if not probs else probs[0]
+        probs = check_tangents({}, a, None) + frame_problems(body, a)
+        seen = f"{len(a['tangents']) // 4} unit tangents ⟂ normals, along ∂p/∂u or the fallback" if not probs else probs[0]
         if pred:
             ok2, s2 = pred(a)
             return not probs and ok2, seen + "; " + s2
         return not probs, seen
-    return check
+    return with_mutation(check, "the first frame flipped (t → −t: still unit, ⟂ n)", flip_frame)
 
 
 def fresnel_r(cos_i, n):
@@ -269,7 +556,8 @@ def faint_film(n2):
             worst_ratio = max(worst_ratio, got / bound)
         finite = all(math.isfinite(v) for v in rgb)
         return finite and worst_ratio <= 1, f"max |rgb| off grazing {top:.2g}; at most {worst_ratio:.2f} of each row's bound"
-    return check
+    return with_mutation(check, "the film's rgb ×2 (its reflectance counted twice)",
+                         lambda answers: answers[0][1]["thinFilm"].update(rgb=[2 * v for v in answers[0][1]["thinFilm"]["rgb"]]))
 
 
 def bubble_scale_invariant(radii):
@@ -279,7 +567,10 @@ def bubble_scale_invariant(radii):
         shapes = [[v / r for v in a["mesh"]["positions"]] for r, (_, a) in zip(radii, answers)]
         err = max(worst(s, shapes[0]) for s in shapes[1:])
         return err <= 1e-5, f"max |p/r at radius {radii[1]:g} − p/r at {radii[0]:g}| = {err:.2g}"
-    return check
+
+    def nudge(answers):
+        answers[-1][1]["mesh"]["positions"][0] += 1e-4 * radii[-1]
+    return with_mutation(check, f"one vertex nudged by 1e-4 radii at radius {radii[-1]:g}", nudge)
 
 
 def checked_by_sweep(answers_body):
@@ -291,7 +582,12 @@ def checked_by_sweep(answers_body):
             return False, f"status {s}"
         probs = check_bubble(body, a, SERVER)
         return not probs, "every triangle oriented as on the undisturbed sphere, none degenerate" if not probs else probs[0]
-    return check
+
+    def invert(answers):
+        mesh = answers[0][1]["mesh"]
+        p, (i, j) = mesh["positions"], mesh["indices"][:2]
+        p[3 * i:3 * i + 3], p[3 * j:3 * j + 3] = p[3 * j:3 * j + 3], p[3 * i:3 * i + 3]
+    return with_mutation(check, "the first triangle folded over (two of its corners swapped)", invert)
 
 
 def thin_film_zero_and_air(answers):
@@ -311,10 +607,216 @@ def thin_film_zero_and_air(answers):
                                            f"1e4 nm column finite: {finite}")
 
 
-# (effect, case, endpoint, bodies, check, what must hold); bodies may be a list (invariances).
+def zero_film_reflects(answers):
+    t = answers[0][1]["thinFilm"]
+    t["rgb"][3 * t["width"]] = 0.01  # row 1 (off grazing), column 0 (thickness 0), red
+
+
+def final_vectors(body):
+    """Eqns 4-8 per vertex from the answer's own positions and normals, written out here: I the unit
+    ray from the camera, γ = N·V, ν_in = (n1/n2)·√(1 − γ²); Final = R·μ_top + T, R = I + 2γN,
+    T = (η·I + (η·γ − γ_in)·N)·μ_bottom while ν_in < 1, else 0 (TIR); α = min(1, 0.05·t)."""
+    prm = body["params"]
+    n1, n2, cam = prm.get("n1", 1.0), prm.get("n2", 1.33), body["camera"]
+    alpha = min(1.0, max(0.0, prm.get("muSpeed", 0.05) * body["time"]))
+    mu_top, mu_bottom = 1 + (0.1 - 1) * alpha, 0.1 + (1 - 0.1) * alpha
+
+    def check(answers):
+        s, a = answers[0]
+        if s != 200:
+            return False, f"status {s}"
+        m = a["mesh"]
+        pos, nor, fin = m["positions"], m["normals"], m["finalVectors"]
+        err, tir = 0.0, 0
+        for v in range(len(pos) // 3):
+            i = ray(cam, pos[3 * v:3 * v + 3])[1]
+            nn = ray([0, 0, 0], nor[3 * v:3 * v + 3])[1]
+            g = -sum(x * y for x, y in zip(i, nn))
+            nu_in = n1 / n2 * math.sqrt(max(0.0, 1 - g * g))
+            want = [(x + 2 * g * y) * mu_top for x, y in zip(i, nn)]
+            if nu_in < 1:
+                eta, g_in = n1 / n2, math.sqrt(1 - nu_in * nu_in)
+                want = [w + (eta * x + (eta * g - g_in) * y) * mu_bottom for w, x, y in zip(want, i, nn)]
+            else:
+                tir += 1
+            err = max([err] + [abs(x - y) for x, y in zip(fin[3 * v:3 * v + 3], want)])
+        finite = all(math.isfinite(v) for v in fin)
+        return finite and err <= 1e-5 and tir > 0, (f"{len(fin) // 3} final vectors ({tir} past the critical angle); "
+                                                    f"max |Final − eqn 8| {err:.2g}")
+
+    def unweighted(answers):
+        f = answers[0][1]["mesh"]["finalVectors"]
+        f[0:3] = [x / mu_top for x in f[0:3]]
+    return with_mutation(check, "one final vector without eqn 8's weight μ_top", unweighted)
+
+
+def drained_film(h_nm):
+    """A film drained to H(t) = h_nm: every texel in [0, H] (h = H·√s, s in [0, 1], wherever the
+    swirl brought the film from), finite, and its bottom near H (max ≥ 0.9 H)."""
+    def check(answers):
+        s, a = answers[0]
+        if s != 200:
+            return False, f"status {s}"
+        nm = a["thickness"]["nm"]
+        ok = all(math.isfinite(v) and 0 <= v <= h_nm * (1 + 1e-6) for v in nm) and max(nm) >= 0.9 * h_nm
+        return ok, f"thickness in [{min(nm):.4g}, {max(nm):.4g}] nm (H = {h_nm:g} nm)"
+    return with_mutation(check, "the undrained film's thickness (H = 1000 nm: ×10/3)",
+                         lambda answers: answers[0][1]["thickness"].update(nm=[v * 10 / 3 for v in answers[0][1]["thickness"]["nm"]]))
+
+
+def bolts_equal(bodies, text):
+    """Every bolt a tree rooted at the start that reaches the target, and all the same, cell for cell."""
+    def check(answers):
+        if not ok_status(200, answers):
+            return False, "statuses " + ", ".join(str(s) for s, _ in answers)
+        probs = [p for b, (_, a) in zip(bodies, answers) for p in tree_problems(b, a, cells_of(a))]
+        probs += ["target not reached" for b, (_, a) in zip(bodies, answers) if tuple(b["targets"][-1]) not in cells_of(a)]
+        same = all(a["cells"] == answers[0][1]["cells"] for _, a in answers[1:])
+        return not probs and same, (probs[0] if probs else f"{len(cells_of(answers[0][1]))} cells, a connected tree; "
+                                    + (text if same else "NOT " + text))
+    return check
+
+
+def regrown(body, text):
+    """A mutation that asks the server for the bolt a plausible mistake would give."""
+    def change(answers):
+        s, a, _ = SERVER.post("/v1/lightning", body)
+        answers[0] = (s, a if isinstance(a, dict) else {})
+    return mutation(text, change)
+
+
+# (effect, case, endpoint, bodies, check, what must hold[, mutation]); bodies may be a list (invariances).
+HEIGHT = {"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0}
+
+
+def fog_sample_rows():
+    """`samples` at the ends of the double range: lengths of 1e-300 and 1e200 (whose squares are 0
+    and ∞), densities of 1e300 against distances of 1e-300, regions of radius 1e-200 and 1e200."""
+    dc = 5e-324  # the smallest denormal (4.94e-324)
+    far = [[5e161, 0, 0], [0, 1e162, 0], [0, 0, 2e162], [3e161, 0, 0]]
+    far_f = ", ".join(f"{exp_neg(dc, d, d):.3g}" for d in (5e161, 1e162, 2e162, 3e161))
+    fil_tiny = {**HEIGHT, "density": 5e299, "heightFalloff": 1e296, "convention": "filament"}
+    tiny_pt = [8e-300, 6e-300, 0]  # d = 1e-299, rise 6e-300: |b·v_y| = 6e-4, under Filament's 0.00125
+    effectd_f = height_f(5e299, 1e296, 0, 0, 0.6, 1e-299)
+    big = {"sphere": {"center": [0, 0, 0], "radius": 1e200}, "fog": {"fogType": "GL_EXP", "density": 1e-200, "color": [0.2, 0.3, 0.4]}}
+    small = {"sphere": {"center": [2e-200, 0, 0], "radius": 1e-200}, "fog": {"fogType": "GL_EXP", "density": 1e200}}
+
+    def first_region(answers):  # the point inside both spheres given to the first that holds it
+        answers[0][1]["samples"][0].update(region=0, factor=exp_neg(1e-200, 2e-200))
+    return [
+        fog_points("GL_EXP, density 1e300, points 1e-300 … 3e-300 away", {"fogType": "GL_EXP", "density": 1e300},
+                   [[1e-300, 0, 0], [0, 2e-300, 0], [1e-300, -1e-300, 0], [0, 0, -3e-300]],
+                   "f = e^(−ρ·d) = e^−1, e^−2, e^−√2, e^−3: |p − c| with no square of 1e-300 (a naive one is 0: f = 1)"),
+        fog_points("GL_EXP2, density 1e-200, points 1e200 and 5e199 away", {"fogType": "GL_EXP2", "density": 1e-200},
+                   [[1e200, 0, 0], [0, 5e199, 0], [-6e199, 0, 8e199]],
+                   "f = e^(−(ρ·d)²) = e^−1, e^−0.25, e^−1: d² = 1e400 never formed"),
+        fog_points("HEIGHT, level rays 1e150, 1e160, 1e200 away", HEIGHT,
+                   [[1e150, 0, 0], [0, 0, 1e160], [1e200, 0, 0], [-1e200, 0, 1e200]],
+                   "τ = a·d on level rays at the layer's base: f = 0 (a naive |p − c| = ∞ gives 1)"),
+        fog_points("HEIGHT, density 1e170, points 1e-170 and 2e-170 away", {**HEIGHT, "density": 1e170},
+                   [[1e-170, 0, 0], [0, 0, -2e-170]], "τ = a·d = 1, 2: f = e^−1, e^−2"),
+        fog_points("DISTANCE_EXP2, d_c = 5e-324 (the denormal), d = 5e161 … 2e162", {"fogType": "DISTANCE_EXP2",
+                   "distanceCoefficient": dc}, far, f"f = exp(−exp(ln d_c + 2 ln d)) = {far_f}: d² overflows past 1.3e154"),
+        fog_points("DISTANCE_GAUSSIAN, d_c = 5e-324, peak 0.5, d = 5e161 … 2e162",
+                   {"fogType": "DISTANCE_GAUSSIAN", "distanceCoefficient": dc, "peak": 0.5}, far, "f = peak·exp(−d_c·d²), in log space"),
+        fog_points("EXPONENTIAL (X3D), visibilityRange 1e-300", {"fogType": "EXPONENTIAL", "visibilityRange": 1e-300},
+                   [[3e-301, 4e-301, 0], [2.5e-301, 0, 0], [0, 9e-301, 0], [0, 0, 2e-300]],
+                   "f = exp(−d/(V − d)) = e^−1, e^−1/3, e^−9, then 0 past V"),
+        fog_points("EXPONENTIAL (X3D), visibilityRange 1e300", {"fogType": "EXPONENTIAL", "visibilityRange": 1e300},
+                   [[3e299, 4e299, 0], [2.5e299, 0, 0], [0, 9e299, 0], [1e300, 1e300, 0]],
+                   "f = exp(−d/(V − d)) = e^−1, e^−1/3, e^−9, then 0 past V"),
+        fog_points("LINEAR (X3D), visibilityRange 1e-300", {"fogType": "LINEAR", "visibilityRange": 1e-300},
+                   [[1.5e-301, 2e-301, 0], [0, 5e-301, 0], [0, 0, 2e-300]], "f = (V − d)/V = 0.75, 0.5, 0"),
+        fog_points("LINEAR (X3D), visibilityRange 1e300", {"fogType": "LINEAR", "visibilityRange": 1e300},
+                   [[1.5e299, 2e299, 0], [0, 5e299, 0], [1e300, 1e300, 0]], "f = (V − d)/V = 0.75, 0.5, 0"),
+        fog_points("GL_LINEAR, start 1e-300, end 3e-300", {"fogType": "GL_LINEAR", "start": 1e-300, "end": 3e-300},
+                   [[5e-301, 0, 0], [0, 2e-300, 0], [1.5e-300, 2e-300, 0], [0, 0, 4e-300]],
+                   "clamp((end − d)/(end − start)) = 1, 0.5, 0.25, 0"),
+        fog_points("GL_LINEAR, start 1e299, end 1e300, camera at x = −5e299", {"fogType": "GL_LINEAR", "start": 1e299, "end": 1e300},
+                   [[0, 0, 0], [5e299, 0, 0], [-5e299, 3e299, 4e299], [-5e299, 5e298, 0]],
+                   "clamp((end − d)/(end − start)) = 5/9, 0, 5/9, 1", camera=(-5e299, 0, 0)),
+        fog_points("ATMOSPHERIC, extinction 1e-300, 1, 300, inscattering 300, 1, 1e-300, d = 1e-300 … 1.7e300",
+                   {"fogType": "ATMOSPHERIC", "extinction": [1e-300, 1, 300], "inscattering": [300, 1, 1e-300]},
+                   [[1e-300, 0, 0], [0, 2e-3, 0], [3e299, 4e299, 0], [1e300, 0, 0], [1e300, 1e300, 1e300]],
+                   "per channel T = e^(−β_e·d) (e^−1 at β 1e-300, d 1e300), fog colour = color·(1 − e^(−β_i·d)); f = mean T"),
+        fog_points("GL_EXP 1e300 with a sun (exponent 2, direction 1e-300 long), d = 1e-300 …",
+                   {"fogType": "GL_EXP", "density": 1e300,
+                    "directional": {"color": [1, 0.8, 0.6], "direction": [0, 0, -1e-300], "exponent": 2}},
+                   [[0, 0, -1e-300], [1e-300, 0, -1e-300], [0, 2e-300, 0]],
+                   "T = f per channel; fog colour = (1 − f)·(color + sun·max(cos θ, 0)²): lobes 1, 0.5, 0"),
+        fog_points("GL_EXP2 1e-200 with a sun (Henyey–Greenstein g 0.5, direction 1e300 long), d = 5e199 …",
+                   {"fogType": "GL_EXP2", "density": 1e-200,
+                    "directional": {"color": [1, 0.8, 0.6], "direction": [1e300, 0, 0], "g": 0.5}},
+                   [[1e200, 0, 0], [0, 1e200, 0], [-5e199, 0, 0]],
+                   "fog colour = (1 − f)·(color + sun·(1 − g²)/(1 + g² − 2g cos θ)^1.5): lobes 6, 0.54, 0.22"),
+        fog_points("HEIGHT, slanted rays 5e199 … 1e200 long", HEIGHT, [[1e200, 1e199, 0], [1e200, -1e199, 0], [3e199, 4e199, 0]],
+                   "height_f with d_y from a scaled norm: rising rays see τ → a/(b·d_y) (f = 0.081, 0.73), "
+                   "the falling one f = 0"),
+        fog_points("HEIGHT, density and falloff 1e300, rays 5e-300 long, camera 1e-300 up",
+                   {**HEIGHT, "density": 1e300, "heightFalloff": 1e300},
+                   [[3e-300, 5e-300, 0], [3e-300, -3e-300, 0], [5e-300, 1e-300, 0]],
+                   "height_f: b·d_y·t = ±4 and 0 (f = 0.64, 2e-11, 0.16): every product of a 1e300 and a 1e-300 in log space",
+                   camera=(0, 1e-300, 0)),
+        fog_points("HEIGHT in Filament's convention, 1e-299 away (|b·v_y| = 6e-4)", fil_tiny, [tiny_pt],
+                   f"Filament's f = e^(−σ(c_y)·d) = e^−5 below its 0.00125 guard (§2.4 F2), not the exact {effectd_f:.6g}",
+                   mutated=mutation(f"effectd's exact integral {effectd_f:.6g} (the convention ignored)",
+                                    lambda answers: answers[0][1]["samples"][0].update(factor=effectd_f))),
+        fog_points("HEIGHT in Filament's convention, 5e199 … 1e200 away", {**HEIGHT, "convention": "filament"},
+                   [[1e200, 1e199, 0], [3e199, 4e199, 0], [1e200, -1e-3, 0]],
+                   "Filament's τ = σ(c_y)·d·(1 − e^(−b·v_y))/(b·v_y): f = 0.081, 0.73, and 0 on the near-level ray"),
+        fog_points("regions: spheres of radius 1e200 and 1e-200 (nested)", {"fogType": "GL_EXP2", "density": 1e-200},
+                   [[2e-200, 0, 0], [2e-200, 5e-201, 0], [2e-200, 1.5e-200, 0], [5e199, 5e199, 0], [1e200, 1e200, 0]],
+                   "the innermost region (log volumes: 1e-600 against 1e600): 1, 1, 0, 0, −1 (global), each with its own "
+                   "fog: f = e^−2, e^−2.06, 1, e^−0.71, e^−2", regions=[big, small],
+                   mutated=mutation("the point inside both spheres given to the first (region 0)", first_region)),
+    ]
+
+
+FRAMES = ["tangents", "normals", "indices", "remap"]
+
+
+def bad_triangles(body):
+    """(triangles with two coincident corners, the others with UV area 0), counted here."""
+    m = body["mesh"]
+    p, uv, idx = m["positions"], m["uvs"], m["indices"]
+    coincident = zero_uv = 0
+    for c in range(0, len(idx), 3):
+        tri = idx[c:c + 3]
+        pts = [tuple(p[3 * v:3 * v + 3]) for v in tri]
+        if len(set(pts)) < 3:
+            coincident += 1
+            continue
+        (u0, v0), (u1, v1), (u2, v2) = (uv[2 * v:2 * v + 2] for v in tri)
+        zero_uv += (u1 - u0) * (v2 - v0) - (v1 - v0) * (u2 - u0) == 0
+    return coincident, zero_uv
+
+
+def side_branch(answers):
+    """Ten cells grown sideways from the fast bolt's middle cell, each a child of the one before."""
+    a = answers[0][1]
+    cells, parent = a["cells"], a["tree"]["parent"]
+    n = len(cells) // 2
+    x, y = cells[n // 2 * 2], cells[n // 2 * 2 + 1]
+    for k in range(1, 11):
+        cells += [x + k if x + 10 < a["grid"][0] else x - k, y]
+        parent.append(n // 2 if k == 1 else n + k - 2)
+
+
 def cases(quick):
     channel_long = 512 if quick else 4096  # 3 x 65536 (the grid limit) would take about 25 min a bolt
     seeds_long = 1 if quick else 2
+    charges_power = 5.2 * 2 ** 0.7 * (64 / 128) ** 0.2  # the calibration's law (docs/effects.md §1.3)
+    uniform = [bolt(64, eta=0, method=m) for m in ("fast", "dbm", "charges")]
+    charges_pair = [bolt(64, method="charges"), bolt(64, method="charges", variant="paper", eta=charges_power)]
+    examples = os.path.join(ROOT, "proto/examples/tangents")
+    degenerate = {**json.load(open(os.path.join(examples, "04-degenerate-triangles.json"))), "include": FRAMES + ["stats"]}
+    mirrored = json.load(open(os.path.join(examples, "02-mirrored-uvs-split.json")))
+    coincident = {"mesh": {"positions": [0, 0, 0, 0, 0, 0, 1, 1, 0], "uvs": [0, 0, 1, 0, 1, 1], "indices": [0, 1, 2]},
+                  "include": FRAMES}
+    sliver = {"mesh": {"positions": [0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1e-16, 0], "uvs": [0, 0, 1, 0, 0, 1, 1, 0.5],
+                       "indices": [0, 1, 2, 1, 3, 2]}, "include": FRAMES}
+    zero_normals = {"mesh": {**QUAD, "normals": [0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1]}, "include": FRAMES + ["stats"]}
+    zero_at = [v for v in range(4) if not any(zero_normals["mesh"]["normals"][3 * v:3 * v + 3])]
     out = [
         ("fog", "DISTANCE_EXP2, d_c = 1e-9 over [0, 1e6]", "fog",
          fog({"fogType": "DISTANCE_EXP2", "distanceCoefficient": 1e-9}, table={"size": 64, "range": [0, 1e6]}),
@@ -322,10 +824,8 @@ def cases(quick):
         ("fog", "DISTANCE_EXP2, d_c = 1e6", "fog",
          fog({"fogType": "DISTANCE_EXP2", "distanceCoefficient": 1e6}, table={"size": 64, "range": [0, 16]}),
          fog_table(lambda d: math.exp(-1e6 * d * d) if d < 1 else 0.0), "1 at d = 0, exactly 0 after (underflow, not NaN)"),
-        ("fog", "EXPONENTIAL (X3D) at d = 1e300", "fog",
-         fog({"fogType": "EXPONENTIAL", "visibilityRange": 10}, samples={"camera": [0, 0, 0], "points": [[0, 0, -1e300]]},
-             include=["samples"]),
-         fog_samples([0.0]), "f = 0 exactly (d ≥ V)"),
+        fog_points("EXPONENTIAL (X3D) at d = 1e300", {"fogType": "EXPONENTIAL", "visibilityRange": 10}, [[0, 0, -1e300]],
+                   "f = 0 exactly (d ≥ V)"),
         ("fog", "LINEAR (X3D), visibilityRange 1e300", "fog",
          fog({"fogType": "LINEAR", "visibilityRange": 1e300}, table={"size": 32, "range": [0, 1e300]}),
          fog_table(lambda d: max(0.0, (1e300 - d) / 1e300)), "f = (V − d)/V at every entry: 1 down to 0"),
@@ -369,46 +869,53 @@ def cases(quick):
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
              table={"size": 64, "elevations": 16, "cameraHeight": 1e6, "range": [0, 1e7]}),
          fog_table(lambda d, dy: height_f(0.05, 0.2, 0, 1e6, dy, d)), "the closed form with e^(−b·h) underflowing: f = 1 up high"),
-        ("fog", "HEIGHT, horizontal rays inside the layer", "fog",
-         fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
-             samples={"camera": [0, 0, 0], "points": [[1e3, 0, 0], [1e6, 0, 0], [0, 0, -50]]}, include=["samples"]),
-         fog_samples([math.exp(-50), 0.0, math.exp(-2.5)]), "b·Δh → 0: exp(−a·d) at the camera's density"),
-        ("lightning", "η = 0 (uniform growth), 64²", "lightning", bolt(64, eta=0), None,
-         "a connected tree inside the grid that reaches the target"),
+        fog_points("HEIGHT, horizontal rays inside the layer", HEIGHT, [[1e3, 0, 0], [1e6, 0, 0], [0, 0, -50]],
+                   "b·Δh → 0: exp(−a·d) at the camera's density (e^−50, 0, e^−2.5)"),
+    ] + fog_sample_rows() + [
+        ("lightning", "η = 0 (uniform growth), 64², fast, dbm and charges", "lightning", uniform,
+         bolts_equal(uniform, "the same bolt from fast, dbm and charges"),
+         "η = 0 weighs every candidate alike whatever the field (0⁰ = 1, even where Φ underflows): the three methods "
+         "grow the same bolt, cell for cell, a connected tree inside the grid that reaches the target"),
         ("lightning", "η = 50, 64², fast and dbm", "lightning", [bolt(64, eta=50), bolt(64, eta=50, method="dbm")],
-         lambda answers: (ok_status(200, answers) and all(len(cells_of(a)) <= 70 for _, a in answers),
+         lambda answers: (ok_status(200, answers) and all(len(cells_of(a)) <= 70 and not tree_problems(bolt(64), a, cells_of(a))
+                                                          for _, a in answers),
                           "cells " + ", ".join(str(len(cells_of(a))) for _, a in answers) + " (64 is the straight line)"),
-         "weights in log space: an almost straight bolt (≤ 70 cells) from both methods"),
+         "weights in log space: an almost straight bolt (≤ 70 cells, a tree rooted at the start) from both methods",
+         mutation("a 10-cell side branch on the fast bolt (η weakened)", side_branch)),
         ("lightning", "3 × 3 grid, start next to the target", "lightning",
          {"grid": {"width": 3, "height": 3}, "start": [1, 0], "targets": [[1, 1]], "include": ["cells"]},
          lambda answers: (answers[0][0] == 200 and answers[0][1]["cells"] == [1, 0, 1, 1], f"cells {answers[0][1].get('cells')}"),
-         "the bolt is exactly the two cells"),
+         "the bolt is exactly the two cells",
+         mutation("the second cell one step diagonal of the target", lambda answers: answers[0][1]["cells"].__setitem__(2, 0))),
         ("lightning", f"{1024 if quick else 4096}², fast", "lightning", bolt(1024 if quick else 4096), None,
          "a connected tree that reaches the target"),
         ("lightning", "walled-in target", "lightning", walled(32), problem(422, "/targets/0"),
          "A* proves it unreachable first: a 422 naming the target"),
         ("lightning", "one-cell corridor, dbm", "lightning", corridor(48),
-         lambda answers: (answers[0][0] == 200 and len(cells_of(answers[0][1])) == 48,
-                          f"{len(cells_of(answers[0][1]))} cells"), "the bolt is the corridor: 48 cells"),
+         lambda answers: (answers[0][0] == 200 and cells_of(answers[0][1]) == [(24, y) for y in range(48)]
+                          and not tree_problems(corridor(48), answers[0][1], cells_of(answers[0][1])),
+                          f"{len(cells_of(answers[0][1]))} cells"),
+         "the bolt is the corridor, cell for cell: x = 24, y = 0 … 47 in order, a tree",
+         mutation("the last cell missing (a bolt one short)", lambda answers: answers[0][1]["cells"].__delitem__(slice(-2, None)))),
         ("lightning", "dbm at tolerance 1e-12 (its limit), 48²", "lightning", bolt(48, method="dbm", solver="mgpcg", tolerance=1e-12),
-         lambda answers: (answers[0][0] == 200 and answers[0][1]["stats"]["counters"]["residual"] <= 1e-12,
-                          f"residual {answers[0][1]['stats']['counters']['residual']:.2g}"), "the relative residual reached ≤ 1e-12"),
+         bolt_ok(bolt(48, method="dbm", solver="mgpcg", tolerance=1e-12),
+                 lambda a: (a["stats"]["counters"]["residual"] <= 1e-12, f"residual {a['stats']['counters']['residual']:.2g}")),
+         "the relative residual reached ≤ 1e-12; a connected tree to the target",
+         mutation("the residual ×100 (a solve stopped early)",
+                  lambda answers: answers[0][1]["stats"]["counters"].update(residual=100 * answers[0][1]["stats"]["counters"]["residual"]))),
         ("lightning", "dbm at tolerance 0.1 (its limit), 48²", "lightning", bolt(48, method="dbm", solver="mgpcg", tolerance=0.1),
          None, "a loose solve still grows a connected tree to the target"),
-        ("lightning", "charges, 64², η 2", "lightning", bolt(64, method="charges"), None,
-         f"a connected tree; the power that ran is 5.2·η^0.7·(64/128)^0.2 = {5.2 * 2 ** 0.7 * 0.5 ** 0.2:.4f}"),
+        ("lightning", "charges, 64², η 2", "lightning", charges_pair,
+         bolts_equal(charges_pair, f"the paper variant's bolt at η = {charges_power:.4f}"),
+         f"a connected tree, the same cell for cell as the paper variant's (power = η) at η = 5.2·2^0.7·(64/128)^0.2 = "
+         f"{charges_power:.4f} with the same seed: the calibration's power law ran",
+         regrown(bolt(64, method="charges", variant="paper"), "the bolt at power η = 2 (the calibration not applied)")),
         ("lightning", "3-D, fast, 64³", "lightning",
          {"grid": {"width": 64, "height": 64, "depth": 64}, "start": [32, 0, 32], "targets": [[32, 63, 32]],
           "include": ["cells", "tree", "stats"]}, None, "a connected 26-neighbour tree that reaches the target"),
     ]
-    # The charges power is a closed form of η and the grid.
     for i, c in enumerate(out):
-        if c[1] == "charges, 64², η 2":
-            body = c[3]
-            power = 5.2 * 2 ** 0.7 * (64 / 128) ** 0.2
-            out[i] = c[:4] + (bolt_ok(body, lambda a: (abs(a["stats"]["counters"]["chargesEta"] - power) < 1e-9,
-                                                       f"power {a['stats']['counters']['chargesEta']:.4f}")),) + c[5:]
-        elif c[4] is None:
+        if c[4] is None:
             out[i] = c[:4] + (bolt_ok(c[3]),) + c[5:]
     for width in (3, 5, 7, 9):
         runs = [(64, s) for s in range(1, 5)] + [(channel_long, s) for s in range(1, seeds_long + 1)]
@@ -431,15 +938,15 @@ def cases(quick):
     wob = {"time": 7, "camera": [0, 0, 3], "params": {"wobbleAmplitude": 0.1, "wobbleFrequency": 5},
            "mesh": {"level": 2, "radius": 1}, "include": ["mesh"]}
     out += [
-        ("bubble", "grazing view, TIR (n₁ 1.5 outside, n₂ 1.0)", "bubble", bub,
-         lambda answers: (answers[0][0] == 200 and all(math.isfinite(v) for v in answers[0][1]["mesh"]["finalVectors"]),
-                          f"{len(answers[0][1]['mesh']['finalVectors']) // 3} final vectors, all finite"),
-         "eqn 8 past the critical angle (T = 0): finite at the silhouette"),
+        ("bubble", "grazing view, TIR (n₁ 1.5 outside, n₂ 1.0)", "bubble", bub, final_vectors(bub),
+         "eqn 8 past the critical angle (T = 0): every vertex's final vector equals R·μ_top + T computed here from its "
+         "position and normal (within 1e-5), finite at the silhouette"),
         ("bubble", "film thickness 0 … 1e4 nm; n₂ = 1", "bubble",
          [{"features": {"iridescence": True}, "thinFilm": {"thicknessRange": [0, 10000], "width": 64, "height": 16},
            "include": ["thinFilm"]},
           {"features": {"iridescence": True}, "params": {"n2": 1}, "thinFilm": {"width": 16, "height": 16}, "include": ["thinFilm"]}],
-         thin_film_zero_and_air, "thickness 0 reflects nothing (1 only at grazing); a film of air's index reflects nothing"),
+         thin_film_zero_and_air, "thickness 0 reflects nothing (1 only at grazing); a film of air's index reflects nothing",
+         mutation("thickness 0 reflecting 1 % off grazing", zero_film_reflects)),
         ("bubble", "n₂ = 1 + 1e-6: a film barely denser than air", "bubble",
          {"features": {"iridescence": True}, "params": {"n2": 1 + 1e-6}, "thinFilm": {"width": 16, "height": 16},
           "include": ["thinFilm"]}, faint_film(1 + 1e-6),
@@ -450,50 +957,51 @@ def cases(quick):
            "include": ["mesh"]} for t in (1e9, math.fmod(1e9, math.pi))],
          lambda answers: (ok_status(200, answers) and worst(answers[0][1]["mesh"]["positions"], answers[1][1]["mesh"]["positions"]) <= 1e-5,
                           f"max |p(1e9) − p(1e9 mod π)| {worst(answers[0][1]['mesh']['positions'], answers[1][1]['mesh']['positions']):.2g}"),
-         "the wobble's phase δ·t reduced mod 2π in double: the mesh at 1e9 s equals the mesh at 1e9 mod π s (δ = 2)"),
+         "the wobble's phase δ·t reduced mod 2π in double: the mesh at 1e9 s equals the mesh at 1e9 mod π s (δ = 2)",
+         mutation("one vertex at 1e9 s nudged by 1e-4", lambda answers: answers[0][1]["mesh"]["positions"].__setitem__(
+             0, answers[0][1]["mesh"]["positions"][0] + 1e-4))),
         ("bubble", "wobble at its bound (amplitude × frequency 0.5), t = 7", "bubble", wob, checked_by_sweep(wob),
          "dented, never folded: no triangle inverted or degenerate"),
         ("bubble", "the paper's literal wobble (amplitude 1, frequency 1)", "bubble",
          {"time": 7, "params": {"wobbleVariant": "paper", "wobbleAmplitude": 1}, "include": ["mesh"]},
-         lambda answers: (answers[0][0] == 422 and bool((answers[0][1].get("errors") or [{}])[0].get("pointer")),
-                          f"{answers[0][0]} at {(answers[0][1].get('errors') or [{}])[0].get('pointer')}"),
-         "its Jacobian reaches 0: a 422 naming the field"),
+         problem(422, "/params/wobbleAmplitude"), "its Jacobian reaches 0: a 422 naming the field"),
         ("bubble", "radius 1e-6 under the paper's wobble of 0.05", "bubble",
          {"time": 1, "params": {"wobbleVariant": "paper", "wobbleAmplitude": 0.05}, "mesh": {"level": 2, "radius": 1e-6},
           "include": ["mesh"]},
-         lambda answers: (answers[0][0] == 422, f"{answers[0][0]}"), "float32 cannot hold the shape: a 422, not a collapsed mesh"),
+         problem(422, "/mesh/radius"), "float32 cannot hold the shape: a 422 naming the radius, not a collapsed mesh"),
         ("bubble", "radius 1e-6 and 1e6, relative wobble", "bubble",
          [{"time": 7, "mesh": {"level": 2, "radius": r}, "include": ["mesh"]} for r in (1e-6, 1e6)],
          bubble_scale_invariant([1e-6, 1e6]), "the same shape at every size (positions / radius equal within 1e-5)"),
         ("bubble", "film swirl 10, swirl speed 1e6, t = 1e12", "bubble",
          {"time": 1e12, "film": {"swirl": 10, "swirlSpeed": 1e6, "width": 32, "height": 16}, "include": ["thickness"]},
-         lambda answers: (answers[0][0] == 200 and all(math.isfinite(v) and 0 < v <= 1000 for v in answers[0][1]["thickness"]["nm"]),
-                          f"thickness in [{min(answers[0][1]['thickness']['nm']):.4g}, {max(answers[0][1]['thickness']['nm']):.4g}] nm"),
-         "within the drainage profile's (0, 1000] nm"),
-        ("tangents", "zero-area triangles and zero-area UVs", "tangents",
-         {**json.load(open(os.path.join(ROOT, "proto/examples/tangents/04-degenerate-triangles.json"))),
-          "include": ["tangents", "normals", "stats"]},
-         unit_frames(lambda a: (a["stats"]["counters"].get("degenerateTriangles", 0) > 0,
-                                f"{a['stats']['counters'].get('degenerateTriangles', 0):g} degenerate triangles counted")),
-         "unit frames ⟂ normals everywhere, the degenerate triangles counted"),
-        ("tangents", "mirrored UVs", "tangents", json.load(open(os.path.join(ROOT, "proto/examples/tangents/02-mirrored-uvs-split.json"))),
-         unit_frames(lambda a: ({-1.0, 1.0} <= set(a["tangents"][3::4]), f"handedness {sorted(set(a['tangents'][3::4]))}")),
-         "both handednesses present (−1 where mirrored)"),
-        ("tangents", "coincident corners", "tangents",
-         {"mesh": {"positions": [0, 0, 0, 0, 0, 0, 1, 1, 0], "uvs": [0, 0, 1, 0, 1, 1], "indices": [0, 1, 2]}},
-         unit_frames(), "no area: the fallback frame, unit and finite"),
-        ("tangents", "a triangle of area 1e-16 beside a healthy one", "tangents",
-         {"mesh": {"positions": [0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1e-16, 0], "uvs": [0, 0, 1, 0, 0, 1, 1, 0.5],
-                   "indices": [0, 1, 2, 1, 3, 2]}},
-         unit_frames(), "the sliver's frame is unit, finite and orthogonal to its normal"),
-        ("tangents", "zero-length given normals", "tangents",
-         {"mesh": {**QUAD, "normals": [0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1]}, "include": ["tangents", "normals", "stats"]},
-         unit_frames(lambda a: (a["stats"]["counters"].get("replacedNormals") == 2,
-                                f"replacedNormals {a['stats']['counters'].get('replacedNormals')}")),
-         "the two zero normals replaced by +z and counted"),
+         drained_film(300),
+         "drained (α = 1 past 20 s): every texel within the profile's [0, H] = [0, 300] nm, its bottom near 300"),
+        ("tangents", "zero-area triangles and zero-area UVs", "tangents", degenerate,
+         unit_frames(degenerate, lambda a: (
+             [a["stats"]["counters"].get(k) for k in ("degenerateTriangles", "zeroUvAreaTriangles")] == list(bad_triangles(degenerate)),
+             f"{a['stats']['counters'].get('degenerateTriangles', 0):g} triangles with coincident corners and "
+             f"{a['stats']['counters'].get('zeroUvAreaTriangles', 0):g} of zero UV area counted")),
+         "unit frames ⟂ normals everywhere, the fallback frame where no triangle gives one; the counters equal the "
+         f"script's count: {bad_triangles(degenerate)[0]} triangles with coincident corners, {bad_triangles(degenerate)[1]} "
+         "with zero UV area"),
+        ("tangents", "mirrored UVs", "tangents", mirrored,
+         unit_frames(mirrored, lambda a: ({-1.0, 1.0} <= set(a["tangents"][3::4]), f"handedness {sorted(set(a['tangents'][3::4]))}")),
+         "both handednesses present: each corner's w the sign of its triangle's UV area, its tangent along ∂p/∂u"),
+        ("tangents", "coincident corners", "tangents", coincident, unit_frames(coincident),
+         "no area: the fallback frame ((1, 0, 0) in the normal's plane, w = −1), unit and finite"),
+        ("tangents", "a triangle of area 1e-16 beside a healthy one", "tangents", sliver, unit_frames(sliver),
+         "the sliver's frame is unit, finite, orthogonal to its normal and along its ∂p/∂u"),
+        ("tangents", "zero-length given normals", "tangents", zero_normals,
+         unit_frames(zero_normals, lambda a: (
+             a["stats"]["counters"].get("replacedNormals") == len(zero_at)
+             and all(a["normals"][3 * v:3 * v + 3] == [0, 0, 1] for v in zero_at),
+             f"replacedNormals {a['stats']['counters'].get('replacedNormals')}, normals "
+             + ", ".join(str(a["normals"][3 * v:3 * v + 3]) for v in zero_at))),
+         f"the {len(zero_at)} zero normals (vertices {', '.join(map(str, zero_at))}) replaced by +z and counted; frames along ∂p/∂u"),
         ("tangents", "coordinates at 1e-30, 1e6 and 1e38 scale", "tangents",
-         [{"mesh": scaled(QUAD, k)} for k in (1, 1e-30, 1e6, 1e38)], tangents_equal_at_scales([1e-30, 1e6, 1e38]),
-         "tangents are directions: the same as at scale 1 within 1e-6"),
+         [{"mesh": scaled(QUAD, k), "include": FRAMES} for k in (1, 1e-30, 1e6, 1e38)],
+         tangents_equal_at_scales({"mesh": QUAD}, [1e-30, 1e6, 1e38]),
+         "tangents are directions: the same as at scale 1 within 1e-6, along ∂p/∂u at every scale"),
     ]
     return out
 
@@ -501,11 +1009,33 @@ def cases(quick):
 SERVER = None
 
 
-def run_cases(server, quick):
+DEFAULT_MUTATIONS = {"lightning": mutation(CELL_OFF, cell_off),
+                     "tangents": mutation("the first frame flipped (t → −t)", flip_frame)}
+
+
+def try_mutation(check, answers, mutated):
+    """(column text, caught): the row's mutation fed to its own check, which must reject it."""
+    if mutated is None:
+        return "none", False
+    text, fn = mutated
+    try:
+        wrong = fn(answers)
+    except Exception as e:  # noqa: BLE001  (a mutation that cannot be made proves nothing)
+        return f"{text} (could not be made: {e!r})", False
+    try:
+        ok, _ = check(wrong)
+    except Exception:  # noqa: BLE001  (a check that cannot read the wrong answer rejects it)
+        ok = False
+    return text, not ok
+
+
+def run_cases(server, quick, mutations=False):
     global SERVER
     SERVER = server
     rows = []
-    for effect, name, endpoint, bodies, check, must in cases(quick):
+    for row in cases(quick):
+        effect, name, endpoint, bodies, check, must = row[:6]
+        mutated = row[6] if len(row) > 6 else getattr(check, "mutation", None) or DEFAULT_MUTATIONS.get(effect)
         bodies = bodies if isinstance(bodies, list) else [bodies]
         answers, ms = [], []
         for b in bodies:
@@ -516,11 +1046,20 @@ def run_cases(server, quick):
             ok, seen = check(answers)
         except Exception as e:  # noqa: BLE001  (a check that cannot read the answer fails its row)
             ok, seen = False, f"check could not read the answer: {e!r}"
+        if mutations and not ok:
+            caught = True  # the row fails the run already; its answers are no base for a mutation
+            mut = f"{mutated[0] if mutated else 'none'}: not tried (the check failed)"
+        elif mutations:
+            text, caught = try_mutation(check, answers, mutated)
+            mut = f"{text}: {'caught' if caught else 'NOT caught'}"
+        else:
+            mut = f"{mutated[0] if mutated else 'none'} (not run: --mutations)"
         method = answers[0][1].get("method", "") if answers[0][0] == 200 else ""
         msq = sorted(ms)[len(ms) // 2]
         rows.append((effect, name, "/".join(sorted({str(s) for s, _ in answers})), method, f"{msq:.1f}", must, seen,
-                     "✓" if ok else "✗ FAILED"))
-        print(f"{'ok  ' if ok else 'FAIL'} {effect}: {name}: {seen}", flush=True)
+                     mut, "✓" if ok else "✗ FAILED"))
+        print(f"{'ok  ' if ok else 'FAIL'} {effect}: {name}: {seen}"
+              + (f" [mutation {'caught' if caught else 'NOT CAUGHT'}]" if mutations else ""), flush=True)
     return rows
 
 
@@ -528,7 +1067,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("binary")
     ap.add_argument("--quick", action="store_true", help="smaller sizes of the heavy cases")
-    ap.add_argument("--check", action="store_true", help="exit 1 when a check fails")
+    ap.add_argument("--check", action="store_true", help="exit 1 when a check fails (or, with --mutations, misses its mutation)")
+    ap.add_argument("--mutations", action="store_true", help="feed each row's mutation (a plausible wrong answer) to its check")
     ap.add_argument("--no-sweep", action="store_true")
     ap.add_argument("--sweep-requests", type=int, default=3000)
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "stability.md"))
@@ -536,26 +1076,38 @@ def main():
     args = ap.parse_args()
     server = Server(args.binary, 600)
     try:
-        rows = run_cases(server, args.quick)
+        rows = run_cases(server, args.quick, args.mutations)
     finally:
         server.stop()
     failed = [r for r in rows if not r[-1].startswith("✓")]
+    missed = [r for r in rows if r[7].endswith("NOT caught")] if args.mutations else []
+    caught = sum(r[7].endswith(": caught") for r in rows)
+    untried = sum(r[7].endswith("not tried (the check failed)") for r in rows)
+    command = ("scripts/stability-report.py build/server/effectd" + (" --quick" if args.quick else "")
+               + (" --mutations" if args.mutations else ""))
     md = ["# Numerical stability: stiff and extreme cases, checked",
           "",
-          stamp(args.command or "scripts/stability-report.py build/server/effectd" + (" --quick" if args.quick else ""),
-                "stability.md"),
+          stamp(args.command or command, "stability.md"),
           "",
           "Each row is one or more requests to the running server and a check that can fail: a closed form "
           "computed by the script (docs/effects.md's formulas, not the server's code), an invariance between "
           "requests (the same answer at another scale, length or size), or the exact 4xx it must get. "
           "A row is right only when its check passes (✓); `--check` makes a failed row fail the run, and the test "
           "suite runs the quick sizes that way (`stability_checks` in ctest). ms: the median request's "
-          "wall-clock time from the client.",
+          "wall-clock time from the client. Fog factors, transmittances and colours are compared within 2e-6 and, "
+          "above 1e-30, within 1e-5 relative (so that e^−50 1 % off fails); a bolt's \"connected tree\" is checked "
+          "cell by cell: rooted at the start, every parent grown before its child and a grid neighbour of it, no cell "
+          "twice, the main channel the parent chain from the start to the target. "
+          "mutation: a plausible wrong answer made from the real ones and fed to "
+          "the same check (`--mutations`), which must reject it (caught); with `--check` one it lets through fails "
+          "the run too.",
           "",
-          f"**{len(rows) - len(failed)} of {len(rows)} checks pass.**",
+          f"**{len(rows) - len(failed)} of {len(rows)} checks pass"
+          + (f"; {caught} of {len(rows)} mutations caught" + (f" ({untried} not tried: their rows fail)" if untried else "")
+             if args.mutations else "") + ".**",
           "",
-          "| effect | case | status | method | ms | must hold | seen | check |",
-          "|---|---|---|---|---|---|---|---|"]
+          "| effect | case | status | method | ms | must hold | seen | mutation | check |",
+          "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         md.append("| " + " | ".join(x.replace("|", "\\|") for x in r) + " |")
     if not args.no_sweep:
@@ -582,8 +1134,11 @@ def main():
             failed.append(f)
     with open(args.out, "w") as o:
         o.write("\n".join(md) + "\n")
-    print(f"wrote {args.out}: {len(rows)} checks, {len(failed)} failed")
-    if args.check and failed:
+    print(f"wrote {args.out}: {len(rows)} checks, {len(failed)} failed"
+          + (f"; {caught} mutations caught, {len(missed)} not, {untried} not tried (their rows failed)" if args.mutations else ""))
+    for r in missed:
+        print(f"mutation NOT caught: {r[0]}: {r[1]}: {r[7]}")
+    if args.check and (failed or missed):
         sys.exit(1)
 
 

@@ -190,8 +190,7 @@ TEST(FogApi, DirectionalGlowInTables) {
   auto bytes = base64Decode(t["inscatterData"].get<std::string>());
   ASSERT_TRUE(bytes);
   EXPECT_EQ(bytes->size(), 17u * 2);
-  auto p = expectProblem(
-      s.postJson("/v1/fog", json{{"fog", {{"directional", {{"direction", {0, 0, 0}}}}}}}), 400);
+  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"directional", {{"direction", {0, 0, 0}}}}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/fog/directional/direction")) << p;
   p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"directional", {{"g", 1}}}}}}), 400);
   EXPECT_TRUE(hasPointer(p, "/fog/directional/g")) << p;
@@ -199,8 +198,11 @@ TEST(FogApi, DirectionalGlowInTables) {
 
 TEST(FogApi, AtmosphericTablesPerChannel) {
   TestServer s;
-  json req = {{"fog", {{"fogType", "ATMOSPHERIC"}, {"color", {1, 0.5, 0.25}}, {"extinction", {0.1, 0.2, 0.3}},
-                       {"inscattering", {0.05, 0.1, 0.2}}}},
+  json req = {{"fog",
+               {{"fogType", "ATMOSPHERIC"},
+                {"color", {1, 0.5, 0.25}},
+                {"extinction", {0.1, 0.2, 0.3}},
+                {"inscattering", {0.05, 0.1, 0.2}}}},
               {"table", {{"size", 5}, {"range", {0, 10}}}},
               {"objectColors", {{0.2, 0.4, 0.6}}}};
   json t = json::parse(s.postJson("/v1/fog", req)->body)["table"];
@@ -217,7 +219,8 @@ TEST(FogApi, AtmosphericTablesPerChannel) {
   json sample = json::parse(s.postJson("/v1/fog", req)->body)["samples"][0];
   EXPECT_NEAR(sample["transmittance"][2].get<double>(), tr, 1e-6);
   EXPECT_NEAR(sample["fogColor"][2].get<double>(), sc, 1e-6);
-  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "ATMOSPHERIC"}, {"extinction", {0, -1, 0}}}}}), 400);
+  auto p = expectProblem(s.postJson("/v1/fog", json{{"fog", {{"fogType", "ATMOSPHERIC"}, {"extinction", {0, -1, 0}}}}}),
+                         400);
   EXPECT_TRUE(hasPointer(p, "/fog/extinction/1")) << p;
 }
 
@@ -230,7 +233,6 @@ TEST(FogApi, TableOverTheLimitIs413) {
   EXPECT_TRUE(hasPointer(p, "/table/size")) << p;
   EXPECT_NE(p["detail"].get<std::string>().find("--max-table-size"), std::string::npos) << p;  // the flag to raise
 }
-
 
 // The fog function for an engine's own shader, per fog type and with regions, in every
 // language: the GLSL snippet holds only the used type's formula; SPIR-V passes spirv-val; HLSL
@@ -289,14 +291,15 @@ TEST(FogApi, ShaderFunctionForEveryTypeInEveryLanguage) {
 TEST(FogApi, ShaderFunctionForEachConvention) {
   TestServer s;
   for (const char* convention : {"filament", "unreal"}) {
-    json body = {{"fog",
-                  {{"fogType", "HEIGHT"},
-                   {"convention", convention},
-                   {"density", 0.05},
-                   {"startDistance", 2},
-                   {"directional", {{"exponent", 8}, {"startDistance", 10}}}}},
-                 {"regions", {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "HEIGHT"}}}}}},
-                 {"include", {"shader"}}};
+    json body = {
+        {"fog",
+         {{"fogType", "HEIGHT"},
+          {"convention", convention},
+          {"density", 0.05},
+          {"startDistance", 2},
+          {"directional", {{"exponent", 8}, {"startDistance", 10}}}}},
+        {"regions", {{{"sphere", {{"center", {0, 0, -10}}, {"radius", 3}}}, {"fog", {{"fogType", "HEIGHT"}}}}}},
+        {"include", {"shader"}}};
     if (std::string(convention) == "unreal") body["fog"]["secondLayer"] = {{"density", 0.01}};
     auto r = s.postJson("/v1/fog", body);
     ASSERT_EQ(r->status, 200) << r->body;
@@ -316,6 +319,36 @@ TEST(FogApi, ShaderFunctionForEachConvention) {
     EXPECT_TRUE(toolAccepts("glslangValidator -V -o /dev/null -D -e main -S frag", hlsl["shader"]["code"], ".hlsl"))
         << convention << hlsl["shader"]["code"].get<std::string>();
   }
+}
+
+// The error pass is its own Server-Timing stage and a choice: a HEIGHT table measured (error
+// stage, kind measured) and not (no error stage, kind estimate, the same table).
+double stage(const std::string& timing, const std::string& name) {
+  const size_t at = timing.find(name + ";dur=");
+  return at == std::string::npos ? -1 : std::stod(timing.substr(at + name.size() + 5));
+}
+
+TEST(FogApi, ErrorMeasurementIsAStageAndAChoice) {
+  TestServer s;
+  json req = {{"fog", {{"fogType", "HEIGHT"}, {"density", 0.05}, {"heightFalloff", 0.2}}},
+              {"table", {{"size", 128}, {"cameraHeight", 2}}}};
+  auto measured = s.postJson("/v1/fog", req);
+  req["table"]["measureError"] = false;
+  auto estimated = s.postJson("/v1/fog", req);
+  ASSERT_TRUE(measured && estimated);
+  ASSERT_EQ(measured->status, 200) << measured->body;
+  ASSERT_EQ(estimated->status, 200) << estimated->body;
+  const std::string tm = measured->get_header_value("Server-Timing"), te = estimated->get_header_value("Server-Timing");
+  EXPECT_GT(stage(tm, "error"), stage(tm, "compute")) << tm;  // 8 evaluations an entry against 1
+  EXPECT_EQ(stage(te, "error"), -1) << te;
+  json a = json::parse(measured->body), b = json::parse(estimated->body);
+  EXPECT_EQ(a["table"]["factor"], b["table"]["factor"]);
+  EXPECT_EQ(a["error"]["kind"], "measured");
+  EXPECT_EQ(b["error"]["kind"], "estimate");
+  // The estimate (second differences / 8) is of the measured error's order.
+  const double m = a["error"]["maxError"].get<double>(), e = b["error"]["maxError"].get<double>();
+  EXPECT_GT(e, m / 10) << m << " " << e;
+  EXPECT_LT(e, m * 10) << m << " " << e;
 }
 
 }  // namespace

@@ -229,17 +229,18 @@ TEST(LightningApi, WalledTargetIs422NotAHang) {
 
 // 3-D: a bolt from a cloud layer down to a tower, around a building block, in world units.
 json volumeRequest() {
-  return {{"grid", {{"width", 32}, {"height", 32}, {"depth", 32}}},
-          {"start", {16, 0, 16}},
-          {"targets", {{20, 31, 8}}},
-          {"world", {{"origin", {-16.0, 32.0, 16.0}}, {"cellSize", 0.5}}},
-          {"obstacles",
-           {{"boxes", {{6, 14, 6, 14, 6, 14}}},
-            {"rows", {{{"y", 25}, {"z", 3}, {"runs", {{0, 10}, {20, 5}}}}}},
-            {"spheres", {{{"center", {-8.0, 20.0, 4.0}}, {"radius", 2.0}}}},
-            {"mesh", {{"positions", {-14.0, 28.0, 14.0, 2.0, 28.0, 14.0, -14.0, 28.0, -2.0}}, {"indices", {0, 1, 2}}}}}},
-          {"seed", 3},
-          {"include", {"polylines", "cells", "guide", "fractalDimension", "timeline"}}};
+  return {
+      {"grid", {{"width", 32}, {"height", 32}, {"depth", 32}}},
+      {"start", {16, 0, 16}},
+      {"targets", {{20, 31, 8}}},
+      {"world", {{"origin", {-16.0, 32.0, 16.0}}, {"cellSize", 0.5}}},
+      {"obstacles",
+       {{"boxes", {{6, 14, 6, 14, 6, 14}}},
+        {"rows", {{{"y", 25}, {"z", 3}, {"runs", {{0, 10}, {20, 5}}}}}},
+        {"spheres", {{{"center", {-8.0, 20.0, 4.0}}, {"radius", 2.0}}}},
+        {"mesh", {{"positions", {-14.0, 28.0, 14.0, 2.0, 28.0, 14.0, -14.0, 28.0, -2.0}}, {"indices", {0, 1, 2}}}}}},
+      {"seed", 3},
+      {"include", {"polylines", "cells", "guide", "fractalDimension", "timeline"}}};
 }
 
 TEST(LightningApi, VolumeBoltInWorldUnits) {
@@ -360,7 +361,8 @@ TEST(LightningApi, TargetRegionStrikesTheGroundAndShapeDescribesTheBolt) {
     for (int parent : j["tree"]["parent"])
       if (parent >= 0) ++children[size_t(parent)];
     EXPECT_EQ(j["shape"]["tips"], std::count(children.begin(), children.end(), 0));
-    EXPECT_EQ(j["shape"]["branchPoints"], std::count_if(children.begin(), children.end(), [](int c) { return c >= 2; }));
+    EXPECT_EQ(j["shape"]["branchPoints"],
+              std::count_if(children.begin(), children.end(), [](int c) { return c >= 2; }));
     EXPECT_GT(j["shape"]["fractalDimension"].get<double>(), 0.8);
   }
   json plain = request(48);  // without a region: no "struck"
@@ -391,6 +393,28 @@ TEST(LightningApi, TargetRegionStrikesTheGroundAndShapeDescribesTheBolt) {
   bad = req;
   bad.erase("targetRegion");
   problem(bad, 400, "");  // neither targets nor a region: the schema's anyOf
+}
+
+// The reference's solves are the error stage, not compute: the fast method at 64^2 takes well
+// under a millisecond, its converged DBM reference per step tens.
+TEST(LightningApi, ReferenceSolvesAreTheErrorStageNotCompute) {
+  TestServer s;
+  json req = {{"grid", {{"width", 64}, {"height", 64}}},
+              {"start", {32, 0}},
+              {"targets", {{32, 63}}},
+              {"include", {"error", "stats"}}};
+  auto r = s.postJson("/v1/lightning", req);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const std::string timing = r->get_header_value("Server-Timing");
+  const auto dur = [&](const std::string& name) {
+    const size_t at = timing.find(name + ";dur=");
+    return at == std::string::npos ? -1.0 : std::stod(timing.substr(at + name.size() + 5));
+  };
+  json j = json::parse(r->body);
+  EXPECT_EQ(j["error"]["kind"], "measured");
+  EXPECT_GT(dur("error"), 5 * dur("compute")) << timing;
+  EXPECT_NEAR(j["stats"]["errorMs"].get<double>(), dur("error"), 1e-3) << timing;
 }
 
 }  // namespace

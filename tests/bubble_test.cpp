@@ -118,15 +118,16 @@ TEST(Bubble, WobbleAndMotionByHand) {
   p.wobbleVariant = WobbleVariant::kPaper;  // eqn 11 in object units
   p.wobbleAmplitude = 0.5;
   p.wobbleFrequency = 1;
-  const double t = 0.25;  // phase 0.5
+  const double t = 0.25;                         // phase 0.5
   dvec3 w = wobble(p, {0.1, 0.2, 0.3}, t, 7.0);  // the paper's wobble ignores the radius
   expectVec(w, {0.1 + 0.5 * std::sin(0.6), 0.2 + 0.5 * std::cos(0.7), 0.3 + 0.5 * std::sin(0.8)}, 1e-12);
   // The relative wobble scales with the radius: a sphere 10x larger moves 10x as far.
   Params r;
   const double k = r.wobbleFrequency, a = r.wobbleAmplitude;
   w = wobble(r, {1, 2, 3}, t, 10.0);
-  expectVec(w, {1 + 10 * a * std::sin(0.5 + k * 0.1), 2 + 10 * a * std::cos(0.5 + k * 0.2),
-                3 + 10 * a * std::sin(0.5 + k * 0.3)},
+  expectVec(w,
+            {1 + 10 * a * std::sin(0.5 + k * 0.1), 2 + 10 * a * std::cos(0.5 + k * 0.2),
+             3 + 10 * a * std::sin(0.5 + k * 0.3)},
             1e-12);
   expectVec(wobble(r, {0.1, 0.2, 0.3}, t, 1.0) * 10.0, w, 1e-12);
   expectVec(moveTowards({0, 0, 0}, {2, 4, 6}, 0.5), {1, 2, 3});
@@ -271,7 +272,8 @@ TEST(BubbleShader, EveryVariantCompilesAndHoldsOnlyItsFeatures) {
       f.shading = model;
       bool* paperFlags[] = {&f.reflection, &f.refraction, &f.rim, &f.textureFlow, &f.wobble, &f.iridescence};
       bool* filmFlags[] = {&f.wobble, &f.thickness, &f.backFace, &f.highlight};
-      for (size_t k = 0; k < marks.size(); ++k) *(model == Shading::kPaper ? paperFlags : filmFlags)[k] = mask & (1 << k);
+      for (size_t k = 0; k < marks.size(); ++k)
+        *(model == Shading::kPaper ? paperFlags : filmFlags)[k] = mask & (1 << k);
       for (Glsl v : {Glsl::kEs300, Glsl::kCore330}) {
         ShaderSource s = shader(f, v);
         std::string log;
@@ -434,6 +436,78 @@ TEST(ThinFilm, ErrorFallsAsWavelengthSamplesGrow) {
     for (float v : t.value().rgb) EXPECT_TRUE(std::isfinite(v));
   }
   EXPECT_LT(previous, 0.1);
+}
+
+// The incoherent limit per polarisation, 2 R12 / (1 + R12), averaged over s and p: what a film
+// whose fringes are far finer than the eye's spectral resolution reflects, at every wavelength.
+double incoherent(double n, double c) {
+  const double ct = std::sqrt(1 - (1 - c * c) / (n * n));
+  const double rs = (c - n * ct) / (c + n * ct), rp = (n * c - ct) / (n * c + ct);
+  return 0.5 * (2 * rs * rs / (1 + rs * rs) + 2 * rp * rp / (1 + rp * rp));
+}
+
+// A second method for the reference: 400 000 samples of the Airy reflectance (1 000 in each
+// 1 nm band, averaged by brute force) weighed by the 1 nm colour matching, before gamut mapping.
+glm::dvec3 bruteForce(double n, double d, double c) {
+  const SpectrumToRgb toRgb(400);
+  std::vector<double> R;
+  for (double nm : toRgb.wavelengthsNm()) {
+    double sum = 0;
+    for (int k = 0; k < 1000; ++k) sum += filmReflectance(n, d, c, nm - 0.5 + (k + 0.5) / 1000);
+    R.push_back(sum / 1000);
+  }
+  return toRgb(R.data());
+}
+
+TEST(ThinFilm, ReferenceConvergesAndMeetsTheIncoherentLimit) {
+  for (double d : {300.0, 5000.0, 1e5})
+    for (double c : {1.0, 0.5, 0.1}) {
+      const glm::dvec3 a = filmColorReference(1.33, d, c), b = filmColorReference(1.33, d, c, 1.0 / 48);
+      EXPECT_LT(glm::length(a - b), 1e-6) << d << " nm, cos " << c;
+    }
+  // At 100 um the fringes are ~0.1 nm apart: the film is grey at the incoherent limit (the old
+  // reference, 400 midpoint samples, was 25 % off here).
+  for (double c : {1.0, 0.5, 0.1}) {
+    const double limit = incoherent(1.33, c);
+    const glm::dvec3 ref = filmColorReference(1.33, 1e5, c);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(ref[k], limit, 0.01 * limit) << "cos " << c << " channel " << k;
+  }
+  // The brute-force integral agrees with the quadrature (in gamut: both are greys or soft colours).
+  for (double d : {500.0, 1e5}) {
+    const glm::dvec3 ref = filmColorReference(1.33, d, 0.8), brute = bruteForce(1.33, d, 0.8);
+    EXPECT_LT(deltaE(ref, intoGamut(brute)), 0.05) << d;
+  }
+}
+
+TEST(ThinFilm, TableIsRightUpToTheSchemasHundredMicrometres) {
+  ThinFilmOptions o;
+  o.thicknessMinNm = 99000;
+  o.thicknessMaxNm = 100000;
+  o.width = o.height = 16;
+  auto t = thinFilmTable(o);
+  ASSERT_TRUE(t.ok());
+  EXPECT_LT(t.value().maxDeltaE, 1.0);  // was 0.084 off on values of 0.1 (16 midpoint samples aliased)
+  for (int y = 1; y < 16; ++y) {        // every texel near the incoherent grey
+    const double limit = incoherent(1.33, y / 15.0);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(t.value().rgb[size_t(y * 16 + 7) * 3 + k], limit, 0.03 * limit + 1e-3);
+  }
+}
+
+TEST(ThinFilm, ColoursStayInTheSrgbGamut) {
+  ThinFilmOptions o;
+  o.width = o.height = 64;
+  auto t = thinFilmTable(o);
+  ASSERT_TRUE(t.ok());
+  EXPECT_GE(*std::min_element(t.value().rgb.begin(), t.value().rgb.end()), 0.0f);  // was -0.044
+  // intoGamut keeps luminance and in-gamut colours; it moves a colour towards its own grey.
+  const glm::dvec3 in(0.2, 0.5, 0.1), out(0.6, 0.3, -0.05);
+  EXPECT_EQ(intoGamut(in), in);
+  const glm::dvec3 m = intoGamut(out);
+  EXPECT_GE(std::min({m.r, m.g, m.b}), 0.0);
+  EXPECT_NEAR(std::min({m.r, m.g, m.b}), 0.0, 1e-12);
+  auto Y = [](const glm::dvec3& c) { return 0.2126729 * c.r + 0.7151522 * c.g + 0.0721750 * c.b; };
+  EXPECT_NEAR(Y(m), Y(out), 1e-12);
+  EXPECT_GT(m.r - m.g, 0.0);  // the hue's order kept
 }
 
 }  // namespace

@@ -1,12 +1,12 @@
 // effects/fog: the paper's worked example, X3D semantics, stiff and extreme inputs, tables.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
-#include <algorithm>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include <effects/fog.h>
 
@@ -19,8 +19,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Fog make(FogType t) { return fixtures::fogOf(t); }
 
-const FogType kAll[] = {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear,         FogType::kGlExp,
-                        FogType::kGlExp2,    FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight,
+const FogType kAll[] = {FogType::kX3dLinear,  FogType::kX3dExponential, FogType::kGlLinear,         FogType::kGlExp,
+                        FogType::kGlExp2,     FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight,
                         FogType::kAtmospheric};
 
 TEST(Fog, PaperWorkedExample) {
@@ -286,7 +286,8 @@ TEST(Fog, EngineTermsStiffCases) {
               f.cutoffDistance = 1e-300 < d && d < 1e30 ? 1e20 : kInf;
               ASSERT_FALSE(validate(f));
               const double w = factorAtElevation(f, oy, dy, d);
-              EXPECT_TRUE(w >= 1.0 - m && w <= 1.0) << b2 << " " << oy << " " << dy << " " << d << " " << start << " " << m;
+              EXPECT_TRUE(w >= 1.0 - m && w <= 1.0)
+                  << b2 << " " << oy << " " << dy << " " << d << " " << start << " " << m;
               const double c = completeDistance(f, oy);
               EXPECT_FALSE(std::isnan(c)) << b2 << " " << oy;
             }
@@ -447,8 +448,9 @@ TEST(Fog, DirectionalInscattering) {
   for (glm::dvec3 p : {glm::dvec3(0, 1.5, -40), glm::dvec3(30, 0, -5), glm::dvec3(0, 1, 40)}) {
     const glm::dvec3 ray = p - eye;
     const double d = glm::length(ray), fw = factor(f, eye, ray, d);
-    const glm::dvec3 want = fw * obj + (1 - fw) * f.color + inscatterWeight(f, 1.0, ray.y / d, d) * sun.color *
-                                                                 lobe(sun, glm::dot(ray / d, glm::normalize(sun.direction)));
+    const glm::dvec3 want =
+        fw * obj + (1 - fw) * f.color +
+        inscatterWeight(f, 1.0, ray.y / d, d) * sun.color * lobe(sun, glm::dot(ray / d, glm::normalize(sun.direction)));
     const glm::dvec3 got = shade(f, obj, eye, p);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-12);
   }
@@ -463,14 +465,16 @@ TEST(Fog, DirectionalInscattering) {
   ASSERT_EQ(t.value().inscatter.size(), t.value().factor.size());
   for (size_t j = 0; j < 5; ++j)
     for (size_t i = 0; i < 33; ++i) {
-      const double dy = -1.0 + 0.5 * double(j), d = t.value().rangeStart + (t.value().rangeEnd - t.value().rangeStart) * double(i) / 32;
+      const double dy = -1.0 + 0.5 * double(j),
+                   d = t.value().rangeStart + (t.value().rangeEnd - t.value().rangeStart) * double(i) / 32;
       EXPECT_NEAR(t.value().inscatter[j * 33 + i], inscatterWeight(f, 1, dy, d), 1e-7);
     }
   // Stiff: the sun on the horizon and straight overhead, g at the edges of (-1, 1), rays
   // grazing the ground, looking at the sun and away, distances from 0 to infinity.
   for (glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, -1)})
     for (double g : {-0.9999999, 0.0, 0.9999999})
-      for (glm::dvec3 p : {glm::dvec3(1e6, 1, 0), glm::dvec3(-1e6, 1, 0), glm::dvec3(0, 1, -1e-9), glm::dvec3(0, 1e9, 0)}) {
+      for (glm::dvec3 p :
+           {glm::dvec3(1e6, 1, 0), glm::dvec3(-1e6, 1, 0), glm::dvec3(0, 1, -1e-9), glm::dvec3(0, 1e9, 0)}) {
         Fog h = f;
         h.directional->direction = dir;
         h.directional->g = g;
@@ -537,8 +541,9 @@ TEST(Fog, AtmosphericPerChannel) {
     };
     size_t off = 0;
     for (size_t i = 0; i < tab.width; ++i) {
-      const double d = i + 1 == tab.width ? tab.rangeEnd
-                                          : tab.rangeStart + (tab.rangeEnd - tab.rangeStart) * double(i) / double(tab.width - 1);
+      const double d = i + 1 == tab.width
+                           ? tab.rangeEnd
+                           : tab.rangeStart + (tab.rangeEnd - tab.rangeStart) * double(i) / double(tab.width - 1);
       const double fd = factorAtElevation(f, 0, 0, d);
       const glm::dvec3 tr = transmittance(f, 0, 0, d), sc = scattered(f, 0, 0, d);
       EXPECT_LE(std::fabs(tab.factor[i] - static_cast<float>(fd)), ulp(fd)) << d;
@@ -791,8 +796,9 @@ TEST(Fog, WarpedAxesStayFiniteOnStiffFogs) {
   struct Case {
     double density, falloff, base, camera, maxOpacity;
   };
-  for (const Case& c : {Case{50, 5, 0, 0, 1}, Case{1e-9, 0.01, 0, 0, 1}, Case{0.05, 50, 0, 2, 1}, Case{0.05, 0, 0, 2, 1},
-                        Case{0.05, 0.2, 0, -3000, 1}, Case{0.05, 0.2, 0, 3000, 1}, Case{0.05, 0.2, 0, 2, 0}}) {
+  for (const Case& c :
+       {Case{50, 5, 0, 0, 1}, Case{1e-9, 0.01, 0, 0, 1}, Case{0.05, 50, 0, 2, 1}, Case{0.05, 0, 0, 2, 1},
+        Case{0.05, 0.2, 0, -3000, 1}, Case{0.05, 0.2, 0, 3000, 1}, Case{0.05, 0.2, 0, 2, 0}}) {
     Fog f = steepFog();
     f.density = c.density;
     f.heightFalloff = c.falloff;
@@ -805,7 +811,8 @@ TEST(Fog, WarpedAxesStayFiniteOnStiffFogs) {
     auto t = buildTable(f, o);
     ASSERT_TRUE(t.ok()) << t.error().message;
     const WarpedAxes& a = t.value().warped;
-    for (double v : {a.rowK, a.kappa, a.lambda, a.falloff, t.value().maxError}) EXPECT_TRUE(std::isfinite(v)) << c.density;
+    for (double v : {a.rowK, a.kappa, a.lambda, a.falloff, t.value().maxError})
+      EXPECT_TRUE(std::isfinite(v)) << c.density;
     for (float x : t.value().factor) ASSERT_TRUE(x >= 0.0f && x <= 1.0f) << c.density << " " << c.falloff;
     EXPECT_LE(randomLookupError(f, t.value(), c.camera, 4000), t.value().maxError * 1.25 + 1e-6)
         << c.density << " " << c.falloff << " " << c.camera;
@@ -836,6 +843,55 @@ TEST(Fog, TableRangesAndLimits) {
   t = buildTable(e, o);
   ASSERT_TRUE(t.ok());
   EXPECT_NEAR(t.value().factor.back(), 1.0 / 255, 1e-6);
+}
+
+// Issue 59's table: samples across the range of double, each against its closed form. Before
+// the scaled lengths (glm::length squares the components) these gave 1, 1 / 0, 0 / 0, 1, 1 / 1 / 0.
+TEST(Fog, SamplesAcrossTheRangeOfDouble) {
+  auto at = [](const Fog& f, glm::dvec3 point, glm::dvec3 camera = glm::dvec3(0)) {
+    return sampleAt(f, {}, camera, point).factor;
+  };
+  Fog e = make(FogType::kGlExp);
+  e.density = 1e300;
+  EXPECT_NEAR(at(e, {1e-300, 0, 0}), std::exp(-1.0), 1e-12);
+  EXPECT_NEAR(at(e, {0, 0, -2e-300}), std::exp(-2.0), 1e-12);
+  Fog e2 = make(FogType::kGlExp2);
+  e2.density = 1e-200;
+  EXPECT_NEAR(at(e2, {1e200, 0, 0}), std::exp(-1.0), 1e-12);
+  EXPECT_NEAR(at(e2, {0, 3e199, 4e199}), std::exp(-0.25), 1e-12);  // |p| by the scaled length: 5e199
+  Fog h = make(FogType::kHeight);
+  h.density = 0.05;
+  h.heightFalloff = 0.2;
+  h.baseHeight = 0;
+  for (double d : {1e150, 1e160, 1e200}) EXPECT_EQ(at(h, {d, 0, 0}), 0.0) << d;  // level rays through the layer
+  h.density = 1e170;
+  EXPECT_NEAR(at(h, {1e-170, 0, 0}), std::exp(-1.0), 1e-12);
+  Fog dx = make(FogType::kDistanceExp2);
+  dx.distanceCoefficient = 5e-324;  // the smallest denormal, 4.94e-324
+  for (double d : {5e161, 1e162, 2e162}) {
+    const double expected = std::exp(-std::exp(std::log(4.9406564584124654e-324) + 2 * std::log(d)));
+    EXPECT_NEAR(at(dx, {0, 0, d}), expected, 1e-12 + 1e-9 * expected) << d;
+    EXPECT_GT(at(dx, {0, 0, d}), 0.0) << d;
+  }
+  // Points on opposite sides at +-1e308: the distance (2e308) is beyond the largest double and
+  // counts as infinite; e^(-1e-300 * 2e308) is 0 as that says, and nothing is NaN.
+  Fog g = make(FogType::kGlExp);
+  g.density = 1e-300;
+  EXPECT_EQ(at(g, {1e308, 0, 0}, {-1e308, 0, 0}), 0.0);
+  EXPECT_EQ(sampleAt(h, {}, {-1e308, 0, 0}, {1e308, 1, 0}).factor, 0.0);
+}
+
+TEST(Fog, RegionsOfExtremeSizeHoldWhatTheyShould) {
+  Region big, tiny;
+  big.shape = tiny.shape = Region::Shape::kSphere;
+  big.radius = 1e200;    // radius^2 overflows
+  tiny.radius = 1e-200;  // radius^2 underflows
+  EXPECT_EQ(regionAt({big}, {1e199, 0, 0}), 0);
+  EXPECT_EQ(regionAt({big}, {1e250, 0, 0}), -1);
+  EXPECT_EQ(regionAt({tiny}, {5e-201, 0, 0}), 0);
+  EXPECT_EQ(regionAt({tiny}, {2e-200, 0, 0}), -1);
+  EXPECT_EQ(regionAt({big, tiny}, {0, 0, 0}), 1);  // the innermost, by log volume
+  EXPECT_LT(logVolume(tiny), logVolume(big));
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ const double kLn255 = std::log(255.0);  // -ln(1/255): complete to 8 bits
 
 bool finite(double v) { return std::isfinite(v); }
 
+using detail::expMinusCD2;
 using detail::logG;
 using detail::mulZero;
 
@@ -36,9 +37,9 @@ const char* toString(FogType type) {
 }
 
 std::optional<FogType> fogTypeFromString(const std::string& name) {
-  for (FogType t : {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear, FogType::kGlExp,
-                    FogType::kGlExp2, FogType::kDistanceExp2, FogType::kDistanceGaussian, FogType::kHeight,
-                    FogType::kAtmospheric}) {
+  for (FogType t :
+       {FogType::kX3dLinear, FogType::kX3dExponential, FogType::kGlLinear, FogType::kGlExp, FogType::kGlExp2,
+        FogType::kDistanceExp2, FogType::kDistanceGaussian, FogType::kHeight, FogType::kAtmospheric}) {
     if (name == toString(t)) return t;
   }
   return std::nullopt;
@@ -112,7 +113,7 @@ std::optional<Error> validate(const Fog& fog) {
     for (int i = 0; i < 3; ++i)
       if (!(d->color[i] >= 0.0 && d->color[i] <= 1e6))
         return invalid("/directional/color/" + std::to_string(i), "must be in [0, 1e6]");
-    const double len = glm::length(d->direction);
+    const double len = detail::length(d->direction);
     if (!(len > 0.0) || !finite(len)) return invalid("/directional/direction", "must be a finite non-zero vector");
     if (!(d->g > -1.0 && d->g < 1.0)) return invalid("/directional/g", "must be in (-1, 1)");
     if (d->exponent && !(*d->exponent > 0.0 && *d->exponent <= 1e6))
@@ -173,9 +174,9 @@ double modeFactor(const Fog& fog, double d) {
       double x = mulZero(fog.density, d);
       return std::exp(-x * x);
     }
-    case FogType::kDistanceExp2: return std::exp(-mulZero(fog.distanceCoefficient, d * d));  // seed 003 eqn 1
+    case FogType::kDistanceExp2: return expMinusCD2(fog.distanceCoefficient, d);  // seed 003 eqn 1
     case FogType::kDistanceGaussian:  // seed 003 eqn 2, parameterised (see header)
-      return fog.peak * std::exp(-mulZero(fog.distanceCoefficient, d * d));
+      return fog.peak * expMinusCD2(fog.distanceCoefficient, d);
     case FogType::kHeight: break;  // along a ray: factorAtElevation
     case FogType::kAtmospheric: {  // the channels' mean (per channel: transmittance)
       double sum = 0.0;
@@ -192,7 +193,8 @@ double heightDepth(const Fog& fog, double originY, double dirY, double distance)
   const double y = s > 0.0 ? originY + dirY * s : originY;
   const double t = distance - s;
   double tau = heightOpticalDepth(fog.density, fog.heightFalloff, fog.baseHeight, y, dirY, t);
-  if (const auto& l = fog.secondLayer) tau += heightOpticalDepth(l->density, l->heightFalloff, l->baseHeight, y, dirY, t);
+  if (const auto& l = fog.secondLayer)
+    tau += heightOpticalDepth(l->density, l->heightFalloff, l->baseHeight, y, dirY, t);
   return tau;
 }
 
@@ -248,29 +250,33 @@ double lobe(const Directional& d, double cosTheta) {
   if (d.exponent) return c > 0.0 ? std::pow(c, *d.exponent) : 0.0;
   const double g = d.g;
   // 1 + g^2 - 2gc as a sum of two non-negative terms (no cancellation as |g| -> 1)
-  const double den = g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);
+  const double den =
+      g >= 0.0 ? (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c) : (1.0 + g) * (1.0 + g) - 2.0 * g * (1.0 + c);
   return (1.0 - g) * (1.0 + g) / (den * std::sqrt(den));
 }
 
 glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point) {
-  const glm::dvec3 ray = point - eye;
-  const double d = glm::length(ray);
-  const double dirY = d > 0.0 ? std::clamp(ray.y / d, -1.0, 1.0) : 0.0;
+  const detail::Ray ray = detail::rayBetween(eye, point);
+  const double d = ray.length;
+  const double dirY = std::clamp(ray.direction.y, -1.0, 1.0);
   glm::dvec3 c = object * transmittance(fog, eye.y, dirY, d) + scattered(fog, eye.y, dirY, d);
   if (fog.directional && d > 0.0) {
-    glm::dvec3 view = ray;  // Unreal's lobe looks from its clamped observer height
-    view.y += eye.y - observerHeight(fog, eye.y);
-    c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color *
-         lobe(*fog.directional, glm::dot(glm::normalize(view), glm::normalize(fog.directional->direction)));
+    // Unreal's lobe looks from its clamped observer height
+    const glm::dvec3 observer(eye.x, observerHeight(fog, eye.y), eye.z);
+    const glm::dvec3 view = detail::rayBetween(observer, point).direction;
+    const glm::dvec3 sun = fog.directional->direction / detail::length(fog.directional->direction);
+    c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color * lobe(*fog.directional, glm::dot(view, sun));
   }
   return c;
 }
 
 double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance) {
   if (fog.type != FogType::kHeight) return factor(fog, distance);
-  double len = glm::length(direction);
-  if (!(len > 0.0) || !finite(len)) return engineLimits(fog, distance, 1.0);
-  double dirY = std::clamp(direction.y / len, -1.0, 1.0);
+  // The largest component scaled out first: directions of 1e-300 and 1e300 keep their angle.
+  const double m = std::max({std::fabs(direction.x), std::fabs(direction.y), std::fabs(direction.z)});
+  if (!(m > 0.0) || !finite(m)) return engineLimits(fog, distance, 1.0);
+  const glm::dvec3 u = direction / m;
+  const double dirY = std::clamp(u.y / detail::length(u), -1.0, 1.0);
   return factorAtElevation(fog, origin.y, dirY, distance);
 }
 
@@ -278,7 +284,7 @@ namespace {
 
 // Distance (from where the fog starts) at which the mode's own weight falls to `level`.
 double modeDistanceTo(const Fog& fog, double level, double cameraHeight) {
-  const bool byte = level <= 1.0 / 255.0;  // complete to 8 bits: where X3D and GL_LINEAR reach 0
+  const bool byte = level <= 1.0 / 255.0;             // complete to 8 bits: where X3D and GL_LINEAR reach 0
   const double q = byte ? kLn255 : -std::log(level);  // e^-q = level
   switch (fog.type) {
     case FogType::kX3dLinear:
@@ -347,12 +353,12 @@ std::optional<Error> validate(const Region& r) {
   return std::nullopt;
 }
 
-double volume(const Region& r) {
-  if (r.shape == Region::Shape::kBox) {
-    glm::dvec3 e = r.max - r.min;
-    return e.x * e.y * e.z;
+double logVolume(const Region& r) {
+  if (r.shape == Region::Shape::kBox) {  // halves: max - min may exceed the largest double
+    const glm::dvec3 e = 0.5 * r.max - 0.5 * r.min;
+    return std::log(e.x) + std::log(e.y) + std::log(e.z) + 3.0 * std::log(2.0);
   }
-  return 4.0 / 3.0 * 3.14159265358979323846 * r.radius * r.radius * r.radius;
+  return std::log(4.0 / 3.0 * 3.14159265358979323846) + 3.0 * std::log(r.radius);
 }
 
 int regionAt(const std::vector<Region>& regions, const glm::dvec3& p) {
@@ -364,16 +370,28 @@ int regionAt(const std::vector<Region>& regions, const glm::dvec3& p) {
     if (r.shape == Region::Shape::kBox) {
       inside = p.x >= r.min.x && p.x <= r.max.x && p.y >= r.min.y && p.y <= r.max.y && p.z >= r.min.z && p.z <= r.max.z;
     } else {
-      glm::dvec3 d = p - r.center;
-      inside = glm::dot(d, d) <= r.radius * r.radius;
+      inside = detail::rayBetween(r.center, p).length <= r.radius;
     }
-    const double v = volume(r);
+    const double v = logVolume(r);
     if (inside && (best < 0 || v < bestVolume)) {
       best = static_cast<int>(i);
       bestVolume = v;
     }
   }
   return best;
+}
+
+Sample sampleAt(const Fog& global, const std::vector<Region>& regions, const glm::dvec3& camera,
+                const glm::dvec3& point) {
+  Sample s;
+  s.region = regionAt(regions, point);
+  const Fog& f = s.region < 0 ? global : regions[size_t(s.region)].fog;
+  const detail::Ray ray = detail::rayBetween(camera, point);
+  const double dirY = std::clamp(ray.direction.y, -1.0, 1.0);
+  s.factor = f.type == FogType::kHeight ? factorAtElevation(f, camera.y, dirY, ray.length) : factor(f, ray.length);
+  s.transmittance = transmittance(f, camera.y, dirY, ray.length);
+  s.fogColor = shade(f, glm::dvec3(0), camera, point);
+  return s;
 }
 
 }  // namespace effects::fog

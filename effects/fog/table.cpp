@@ -184,12 +184,14 @@ void fill(const Fog& fog, double cameraHeight, Table& t) {
   for (size_t j = 0; j < t.height; ++j) {
     const double dirY = rowY(t, double(j));
     const Extent ef = rowExtent(t, dirY, false), eg = rowExtent(t, dirY, true);
-    const bool rowDone = fog.type == FogType::kHeight ? fillHeightRow(fog, cameraHeight, dirY, ef, t.width, &t.factor[j * t.width])
-                                                      : rgb && fillAtmosphericRow(fog, t, j);
+    const bool rowDone = fog.type == FogType::kHeight
+                             ? fillHeightRow(fog, cameraHeight, dirY, ef, t.width, &t.factor[j * t.width])
+                             : rgb && fillAtmosphericRow(fog, t, j);
     for (size_t i = 0; i < t.width; ++i) {
       const size_t e = j * t.width + i;
       if (fog.directional)
-        t.inscatter[e] = static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, columnDistance(eg, t.width, double(i))));
+        t.inscatter[e] =
+            static_cast<float>(inscatterWeight(fog, cameraHeight, dirY, columnDistance(eg, t.width, double(i))));
       if (rowDone) continue;
       const double d = columnDistance(ef, t.width, double(i));
       t.factor[e] = static_cast<float>(exact(fog, cameraHeight, d, dirY));
@@ -296,10 +298,36 @@ size_t entries(bool twoD, size_t n, size_t m) {
 void measure(const Fog& fog, const TableOptions& o, int sub, Table& t) {
   Stopwatch w;
   t.maxError = measureTableError(fog, t, o.cameraHeight, sub, &t.errorAtDistance);
-  t.stats.counters["errorMs"] = w.ms();
+  t.stats.errorMs = w.ms();
+  t.stats.counters["errorMs"] = t.stats.errorMs;
   t.stats.error = t.maxError;
   t.stats.errorMetric = "max |lerp(table) - f| over " + std::to_string(sub) + "x denser sampling";
   t.stats.reference = "exact closed form";
+  t.stats.errorKind = "measured";
+}
+
+// Without the measurement: linear interpolation's leading error term, |second difference| / 8,
+// along each row and each column of the table itself (no evaluation of the fog; an estimate).
+void estimate(Table& t) {
+  double worst = 0;
+  auto along = [&](const std::vector<float>& v, size_t count, size_t stride, size_t lines, size_t lineStride) {
+    for (size_t l = 0; l < lines; ++l)
+      for (size_t i = 1; i + 1 < count; ++i) {
+        const size_t at = l * lineStride + i * stride;
+        worst = std::max(worst, std::fabs(double(v[at - stride]) - 2.0 * v[at] + double(v[at + stride])) / 8);
+      }
+  };
+  for (const std::vector<float>* v : {&t.factor, &t.inscatter}) {
+    if (v->empty()) continue;
+    along(*v, t.width, 1, t.height, t.width);  // along distance
+    along(*v, t.height, t.width, t.width, 1);  // along elevation
+  }
+  t.maxError = worst;
+  t.stats.error = worst;
+  t.stats.errorMetric =
+      "estimate of max |lerp(table) - f|: max |second difference| / 8 over the table's rows and columns";
+  t.stats.reference = "none (not measured: table.measureError false)";
+  t.stats.errorKind = "estimate";
 }
 
 // The table of the size asked for (o.size, and o.elevations for height fog).
@@ -310,7 +338,11 @@ Result<Table> fixedSize(const Fog& fog, const TableOptions& o, bool twoD, int su
     return overLimit("/size", "table of " + std::to_string(entries(twoD, o.size, m)) +
                                   " entries exceeds the limit of " + std::to_string(o.maxSize));
   auto t = sized(fog, o, o.size, m, start, end);
-  if (o.measureError) measure(fog, o, sub, t.value());
+  if (!t.ok()) return t;
+  if (o.measureError)
+    measure(fog, o, sub, t.value());
+  else
+    estimate(t.value());
   return t;
 }
 
@@ -334,8 +366,8 @@ Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD,
   };
   if (cells(2) > double(o.maxSize)) return unsatisfiable("/maxError", "not reachable within the table size limit");
   // The largest N allowed: from an estimate, then to the exact bound.
-  size_t cap = !twoD ? o.maxSize
-               : !warped ? size_t(std::sqrt(double(o.maxSize)))
+  size_t cap = !twoD          ? o.maxSize
+               : !warped      ? size_t(std::sqrt(double(o.maxSize)))
                : o.elevations ? o.maxSize / o.elevations
                               : size_t(std::sqrt(2.0 * double(o.maxSize)));
   while (cap > 2 && cells(cap) > double(o.maxSize)) --cap;
@@ -355,8 +387,8 @@ Result<Table> smallestForError(const Fog& fog, const TableOptions& o, bool twoD,
     ++measurements;
     if (best.value().maxError > o.maxError && hi == cap)
       return unsatisfiable("/maxError", "error " + shortNumber(best.value().maxError) + " at the size limit (" +
-                                            std::to_string(size_t(cells(hi))) + " entries) is above the requested maximum " +
-                                            shortNumber(o.maxError));
+                                            std::to_string(size_t(cells(hi))) +
+                                            " entries) is above the requested maximum " + shortNumber(o.maxError));
   }
   while (hi - lo > 1) {
     size_t mid = lo + (hi - lo) / 2;
@@ -387,12 +419,14 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& o) {
   constexpr double kLargestDistance = 1e300;
   const bool x3d = fog.type == FogType::kX3dLinear || fog.type == FogType::kX3dExponential;
   if (!o.rangeEnd && x3d && fog.visibilityRange <= 0)  // X3D's rule: visibilityRange 0 turns the fog off
-    return unsatisfiable("/visibilityRange", std::string("is 0, which turns X3D fog off (fogType ") + toString(fog.type) +
+    return unsatisfiable("/visibilityRange", std::string("is 0, which turns X3D fog off (fogType ") +
+                                                 toString(fog.type) +
                                                  "; LINEAR is the default): give visibilityRange > 0, another "
                                                  "fogType, or table.range");
   if (!o.rangeEnd && !(std::isfinite(end) && end > start && end <= kLargestDistance))
-    return unsatisfiable("/range", "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) within "
-                                   "1e300 beyond range[0]; give range explicitly");
+    return unsatisfiable("/range",
+                         "this fog does not reach its densest (f = max(1/255, 1 - maxOpacity)) within "
+                         "1e300 beyond range[0]; give range explicitly");
   if (!std::isfinite(end) || !(end > start)) return invalid("/range/1", "must be finite and greater than range[0]");
 
   constexpr int kSub1D = 8, kSub2D = 4;

@@ -25,9 +25,7 @@ const char* toString(Method m) {
   }
   return "?";
 }
-const char* toString(Solver s) {
-  return s == Solver::kCg ? "cg" : s == Solver::kCapacitance ? "capacitance" : "mgpcg";
-}
+const char* toString(Solver s) { return s == Solver::kCg ? "cg" : s == Solver::kCapacitance ? "capacitance" : "mgpcg"; }
 
 std::optional<Error> validate(const Params& p) {
   if (p.width < 3 || p.height < 3) return invalid("/grid", "width and height must be >= 3");
@@ -45,7 +43,8 @@ std::optional<Error> validate(const Params& p) {
   if (p.screeningRadius < 0 || p.screeningRadius > 7) return invalid("/screeningRadius", "must be in [0, 7]");
   if (p.lifetime < 0) return invalid("/lifetime", "must be >= 0 (0 = candidates never expire)");
   if (!(p.tolerance >= 1e-12 && p.tolerance <= 1e-1)) return invalid("/tolerance", "must be in [1e-12, 0.1]");
-  if (p.targets.empty() && p.targetRegion.empty()) return invalid("/targets", "needs at least one target or a targetRegion");
+  if (p.targets.empty() && p.targetRegion.empty())
+    return invalid("/targets", "needs at least one target or a targetRegion");
   if (!p.targetRegion.empty() && p.targetRegion.size() != cells)
     return invalid("/targetRegion", p.depth ? "must have width*height*depth cells" : "must have width*height cells");
   if (p.depth == 0 && p.neighbourhood != 4 && p.neighbourhood != 8)
@@ -153,14 +152,14 @@ class Grower {
   detail::SceneBoundary<detail::BoundaryMap> boundaryMap_;
   detail::SceneBoundary<detail::VolumeBoundary> volumeMap_;  // 3-D
   std::unique_ptr<detail::DeepField> laplace_, reference_;
-  std::vector<Cell> probes_;        // the candidates' cells, for DeepField::solve
-  std::vector<double> dbmLogPhi_;   // kDbm: their log Phi from it
+  std::vector<Cell> probes_;       // the candidates' cells, for DeepField::solve
+  std::vector<double> dbmLogPhi_;  // kDbm: their log Phi from it
   Rng rng_{p_.seed};
   const double lnGrowth_ = std::log(p_.axisGrowth);  // kFast: the base of 2^G
   // The power the candidates' Phi is raised to: eta, or for kCharges the charges exponent.
   const double exponent_ = p_.method != Method::kCharges ? p_.eta
-                           : p_.chargesEta > 0       ? p_.chargesEta
-                                                     : calibratedChargesEta(p_);
+                           : p_.chargesEta > 0           ? p_.chargesEta
+                                                         : calibratedChargesEta(p_);
   // kFast: N counted within radius_ (1: the adjacent cells), and screening * ln n for the
   // counts 1..26 (26 in a 3-D grid's 26-neighbourhood) or 1..(2 radius_ + 1)^2, looked up
   // (screening 1: the values std::log gives).
@@ -181,6 +180,7 @@ class Grower {
   double solverIterations_ = 0, lastResidual_ = 0, errorSum_ = 0;
   size_t directSteps_ = 0, iterativeSteps_ = 0;  // kDbm: steps solved by each kind of solver
   int errorSteps_ = 0;
+  double errorMs_ = 0;  // the reference's solves: not the method's time
   size_t candidatesMax_ = 0;
 };
 
@@ -323,11 +323,12 @@ double Grower::fastLogStatic(const Candidate& cand) const {
   // distance. Unfolded, 2^G kept rewarding cells beyond the target, and a bolt that
   // overshot in a tall grid ran on to the far wall (128 x 32767: 2 M steps, minutes).
   const double along = p_.depth ? (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay + (c.z - anchor_.z) * az
-                               : (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
+                                : (c.x - anchor_.x) * ax + (c.y - anchor_.y) * ay;
   const double G = std::floor(along <= len ? along : 2 * len - along);
   const double P = towardsRegion_ ? regionNearest_.distance(c)
-                    : p_.depth    ? std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y), double(c.z - attractor_.z))
-                                  : std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
+                   : p_.depth
+                       ? std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y), double(c.z - attractor_.z))
+                       : std::hypot(double(c.x - attractor_.x), double(c.y - attractor_.y));
   return G * lnGrowth_ - cand.logBoundary - std::log(std::max(P, 0.5));
 }
 
@@ -470,8 +471,9 @@ std::vector<Cell> Grower::guidePath(size_t k, Cell fromCell, Cell target) {
   }
   const std::vector<uint8_t>& blocked = copy ? withBolt : p_.obstacles;
   Stopwatch guideWatch;
-  std::vector<Cell> path = toRegion_ ? astarToRegion(p_.width, p_.height, blocked, fromCell, region_, p_.neighbourhood, p_.depth)
-                                     : astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
+  std::vector<Cell> path =
+      toRegion_ ? astarToRegion(p_.width, p_.height, blocked, fromCell, region_, p_.neighbourhood, p_.depth)
+                : astar(p_.width, p_.height, blocked, fromCell, target, p_.neighbourhood, p_.depth);
   bolt_.stats.counters["guideMs"] += guideWatch.ms();
   return path;
 }
@@ -541,8 +543,10 @@ void Grower::weighCandidates(std::vector<double>& logPhi) {
   }
   logWeights(logPhi);
   if (reference_) {
+    Stopwatch w;
     errorSum_ += stepError(logPhi);
     ++errorSteps_;
+    errorMs_ += w.ms();
   }
 }
 
@@ -577,8 +581,9 @@ std::optional<Error> Grower::growSegment(size_t k) {
   // Reachability (and the guide) with the bolt so far blocked, except the segment's start.
   std::vector<Cell> path = guidePath(k, fromCell, target);
   if (path.empty())
-    return unsatisfiable(field, std::string(toRegion_ ? "no cell of the region is reachable" : "target is unreachable") +
-                                    " from " + (k ? "the previous target" : "start"));
+    return unsatisfiable(
+        field, std::string(toRegion_ ? "no cell of the region is reachable" : "target is unreachable") + " from " +
+                   (k ? "the previous target" : "start"));
   const bool useGuide =
       p_.method != Method::kDbm && (p_.guide == Guide::kAstar || (p_.guide == Guide::kAuto && !p_.obstacles.empty()));
   // Towards a region, the axis (and fast's eqn 8) aims at the region's cell the search reached.
@@ -588,9 +593,14 @@ std::optional<Error> Grower::growSegment(size_t k) {
   anchor_ = fromCell;
   attractor_ = waypoints[0];
   towardsRegion_ = toRegion_ && waypoints.size() == 1;
-  if (toRegion_ && p_.method == Method::kFast) regionNearest_ = detail::NearestCells(p_.width, p_.height, p_.depth, region_);
+  if (toRegion_ && p_.method == Method::kFast)
+    regionNearest_ = detail::NearestCells(p_.width, p_.height, p_.depth, region_);
   if (p_.method == Method::kDbm) laplace_ = dbmProblem(target, p_.solver);
-  if (p_.measureError) reference_ = dbmProblem(target, Solver::kMgpcg);
+  if (p_.measureError) {
+    Stopwatch w;
+    reference_ = dbmProblem(target, Solver::kMgpcg);
+    errorMs_ += w.ms();
+  }
 
   // Chain lightning: the new segment grows from the previous target only.
   for (size_t i = cands_.size(); i-- > 0;) removeCandidate(i);
@@ -610,14 +620,20 @@ std::optional<Error> Grower::growSegment(size_t k) {
     }
     size_t pick = 0;
     if (p_.method == Method::kFast) {
-      if (reference_) weighCandidates(logPhi);  // only the error needs every log Phi
+      if (reference_) {  // only the error needs every log Phi: all of it is the error's time
+        Stopwatch w;
+        const double before = errorMs_;
+        weighCandidates(logPhi);
+        errorMs_ = before + w.ms();
+      }
       pick = sampleFast();
     } else {
       weighCandidates(logPhi);
       pick = sample(logPhi, exponent_, rng_, scratch);
     }
     if (laplace_ && laplace_->exhausted())
-      return overLimit("/grid", "the field at the bolt fell below 1e-" + std::to_string(5 * detail::DeepField::kMaxStages) +
+      return overLimit("/grid", "the field at the bolt fell below 1e-" +
+                                    std::to_string(5 * detail::DeepField::kMaxStages) +
                                     " of the target's, beyond what the exact solver resolves");
     Candidate chosen = cands_[pick];
     last = addNode(chosen.cell, chosen.parent);
@@ -702,6 +718,7 @@ std::optional<Error> Grower::run() {
     s.errorMetric = "mean per-step total-variation distance of the candidate distribution";
     s.reference = "dbm, converged Laplace solve (MGPCG, relative residual 1e-10)";
   }
+  s.errorMs = errorMs_;
   return std::nullopt;
 }
 
@@ -717,7 +734,7 @@ Result<Bolt> grow(const Params& params) {
   Grower grower(params, bolt);
   if (auto e = grower.run()) return *e;
   if (bolt.stats.method.empty()) bolt.stats.method = toString(params.method);  // dbm's names its solver
-  bolt.stats.elapsedMs = watch.ms();
+  bolt.stats.elapsedMs = watch.ms() - bolt.stats.errorMs;                      // the method's own time
   return bolt;
 }
 

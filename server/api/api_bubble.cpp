@@ -12,9 +12,9 @@
 #include "api/api_bubble.h"
 #include "api/api_common.h"
 #include "api/bubble_glb.h"
-#include "contract/codec.h"
 #include "api/costs.h"
 #include "api/shader_targets.h"
+#include "contract/codec.h"
 
 namespace effectd {
 
@@ -108,6 +108,7 @@ bb::ThinFilmOptions readThinFilm(const json& body, const bb::Params& params, con
   bb::ThinFilmOptions o;
   o.ior = params.n2;
   o.wavelengths = tf.value("wavelengths", o.wavelengths);
+  o.measureError = tf.value("measureError", o.measureError);
   o.width = tf.value("width", o.width);
   o.height = tf.value("height", o.height);
   o.thicknessMinNm = range[0].get<double>();
@@ -124,8 +125,8 @@ void checkThinFilmSize(const bb::ThinFilmOptions& o, const Config& config, const
 
 }  // namespace
 
-bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const json& range,
-                                    const Config& config, const std::string& pointer) {
+bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const json& range, const Config& config,
+                                    const std::string& pointer) {
   bb::ThinFilmOptions o = readThinFilm(body, params, range);
   checkThinFilmSize(o, config, pointer);
   return o;
@@ -197,9 +198,12 @@ bb::Mesh buildMesh(const BubbleRequest& request, bool wobbled, const RequestCont
 json meshJson(bb::Mesh mesh, bool topLeft, bool wobbled) {
   if (topLeft)
     for (auto& t : mesh.tangents) t.w = -t.w;
-  json mj = {{"vertexCount", mesh.positions.size()}, {"positions", flat<3>(mesh.positions)},
-             {"normals", flat<3>(mesh.normals)},     {"uvs", flat<2>(mesh.uvs)},
-             {"tangents", flat<4>(mesh.tangents)},   {"indices", mesh.indices},
+  json mj = {{"vertexCount", mesh.positions.size()},
+             {"positions", flat<3>(mesh.positions)},
+             {"normals", flat<3>(mesh.normals)},
+             {"uvs", flat<2>(mesh.uvs)},
+             {"tangents", flat<4>(mesh.tangents)},
+             {"indices", mesh.indices},
              {"wobbled", wobbled}};
   if (!mesh.finalVectors.empty()) {
     mj["finalVectors"] = flat<3>(mesh.finalVectors);
@@ -214,10 +218,11 @@ json thinFilmJson(const BubbleRequest& request, const json& tf, const RequestCon
   checkThinFilmSize(o, ctx.config, ctx.at);
   const json& range = request.thicknessRange;
   auto r = bb::thinFilmTable(o);
-  if (!r.ok()) {
-    effects::Error e = r.error();
-    throwError(e, ctx.at + "/thinFilm");
-  }
+  // The table's index of refraction is the film's own, params.n2 (the thin film has no ior): an
+  // n2 the schema allows but the table cannot take is a 422 at /params/n2.
+  if (!r.ok() && r.error().field == "/ior")
+    throw fieldError(422, ctx.at + "/params/n2", "the thin film's table takes n2 in [1, 3]: " + r.error().message);
+  if (!r.ok()) throwError(r.error(), ctx.at + "/thinFilm");
   const bb::ThinFilmTable& table = r.value();
   json j = {{"width", table.width},
             {"height", table.height},
@@ -227,6 +232,7 @@ json thinFilmJson(const BubbleRequest& request, const json& tf, const RequestCon
             {"colorSpace", "linear sRGB, D65, reflectance of the film (white-balanced: R = 1 gives 1)"},
             {"meanDeltaE", table.meanDeltaE},
             {"maxDeltaE", table.maxDeltaE},
+            {"errorKind", table.stats.errorKind},
             {"errorMetric", table.stats.errorMetric},
             {"reference", table.stats.reference}};
   if (tf.value("encoding", "json") == "json") {
@@ -323,8 +329,9 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
 json thicknessJson(const bb::ThicknessField& f, const std::string& encoding) {
   json j = {{"width", f.width},
             {"height", f.height},
-            {"axes", "equirectangular as the mesh's uvs: u = atan2(z, x) / 2 pi + 0.5 (wrap), v = 0 (row 0) at the "
-                     "bottom (y = -1) to 1 at the top"},
+            {"axes",
+             "equirectangular as the mesh's uvs: u = atan2(z, x) / 2 pi + 0.5 (wrap), v = 0 (row 0) at the "
+             "bottom (y = -1) to 1 at the top"},
             {"unit", "nm"},
             {"meanErrorNm", f.meanErrorNm},
             {"maxErrorNm", f.maxErrorNm}};
@@ -403,7 +410,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
   }
   JsonReply reply;
   reply.method = film ? "thin-film" : "seed000";
-  if (request.glb) {  // the whole bubble as one file instead of JSON
+  if (request.glb) {                                      // the whole bubble as one file instead of JSON
     const bb::Mesh mesh = buildMesh(request, true, ctx);  // no shader in a GLB
     reply.computeMs = mesh.stats.elapsedMs;
     if (film && features.thickness) {
@@ -445,6 +452,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
     effects::Stats st;
     out["thinFilm"] = thinFilmJson(request, tf, ctx, st);
     reply.computeMs += st.elapsedMs;
+    reply.errorMs += st.errorMs;
     stats.push_back(statsJson(st));
   }
   if (include.has("gltf")) {

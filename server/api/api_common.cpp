@@ -26,9 +26,11 @@ nlohmann::json statsJson(const effects::Stats& s) {
   if (!s.counters.empty()) j["counters"] = s.counters;
   if (s.error) {
     j["error"] = *s.error;
+    if (!s.errorKind.empty()) j["errorKind"] = s.errorKind;
     j["errorMetric"] = s.errorMetric;
     j["reference"] = s.reference;
   }
+  if (s.errorMs > 0) j["errorMs"] = s.errorMs;
   return j;
 }
 

@@ -9,9 +9,9 @@
 
 #include "api/api_common.h"
 #include "api/api_fog.h"
-#include "contract/codec.h"
 #include "api/costs.h"
 #include "api/shader_targets.h"
+#include "contract/codec.h"
 
 namespace effectd {
 
@@ -125,12 +125,8 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
       const fog::WarpedAxes& a = t.warped;
       out["layout"] = fog::toString(t.layout);
       out["elevationAxis"] = "ray direction y at v = 1/2 + asinh(k y) / (2 asinh k), row 0 at v = 0 (straight down)";
-      out["axes"] = {{"k", a.rowK},
-                     {"factorStart", a.factorStart},
-                     {"inscatterStart", a.inscatterStart},
-                     {"end", a.end},
-                     {"falloff", a.falloff},
-                     {"kappa", a.kappa},
+      out["axes"] = {{"k", a.rowK},       {"factorStart", a.factorStart}, {"inscatterStart", a.inscatterStart},
+                     {"end", a.end},      {"falloff", a.falloff},         {"kappa", a.kappa},
                      {"lambda", a.lambda}};
     } else {
       out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";
@@ -166,14 +162,16 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
       out["finalColors"] = std::move(finals);
     }
   } else {
-    out["texelLayout"] = "RGBA = (S, f), S the fog's colour reaching the eye ((1-f)*fogColor; ATMOSPHERIC: per channel), row-major, " +
-                         std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
+    out["texelLayout"] =
+        "RGBA = (S, f), S the fog's colour reaching the eye ((1-f)*fogColor; ATMOSPHERIC: per channel), row-major, " +
+        std::string(encoding == "rgba8" ? "unsigned bytes" : "little-endian binary16");
     out["data"] = encodeTexels(t, f, encoding);
     if (!t.inscatter.empty()) out["inscatterData"] = encodeChannel(t.inscatter, encoding);
     if (!t.transmittanceRgb.empty()) {  // RGBA = (T, 1): the object's weight per channel
       std::vector<float> rgba;
       for (size_t i = 0; i < t.factor.size(); ++i)
-        rgba.insert(rgba.end(), {t.transmittanceRgb[3 * i], t.transmittanceRgb[3 * i + 1], t.transmittanceRgb[3 * i + 2], 1.0f});
+        rgba.insert(rgba.end(),
+                    {t.transmittanceRgb[3 * i], t.transmittanceRgb[3 * i + 1], t.transmittanceRgb[3 * i + 2], 1.0f});
       out["transmittanceData"] = encodeChannel(rgba, encoding);
     }
   }
@@ -181,7 +179,8 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
     out["transmittanceLayout"] =
         "ATMOSPHERIC: colour = object * transmittance + fogContribution, per channel; factor is the channels' mean";
   if (!t.inscatter.empty())
-    out["inscatterLayout"] = "1 - f_dir per entry, as factor; colour += inscatter * directional.color * lobe(cos theta)";
+    out["inscatterLayout"] =
+        "1 - f_dir per entry, as factor; colour += inscatter * directional.color * lobe(cos theta)";
   return out;
 }
 
@@ -198,6 +197,7 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
   opt.elevations = o.value("elevations", size_t(0));
   opt.cameraHeight = o.value("cameraHeight", 0.0);
   opt.layout = *fog::layoutFromString(o.value("layout", fog::toString(opt.layout)));
+  opt.measureError = o.value("measureError", opt.measureError);
   return opt;
 }
 
@@ -221,15 +221,16 @@ json fogShaderJson(const fog::Fog& global, const std::vector<fog::Region>& regio
               {"uniforms", std::move(uniforms)}};
   if (ShaderTarget target; shaderTarget(language, target)) {
     // The snippet inside a fragment shader that calls it, so that every target keeps it.
-    const std::string wrapper = "#version 330 core\nin vec3 vWorld;\nin vec3 vColor;\nout vec4 fragColor;\n" +
-                                fs.glsl + "void main() { fragColor = vec4(applyFog(vColor, vWorld), 1.0); }\n";
+    const std::string wrapper = "#version 330 core\nin vec3 vWorld;\nin vec3 vColor;\nout vec4 fragColor;\n" + fs.glsl +
+                                "void main() { fragColor = vec4(applyFog(vColor, vWorld), 1.0); }\n";
     auto t = translateShader("", wrapper, target);
     if (!t.ok()) throwError(t.error());
     out["code"] = stageCode(t.value().fragment);
     out["entryPoint"] = t.value().fragment.entryPoint;
     out["resources"] = resourcesJson(t.value().resources);
-    out["note"] = "a whole fragment shader (in vWorld, vColor; out the fogged colour) around applyFog, as the "
-                  "target language has it: take applyFog and its uniforms into your own shader";
+    out["note"] =
+        "a whole fragment shader (in vWorld, vColor; out the fogged colour) around applyFog, as the "
+        "target language has it: take applyFog and its uniforms into your own shader";
   }
   reply.computeMs += watch.ms();
   return out;
@@ -259,7 +260,8 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
 
   JsonReply reply;
   reply.method = std::string("table-") + fog::toString(global.type);
-  if (global.convention != fog::Convention::kEffectd) reply.method += std::string("-") + fog::toString(global.convention);
+  if (global.convention != fog::Convention::kEffectd)
+    reply.method += std::string("-") + fog::toString(global.convention);
   json out = {{"method", reply.method}};
   json stats = json::array();
   auto build = [&](const fog::Fog& f, const std::string& pointer) {
@@ -271,13 +273,18 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
                   {"size", {ctx.at + "/table/size", 1, "--max-table-size"}},
                   {"maxError", {ctx.at + "/table/maxError"}}});
     reply.computeMs += t.value().stats.elapsedMs;
+    reply.errorMs += t.value().stats.errorMs;
     stats.push_back(statsJson(t.value().stats));
     return tableJson(t.value(), f, tableOpts, objectColors);
   };
   if (include.has("table")) {
     out["table"] = build(global, ctx.at + "/fog");
+    const bool measured = request.table.measureError || request.table.size == 0;  // maxError: always
     out["error"] = {{"maxError", out["table"]["maxError"]},
-                    {"metric", "max |linear interpolation of the table - exact f|"},
+                    {"kind", measured ? "measured" : "estimate"},
+                    {"metric", measured ? "max |linear interpolation of the table - exact f|"
+                                        : "estimate of max |linear interpolation - exact f|: the table's largest "
+                                          "|second difference| / 8 (table.measureError false)"},
                     {"reference", global.convention == fog::Convention::kEffectd
                                       ? "exact closed form"
                                       : std::string("the closed form of the ") + fog::toString(global.convention) +
@@ -296,17 +303,12 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
     glm::dvec3 camera = toVec3(body["samples"]["camera"]);
     json list = json::array();
     for (const auto& pj : body["samples"]["points"]) {
-      glm::dvec3 p = toVec3(pj);
-      int r = fog::regionAt(regions, p);
-      const fog::Fog& f = r < 0 ? global : regions[size_t(r)].fog;
-      glm::dvec3 d = p - camera;
-      const double len = glm::length(d);
-      json sample = {{"region", r}, {"factor", wire(fog::factor(f, camera, d, len))}};
+      const fog::Sample at = fog::sampleAt(global, regions, camera, toVec3(pj));
+      const fog::Fog& f = at.region < 0 ? global : regions[size_t(at.region)].fog;
+      json sample = {{"region", at.region}, {"factor", wire(at.factor)}};
       if (f.type == fog::FogType::kAtmospheric || f.directional) {  // colour = object * T + fogColor
-        const glm::dvec3 t = fog::transmittance(f, camera.y, len > 0 ? std::clamp(d.y / len, -1.0, 1.0) : 0.0, len);
-        const glm::dvec3 s0 = fog::shade(f, glm::dvec3(0), camera, p);
-        sample["transmittance"] = {wire(t.r), wire(t.g), wire(t.b)};
-        sample["fogColor"] = {wire(s0.r), wire(s0.g), wire(s0.b)};
+        sample["transmittance"] = {wire(at.transmittance.r), wire(at.transmittance.g), wire(at.transmittance.b)};
+        sample["fogColor"] = {wire(at.fogColor.r), wire(at.fogColor.g), wire(at.fogColor.b)};
       }
       list.push_back(std::move(sample));
     }
@@ -319,7 +321,9 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
   return reply;
 }
 
-JsonReply handleFog(const json& body, const RequestContext& ctx) { return runFog(parseFogRequest(body, ctx), body, ctx); }
+JsonReply handleFog(const json& body, const RequestContext& ctx) {
+  return runFog(parseFogRequest(body, ctx), body, ctx);
+}
 
 void addFogEndpoints(Service& service) {
   service.addJsonEndpoint("/v1/fog", "fog.json", twoSteps(parseFogRequest, fogCost, runFog));

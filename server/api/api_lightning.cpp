@@ -8,8 +8,8 @@
 #include "api/api_common.h"
 #include "api/api_lightning.h"
 #include "api/bolt_ribbons.h"
-#include "contract/codec.h"
 #include "api/costs.h"
+#include "contract/codec.h"
 
 namespace effectd {
 namespace {
@@ -35,7 +35,8 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::stri
     for (size_t i = 0; i < rows.size(); ++i) {
       int y = rows[i]["y"];
       if (y >= h) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/y", "is outside the grid");
-      if (rows[i].contains("z")) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/z", "is for 3-D grids (grid.depth)");
+      if (rows[i].contains("z"))
+        throw fieldError(400, at + "/rows/" + std::to_string(i) + "/z", "is for 3-D grids (grid.depth)");
       for (const auto& run : rows[i]["runs"]) {
         int x0 = run[0], len = run[1];
         for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;
@@ -62,7 +63,8 @@ std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::stri
 // A cell of the request: [x, y] on a 2-D grid, [x, y, z] on a 3-D one.
 lt::Cell cellOf(const json& j, int depth, const std::string& at) {
   if (j.size() != (depth ? 3u : 2u))
-    throw fieldError(400, at, depth ? "must be [x, y, z] on a 3-D grid" : "must be [x, y] on a 2-D grid (no grid.depth)");
+    throw fieldError(400, at,
+                     depth ? "must be [x, y, z] on a 3-D grid" : "must be [x, y] on a 2-D grid (no grid.depth)");
   return {j[0].get<int>(), j[1].get<int>(), depth ? j[2].get<int>() : 0};
 }
 
@@ -134,13 +136,18 @@ json strikeJson(const lt::Timeline& tl) {
   return {{"connect", tl.connect},
           {"duration", tl.duration},
           {"strokes", std::move(strokes)},
-          {"keyframes", {{"t", std::move(t)}, {"leader", std::move(leader)}, {"main", std::move(main)}, {"branches", std::move(branches)}}}};
+          {"keyframes",
+           {{"t", std::move(t)},
+            {"leader", std::move(leader)},
+            {"main", std::move(main)},
+            {"branches", std::move(branches)}}}};
 }
 
 // "timeline": the strike and, per polyline, when each vertex lights.
 json timelineJson(const lt::Timeline& tl) {
   json lines = json::array();
-  for (size_t i = 0; i < tl.leader.size(); ++i) lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
+  for (size_t i = 0; i < tl.leader.size(); ++i)
+    lines.push_back({{"leader", tl.leader[i]}, {"strokeDelay", tl.strokeDelay[i]}});
   json out = strikeJson(tl);
   out["polylines"] = std::move(lines);
   return out;
@@ -226,12 +233,13 @@ lt::Params boltParams(const LightningRequest& r, const json& body, const Config&
                           : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
   if (r.targetRegion) {
     const json& region = body["targetRegion"];
-    p.targetRegion = p.depth ? parseVolumeObstacles(region, p.width, p.height, p.depth, r.world, config, at + "/targetRegion")
-                             : parseObstacles(region, p.width, p.height, at + "/targetRegion");
+    p.targetRegion =
+        p.depth ? parseVolumeObstacles(region, p.width, p.height, p.depth, r.world, config, at + "/targetRegion")
+                : parseObstacles(region, p.width, p.height, at + "/targetRegion");
     if (std::find(p.targetRegion.begin(), p.targetRegion.end(), uint8_t(1)) == p.targetRegion.end())
       throw fieldError(400, at + "/targetRegion", "holds no cell of the grid");
   }
-  lt::calibrate(p);  // from one look at the obstacles
+  lt::calibrate(p);            // from one look at the obstacles
   if (r.variant == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
     p.lifetime = lt::kPaperLifetime;
     p.axisGrowth = lt::kPaperAxisGrowth;
@@ -245,7 +253,8 @@ lt::Params boltParams(const LightningRequest& r, const json& body, const Config&
 
 lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
   auto grown = lt::grow(p);
-  if (!grown.ok()) throwError(grown.error(), at, {{"maxSteps", {at + "/maxSteps", 1, "--max-growth-steps / maxSteps"}}});
+  if (!grown.ok())
+    throwError(grown.error(), at, {{"maxSteps", {at + "/maxSteps", 1, "--max-growth-steps / maxSteps"}}});
   return std::move(grown.value());
 }
 
@@ -261,11 +270,11 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   const lt::Bolt bolt = growBolt(p, ctx.at);
   JsonReply reply;
   reply.method = bolt.stats.method;
-  reply.computeMs = bolt.stats.elapsedMs;
+  reply.computeMs = bolt.stats.elapsedMs;  // the method's own: the reference's solves are errorMs
+  reply.errorMs = bolt.stats.errorMs;
   json out = {{"method", bolt.stats.method},
               {"grid", p.depth ? json::array({p.width, p.height, p.depth}) : json::array({p.width, p.height})}};
-  if (request.world.given)
-    out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};
+  if (request.world.given) out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};
   if (p.method != lt::Method::kDbm) out["variant"] = request.variant;
   out["mainChannelLength"] = bolt.mainChannel.size();
   out["cellCount"] = bolt.nodes.size();
@@ -306,6 +315,7 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   }
   if (include.has("error")) {
     out["error"] = {{"meanTotalVariation", bolt.stats.error.value_or(0.0)},
+                    {"kind", "measured"},
                     {"metric", bolt.stats.errorMetric},
                     {"reference", bolt.stats.reference}};
   }

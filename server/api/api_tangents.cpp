@@ -72,6 +72,7 @@ JsonReply runTangents(const TangentsRequest& request, const json& body, const Re
   JsonReply reply;
   reply.method = out.stats.method;
   reply.computeMs = out.stats.elapsedMs;
+  reply.errorMs = out.stats.errorMs;
   json res = {{"method", reply.method}, {"vertexCount", out.remap.size()}};
   if (include.has("tangents")) res["tangents"] = flat<4>(out.tangents);
   if (include.has("remap")) res["remap"] = out.remap;
@@ -92,15 +93,26 @@ JsonReply runTangents(const TangentsRequest& request, const json& body, const Re
       res["error"] = {{"meanAngleDeg", *out.stats.error},
                       {"maxAngleDeg", out.stats.counters["maxAngleDeg"]},
                       {"handednessMismatches", out.stats.counters["handednessMismatches"]},
+                      {"kind", "measured"},
                       {"metric", out.stats.errorMetric},
                       {"reference", out.stats.reference}};
     else
       res["error"] = {{"meanAngleDeg", 0.0},
                       {"maxAngleDeg", 0.0},
                       {"handednessMismatches", 0},
+                      {"kind", "measured"},
                       {"metric", "mean angle between corner tangents, degrees"},
                       {"reference", "mikktspace (this is it)"}};
   }
+  // MikkTSpace (and so every engine that bakes with it) treats a UV area at or below float's
+  // FLT_MIN as none: such triangles get the fallback frame. Said in the answer, not only in stats.
+  if (const auto it = out.stats.counters.find("zeroUvAreaTriangles"); it != out.stats.counters.end() && it->second > 0)
+    res["warnings"] = json::array(
+        {{{"pointer", "/mesh/uvs"},
+          {"message",
+           std::to_string(size_t(it->second)) +
+               " triangles have no UV area in float (|2 x area| <= FLT_MIN, MikkTSpace's cut-off): "
+               "their corners get the fallback frame. UVs scaled down to ~1e-19 land here; scale them up"}}});
   if (include.has("stats")) res["stats"] = statsJson(out.stats);
   reply.body = std::move(res);
   return reply;
@@ -188,7 +200,8 @@ tg::Mesh readPrimitive(glb::Asset& asset, json& prim, json& attrs, const std::st
                                 {"uvs", {at + "/attributes/" + uvs, 0}},
                                 {"normals", {at + "/attributes/NORMAL", 0}},
                                 {"", {at + "/indices", 0}}};
-  throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422, {placeField(e.field, at, accessors), e.message});
+  throw gltfProblem(e.kind == effects::ErrorKind::kLimitExceeded ? 413 : 422,
+                    {placeField(e.field, at, accessors), e.message});
 }
 
 // The vertices were split (`remap`): every vertex attribute but those being written (and every

@@ -15,14 +15,14 @@
 #include <effects/common.h>
 
 #include "contract/codec.h"
+#include "contract/json_reader.h"
+#include "contract/json_writer.h"
+#include "contract/resources.h"
 #include "http/access.h"
 #include "http/elastic_pool.h"
 #include "http/encoding.h"
 #include "http/etag.h"
-#include "contract/json_reader.h"
-#include "contract/json_writer.h"
 #include "http/request_state.h"
-#include "contract/resources.h"
 #include "http/route.h"
 
 namespace effectd {
@@ -105,10 +105,11 @@ double answerBinary(const BinaryHandler& handler, const std::string& body, const
   return reply.computeMs;
 }
 
-// Server-Timing's value: compute first, then its stages, then the request's own (parse, validate,
-// etag, write).
-std::string serverTiming(double computeMs, const Stages& stages, const Stages& requestStages = {}) {
+// Server-Timing's value: compute first, then the error measurement (when one ran), its stages,
+// then the request's own (parse, validate, etag, write).
+std::string serverTiming(double computeMs, const Stages& stages, const Stages& requestStages = {}, double errorMs = 0) {
   std::string timing = "compute;dur=" + std::to_string(computeMs);
+  if (errorMs > 0) timing += ", error;dur=" + std::to_string(errorMs);
   for (const Stages* list : {&stages, &requestStages})
     for (const auto& [name, ms] : *list) timing += ", " + name + ";dur=" + std::to_string(ms);
   return timing;
@@ -133,7 +134,7 @@ void answerJson(const PreparedRequest& prepared, json& body, CachedAnswer& answe
     answer.contentType = "application/json";
     requestStages.emplace_back("write", write.ms());
   }
-  res.set_header("Server-Timing", serverTiming(reply.computeMs, reply.stages, requestStages));
+  res.set_header("Server-Timing", serverTiming(reply.computeMs, reply.stages, requestStages, reply.errorMs));
 }
 
 // Encodes an answer worth compressing in the negotiated coding.
@@ -291,7 +292,8 @@ void Service::addStatic(const std::string& path, const std::string& contentType,
   routes_.push_back(std::move(r));
   const bool html = contentType.rfind("text/html", 0) == 0;
   const std::string csp = "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'" +
-                          (scriptOrigin.empty() ? "" : " " + scriptOrigin) + "; connect-src 'self'; frame-ancestors 'none'";
+                          (scriptOrigin.empty() ? "" : " " + scriptOrigin) +
+                          "; connect-src 'self'; frame-ancestors 'none'";
   http_->Get(path, [contentType, html, csp, body = std::move(body)](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -330,22 +332,35 @@ void Service::handleGet(const Route& route, const httplib::Request& req, httplib
   };
   for (const auto& [name, value] : req.params)
     if (name != "r" && name != "exp" && name != "sig")
-      return refuse({400, "invalid-query", "Unknown query parameter",
+      return refuse({400,
+                     "invalid-query",
+                     "Unknown query parameter",
                      "a GET takes r (the base64url JSON body), and exp and sig when signed; not '" + name + "'",
-                     {{"?" + name, "not a parameter of GET " + route.path}}, {}});
+                     {{"?" + name, "not a parameter of GET " + route.path}},
+                     {}});
   if (!req.has_param("r"))
-    return refuse({400, "invalid-query", "Missing query parameter",
+    return refuse({400,
+                   "invalid-query",
+                   "Missing query parameter",
                    "GET " + route.path + " needs r: the request's JSON body in base64url (RFC 4648 §5, no padding)",
-                   {{"?r", "required"}}, {}});
+                   {{"?r", "required"}},
+                   {}});
   auto body = base64UrlDecode(req.get_param_value("r"));
   if (!body)
-    return refuse({400, "invalid-query", "Malformed query parameter", "r is not base64url (RFC 4648 §5, no padding)",
-                   {{"?r", "not base64url"}}, {}});
+    return refuse({400,
+                   "invalid-query",
+                   "Malformed query parameter",
+                   "r is not base64url (RFC 4648 §5, no padding)",
+                   {{"?r", "not base64url"}},
+                   {}});
   if (body->size() > config_.limits.maxBodyBytes)
-    return refuse({413, "body-too-large", "Content Too Large",
+    return refuse({413,
+                   "body-too-large",
+                   "Content Too Large",
                    "r decodes to " + std::to_string(body->size()) + " bytes, over the limit of " +
                        std::to_string(config_.limits.maxBodyBytes) + " bytes (--max-body-bytes)",
-                   {{"?r", "too large"}}, {}});
+                   {{"?r", "too large"}},
+                   {}});
   try {
     tl.bodyTicket = admission_->admit(body->size() * kJsonBodyFactor, false);
   } catch (const ApiError& e) {

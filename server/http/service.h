@@ -44,8 +44,9 @@ using Stages = std::vector<std::pair<std::string, double>>;
 // What a JSON endpoint returns: the body, plus the stats whose timing goes to Server-Timing.
 struct JsonReply {
   nlohmann::json body;
-  double computeMs = 0;
-  std::string method;  // the method that ran, echoed in the X-Effect-Method header
+  double computeMs = 0;  // the method's own work
+  double errorMs = 0;    // measuring its error against the reference (Server-Timing "error")
+  std::string method;    // the method that ran, echoed in the X-Effect-Method header
   // A JSON request may answer with bytes of another media type instead (e.g. image/png).
   std::string binary, contentType;
   std::map<std::string, std::string> headers;     // part of the answer (cached with it)
@@ -95,7 +96,8 @@ JsonEndpoint twoSteps(Parse parse, CostOf cost, Run run) {
     using R = std::decay_t<std::invoke_result_t<Parse, const nlohmann::json&, const RequestContext&>>;
     auto request = std::make_shared<const R>(parse(body, ctx));
     // body and ctx outlive run(): the service calls it before its own handler returns.
-    return PreparedRequest{cost(*request, ctx.config), [request, run, &body, &ctx] { return run(*request, body, ctx); }};
+    return PreparedRequest{cost(*request, ctx.config),
+                           [request, run, &body, &ctx] { return run(*request, body, ctx); }};
   };
 }
 // Binary request bodies (e.g. model/gltf-binary) -> a binary reply with a media type.
@@ -174,7 +176,7 @@ class Service {
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
   std::unique_ptr<Access> access_;                // who may ask, and how much
   std::unique_ptr<IdleTrim> idleTrim_;
-  int listenSocket_ = -1;                         // the socket bind() made, so that its backlog can be raised
+  int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
 };

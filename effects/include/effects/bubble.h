@@ -86,7 +86,7 @@ double rim(const Params& p, double gammaOut);  // eqn 10, in [0, 1]
 
 // omega t mod 2 pi in [0, 2 pi), computed in long double.
 double reducedPhase(double omega, double t);
-glm::dvec2 flowOffset(const Params& p, double t);                                // eqn 9: (sin bt, cos bt)
+glm::dvec2 flowOffset(const Params& p, double t);  // eqn 9: (sin bt, cos bt)
 // The wobble of a sphere of `radius` in object units: x += amplitude sin(phase + frequency x)
 // (what the vertex shader's uWobbleAmplitude and uWobbleFrequency hold).
 WobbleShape wobbleInObject(const Params& p, double radius);
@@ -124,7 +124,7 @@ double thicknessAt(const Params& p, const ThicknessOptions& o, const glm::dvec3&
 double equatorThickness(const Params& p, const ThicknessOptions& o, double t);
 struct ThicknessField {
   int width = 0, height = 0;
-  std::vector<float> nm;  // row-major, row 0 at v = 0 (the bottom), texel centres
+  std::vector<float> nm;                   // row-major, row 0 at v = 0 (the bottom), texel centres
   double meanErrorNm = 0, maxErrorNm = 0;  // bilinear lookup against thicknessAt between texels
   Stats stats;
 };
@@ -159,9 +159,9 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 //     direction sees (the environment, plus each light's highlight); the light behind passes
 //     through weighted 1 - R per channel (the film absorbs nothing). Two draws per face set:
 //     uPass 0 writes (1 - R, 1 - opacity) blended with (ZERO, SRC_COLOR; ZERO, SRC_ALPHA), uPass 1
-//     writes (R * seen, opacity) with (ONE, ONE), opacity the luminance of R; uPass 2 is one draw, premultiplied (R * seen, luminance of R) with (ONE,
-//     ONE_MINUS_SRC_ALPHA), for engines that cannot draw twice (its transmission is grey). Back
-//     faces see the film from inside (normal flipped by gl_FrontFacing): draw them first.
+//     writes (R * seen, opacity) with (ONE, ONE), opacity the luminance of R; uPass 2 is one draw, premultiplied (R *
+//     seen, luminance of R) with (ONE, ONE_MINUS_SRC_ALPHA), for engines that cannot draw twice (its transmission is
+//     grey). Back faces see the film from inside (normal flipped by gl_FrontFacing): draw them first.
 //   kPaper: seed 000's eqns 3-10 (final vector lookup, rim alpha, texture flow), straight alpha
 //     blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA); iridescence adds the table's colour.
 enum class Shading { kFilm, kPaper };
@@ -225,9 +225,19 @@ double deltaE(const glm::dvec3& a, const glm::dvec3& b);
 // "evalSensitivity"), unpolarised Fresnel: linear sRGB without sampling wavelengths. Compared
 // with the table in docs/bubble-shading.md (build/bench/bubble_shading).
 glm::dvec3 filmColorAnalytic(double ior, double thicknessNm, double cosTheta);
-// Linear sRGB reflectance colour under D65 using `wavelengths` midpoint samples over
-// 380-780 nm (white-balanced so that R = 1 gives (1, 1, 1)); 400 = the 1 nm reference.
+// Linear sRGB reflectance colour under D65 in `wavelengths` equal bands over 380-780 nm, each
+// band's reflectance the mean of the Airy function over the band's phases (a film whose fringes
+// are finer than a band gets their mean, the incoherent limit), white-balanced so that R = 1
+// gives (1, 1, 1), then brought into the sRGB gamut (intoGamut). The thin-film table's method.
 glm::dvec3 filmColor(double ior, double thicknessNm, double cosTheta, int wavelengths);
+// The reference: the spectral integral over the CIE tables (linearly interpolated) by
+// Gauss-Legendre quadrature with sub-intervals of at most `fringeFraction` of a fringe (of the
+// sharpest fringe's peak at grazing incidence); converged to 1e-6 at the default.
+glm::dvec3 filmColorReference(double ior, double thicknessNm, double cosTheta, double fringeFraction = 1.0 / 12);
+// A linear sRGB colour with a negative channel (a saturated interference colour outside the
+// sRGB gamut) moved towards the grey of its own luminance Y just far enough that every channel
+// is >= 0: what a UNORM texture can hold, with hue and luminance kept. In-gamut colours are kept.
+glm::dvec3 intoGamut(const glm::dvec3& linearSrgb);
 
 struct ThinFilmOptions {
   double ior = 1.33;
@@ -235,7 +245,8 @@ struct ThinFilmOptions {
   int width = 256;           // thickness samples (u)
   int height = 256;          // cos(theta) samples (v), from 0 (row 0) to 1
   int wavelengths = 16;      // [3, 400]
-  bool measureError = true;  // Delta E*ab against the 1 nm reference on a sub-grid
+  bool measureError = true;  // Delta E*ab against filmColorReference on a 32 x 32 sub-grid;
+                             // false: on 4 x 4 texels (an estimate, 1/64 of the cost)
 };
 struct ThinFilmTable {
   int width = 0, height = 0;

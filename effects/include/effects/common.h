@@ -64,10 +64,12 @@ inline Error overLimit(std::string field, std::string message) {
 struct Stats {
   std::string method;                      // e.g. "fast", "dbm-multigrid", "mikktspace"
   double elapsedMs = 0.0;                  // wall time of the computation itself
+  double errorMs = 0.0;                    // wall time of measuring `error` (not in elapsedMs)
   std::map<std::string, double> counters;  // steps, candidates, iterations, residual ...
   std::optional<double> error;             // estimated error against the reference
   std::string errorMetric;                 // what `error` measures, e.g. "max |f - f_exact|"
   std::string reference;                   // the reference method the error is measured against
+  std::string errorKind;                   // "measured" (against `reference`) or "estimate" (computed cheaply)
 };
 
 // Wall-clock stopwatch in milliseconds.

@@ -86,16 +86,16 @@ enum class Convention { kEffectd, kFilament, kUnreal };
 struct Fog {
   FogType type = FogType::kX3dLinear;
   Convention convention = Convention::kEffectd;  // kHeight only
-  glm::dvec3 color{1.0, 1.0, 1.0};    // X3D default 1 1 1; each component in [0, 1]
-  double visibilityRange = 0.0;       // X3D V >= 0; 0 = no fog
-  double start = 0.0, end = 1.0;      // GL_LINEAR, 0 <= start < end
-  double density = 1.0;               // GL_EXP/GL_EXP2 >= 0; height fog: density a >= 0 at baseHeight
-  double distanceCoefficient = 0.07;  // d_c >= 0 (seed 003's worked example uses 0.07)
-  double peak = kPaperGaussianPeak;   // kDistanceGaussian only, in (0, 1]
-  double heightFalloff = 0.1;         // height fog b >= 0: density a * e^(-b (y - h))
-  double baseHeight = 0.0;            // height fog h
-  glm::dvec3 extinction{0.0};         // kAtmospheric: per channel, per unit distance, each >= 0
-  glm::dvec3 inscattering{0.0};       // kAtmospheric: per channel, per unit distance, each >= 0
+  glm::dvec3 color{1.0, 1.0, 1.0};               // X3D default 1 1 1; each component in [0, 1]
+  double visibilityRange = 0.0;                  // X3D V >= 0; 0 = no fog
+  double start = 0.0, end = 1.0;                 // GL_LINEAR, 0 <= start < end
+  double density = 1.0;                          // GL_EXP/GL_EXP2 >= 0; height fog: density a >= 0 at baseHeight
+  double distanceCoefficient = 0.07;             // d_c >= 0 (seed 003's worked example uses 0.07)
+  double peak = kPaperGaussianPeak;              // kDistanceGaussian only, in (0, 1]
+  double heightFalloff = 0.1;                    // height fog b >= 0: density a * e^(-b (y - h))
+  double baseHeight = 0.0;                       // height fog h
+  glm::dvec3 extinction{0.0};                    // kAtmospheric: per channel, per unit distance, each >= 0
+  glm::dvec3 inscattering{0.0};                  // kAtmospheric: per channel, per unit distance, each >= 0
   // What engines add on top of every mode (Unreal ExponentialHeightFog, Filament FogOptions;
   // docs/effects.md), applied in this order:
   double startDistance = 0.0;  // >= 0: the first part of every ray is clear (Unreal StartDistance,
@@ -103,10 +103,11 @@ struct Fog {
                                // fog integrates from start to d
   double maxOpacity = 1.0;     // in [0, 1]: fog never hides more than this, f >= 1 - maxOpacity
                                // (Unreal FogMaxOpacity, Filament maximumOpacity)
-  double cutoffDistance = std::numeric_limits<double>::infinity();  // > 0: beyond it f = 1, unfogged
-                               // (Unreal FogCutoffDistance, Filament cutOffDistance: the skybox)
-  std::optional<HeightLayer> secondLayer;  // kHeight only
-  std::optional<Directional> directional;  // every mode
+  double cutoffDistance =
+      std::numeric_limits<double>::infinity();  // > 0: beyond it f = 1, unfogged
+                                                // (Unreal FogCutoffDistance, Filament cutOffDistance: the skybox)
+  std::optional<HeightLayer> secondLayer;       // kHeight only
+  std::optional<Directional> directional;       // every mode
 };
 
 // Names used on the wire ("LINEAR", "EXPONENTIAL", "GL_LINEAR", ... "HEIGHT"; "effectd", ...).
@@ -187,9 +188,23 @@ struct Region {
   Fog fog;
 };
 std::optional<Error> validate(const Region& region);
-double volume(const Region& region);  // what "innermost" compares
+// ln of the region's volume: what "innermost" compares (in log space, so that regions of 1e-200
+// and 1e200 compare; -infinity for a flat one).
+double logVolume(const Region& region);
 // Index of the region that applies at `point`, or -1 for the global fog.
 int regionAt(const std::vector<Region>& regions, const glm::dvec3& point);
+
+// What an object at `point` seen from `camera` gets from the fog of the innermost region that
+// holds the point (the global fog where none does): C = object * transmittance + fogColor.
+// Every length and product is taken so that points 1e-300 or 1e300 away come out as the
+// closed form says (no overflow in |point - camera| or d^2).
+struct Sample {
+  int region = -1;  // the index in `regions`, -1 for the global fog
+  double factor = 1.0;
+  glm::dvec3 transmittance{1.0}, fogColor{0.0};  // per channel; fogColor holds the glow too
+};
+Sample sampleAt(const Fog& global, const std::vector<Region>& regions, const glm::dvec3& camera,
+                const glm::dvec3& point);
 
 // ---- Colour tables ---------------------------------------------------------------------
 struct TableOptions {
@@ -200,7 +215,9 @@ struct TableOptions {
   size_t elevations = 0;                       // kHeight only: samples of the ray's y component over [-1, 1];
                                                // 0 = same as size
   double cameraHeight = 0.0;                   // kHeight only
-  bool measureError = true;                    // dense-sampling error measurement (costs ~8 evaluations/entry)
+  bool measureError = true;                    // dense-sampling error measurement (~8 evaluations/entry); false: an
+                                               // estimate from the table's second differences (size tables only:
+                                               // maxError's search is made of measurements)
   // kHeight only. kLinear: rows even in the ray's y, columns even in distance (the layout of
   // every table before it). kWarped: rows dense near the horizon and each row's columns over
   // its own span, so that f is smooth along both axes (WarpedAxes). Other fog types ignore it.
@@ -231,7 +248,7 @@ struct WarpedAxes {
   double factorStart = 0.0, inscatterStart = 0.0, end = 0.0;
 };
 WarpedAxes warpedAxes(const Fog& fog, double cameraHeight, double rangeStart, double rangeEnd);
-double warpedRowY(const WarpedAxes& axes, double v);                  // v in [0, 1] -> y
+double warpedRowY(const WarpedAxes& axes, double v);                // v in [0, 1] -> y
 double warpedSpan(const WarpedAxes& axes, double y, double start);  // as above
 
 struct Table {
