@@ -44,11 +44,11 @@ using nlohmann::json;
 constexpr double kPi = 3.14159265358979323846;
 
 struct Point {
-  std::string series;   // one curve per series (a method, a fog type ...)
-  std::string setting;  // what varies along the curve
-  double ms = 0;        // median run time
-  double error = 0;     // against the section's reference
-  std::string note;     // extra column
+  std::string series;     // one curve per series (a method, a fog type ...)
+  std::string setting;    // what varies along the curve
+  double ms = 0;          // median run time
+  double error = 0;       // against the section's reference
+  std::string note;       // extra column
   double q1 = 0, q3 = 0;  // the run time's interquartile range (repeats, or seeds for bolts)
   int repeats = 0;
   std::string group;  // what a client fixes before choosing (a grid, a fog type, a mesh): the
@@ -161,7 +161,10 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
     lt::Params p = layout();
     p.axisGrowth = lt::kPaperAxisGrowth;
     p.lifetime = life;
-    settings.push_back({"fast paper", (life == 4 ? "variant paper: lifetime 4" : "lifetime " + (life ? std::to_string(life) : std::string("inf"))), p});
+    settings.push_back(
+        {"fast paper",
+         (life == 4 ? "variant paper: lifetime 4" : "lifetime " + (life ? std::to_string(life) : std::string("inf"))),
+         p});
   }
   for (double growth : {1.5, 1.25, 1.1, 1.0}) {  // eqn 8's base, candidates never expiring
     lt::Params p = layout();
@@ -245,7 +248,8 @@ void lightningRows(bool quick, int n, int hood, bool volume, Section& tv, Sectio
     fd.points.back().group = grid;
     if (tvs.empty()) continue;
     const auto [tvMean, tvSd] = meanSd(tvs);
-    tv.points.push_back(pointOf(series, s.setting, t, tvMean, "± " + fmt(tvSd, 2) + " (" + std::to_string(tvs.size()) + " seeds)"));
+    tv.points.push_back(
+        pointOf(series, s.setting, t, tvMean, "± " + fmt(tvSd, 2) + " (" + std::to_string(tvs.size()) + " seeds)"));
     tv.points.back().group = grid;
   }
   fd.points.push_back(pointOf("dbm reference " + grid, "D_ref", Timing{}, 0,
@@ -326,7 +330,8 @@ void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
     p.targets.clear();
     p.targetRegion.assign(size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1)), 0);
     for (int z = 0; z < std::max(p.depth, 1); ++z)
-      for (int x = 0; x < p.width; ++x) p.targetRegion[(size_t(z) * size_t(p.height) + size_t(p.height - 1)) * size_t(p.width) + size_t(x)] = 1;
+      for (int x = 0; x < p.width; ++x)
+        p.targetRegion[(size_t(z) * size_t(p.height) + size_t(p.height - 1)) * size_t(p.width) + size_t(x)] = 1;
     lt::calibrate(p);
     return p;
   };
@@ -393,7 +398,8 @@ void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
         if (!b.ok()) continue;
         v.push_back(lt::shapeOf(b.value(), p.width, p.height, p.depth));
         if (times) times->push_back(b.value().stats.elapsedMs);
-        if (label && drawSheet && seed <= drawn) sheetPanel(sheet, b.value(), std::string(label) + " seed " + std::to_string(seed));
+        if (label && drawSheet && seed <= drawn)
+          sheetPanel(sheet, b.value(), std::string(label) + " seed " + std::to_string(seed));
       }
       return v;
     };
@@ -423,13 +429,14 @@ void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
       const auto d = lt::shapeDistance(methodShapes, refShapes);
       // Fewer than two bolts on a side (failed growths) have no spread to measure against.
       const double score = methodShapes.size() < 2 || refShapes.size() < 2 ? NAN : d.worst;
-      const std::string note = fmt(d.mean.cells, 4) + " / " + fmt(d.refMean.cells, 4) + ", " + fmt(d.mean.tips, 3) + " / " +
-                               fmt(d.refMean.tips, 3) + ", " + fmt(d.mean.dimension, 3) + " / " + fmt(d.refMean.dimension, 3) +
-                               " (z " + fmt(d.cells, 2) + ", " + fmt(d.tips, 2) + ", " + fmt(d.dimension, 2) + "; " +
-                               std::to_string(times.size()) + " seeds)";
-      out.points.push_back(pointOf(name.substr(0, name.find(" tol")) + " " + l.name,
-                                   name.find(" tol") == std::string::npos ? "default" : name.substr(name.find(" tol") + 1),
-                                   spreadOf(times), score, note));
+      const std::string note = fmt(d.mean.cells, 4) + " / " + fmt(d.refMean.cells, 4) + ", " + fmt(d.mean.tips, 3) +
+                               " / " + fmt(d.refMean.tips, 3) + ", " + fmt(d.mean.dimension, 3) + " / " +
+                               fmt(d.refMean.dimension, 3) + " (z " + fmt(d.cells, 2) + ", " + fmt(d.tips, 2) + ", " +
+                               fmt(d.dimension, 2) + "; " + std::to_string(times.size()) + " seeds)";
+      out.points.push_back(
+          pointOf(name.substr(0, name.find(" tol")) + " " + l.name,
+                  name.find(" tol") == std::string::npos ? "default" : name.substr(name.find(" tol") + 1),
+                  spreadOf(times), score, note));
       out.points.back().group = l.name;
     }
     out.points.push_back(pointOf("dbm exact " + l.name, "reference", spreadOf(refTimes), 0,
@@ -441,17 +448,16 @@ void lightningShape(bool quick, Section& out, std::vector<Sheet>& sheets) {
 
 // The same two sections for 3-D grids (26-neighbourhood): 32^3 (16^3 in the quick run).
 void lightning3d(bool quick, Section& tv, Section& fd) {
-  tv = {
-      "lightning3d-tv",
-      "Lightning in 3-D: per-step candidate distribution against the converged Laplace solution",
-      "the 3-D DBM distribution from a converged solve (7-point Laplacian, MGPCG, relative residual 1e-10) on the "
-      "same bolt state, every step",
-      "mean total-variation distance per step",
-      "ms per bolt (median)",
-      "setting",
-      "sd over seeds",
-      {},
-      {}};
+  tv = {"lightning3d-tv",
+        "Lightning in 3-D: per-step candidate distribution against the converged Laplace solution",
+        "the 3-D DBM distribution from a converged solve (7-point Laplacian, MGPCG, relative residual 1e-10) on the "
+        "same bolt state, every step",
+        "mean total-variation distance per step",
+        "ms per bolt (median)",
+        "setting",
+        "sd over seeds",
+        {},
+        {}};
   fd = {"lightning3d-fd",
         "Lightning in 3-D: fractal dimension against DBM",
         "mean box-counting dimension D_ref of 3-D DBM (the default solver: exact while the capacitance method runs, "
@@ -510,15 +516,16 @@ void fogConventions(bool quick, Section& out) {
     double worstF = 0, worstGlow = 0;
     for (double dy : dirs)
       for (double d : distances) {
-        worstF = std::max(worstF, std::abs(fg::factorAtElevation(f, cameraY, dy, d) -
-                                           fg::factorAtElevation(base, cameraY, dy, d)));
-        worstGlow = std::max(worstGlow, std::abs(fg::inscatterWeight(f, cameraY, dy, d) -
-                                                 fg::inscatterWeight(base, cameraY, dy, d)));
+        worstF = std::max(
+            worstF, std::abs(fg::factorAtElevation(f, cameraY, dy, d) - fg::factorAtElevation(base, cameraY, dy, d)));
+        worstGlow = std::max(
+            worstGlow, std::abs(fg::inscatterWeight(f, cameraY, dy, d) - fg::inscatterWeight(base, cameraY, dy, d)));
       }
     volatile double sink = 0;
     const Timing t = timeMs(quick ? 5 : 21, [&] {
       for (double dy : dirs)
-        for (double d : distances) sink = sink + fg::factorAtElevation(f, cameraY, dy, d) + fg::inscatterWeight(f, cameraY, dy, d);
+        for (double d : distances)
+          sink = sink + fg::factorAtElevation(f, cameraY, dy, d) + fg::inscatterWeight(f, cameraY, dy, d);
     });
     out.points.push_back(pointOf(fg::toString(c), "weight f", t, worstF));
     out.points.push_back(pointOf(fg::toString(c), "glow 1 − f_dir", t, worstGlow));
@@ -560,10 +567,9 @@ void fog(bool quick, Section& tables, Section& march) {
       tables.points.back().group = name;
     }
   };
-  for (fg::FogType t :
-       {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear, fg::FogType::kGlExp,
-        fg::FogType::kGlExp2, fg::FogType::kDistanceExp2, fg::FogType::kDistanceGaussian, fg::FogType::kHeight,
-        fg::FogType::kAtmospheric})
+  for (fg::FogType t : {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear,
+                        fg::FogType::kGlExp, fg::FogType::kGlExp2, fg::FogType::kDistanceExp2,
+                        fg::FogType::kDistanceGaussian, fg::FogType::kHeight, fg::FogType::kAtmospheric})
     series(fogOf(t), fg::toString(t));
   // The engine terms (fog.h): a start distance, an opacity cap, a cutoff, height fog's second
   // layer and the sun's glow, whose weight 1 - f_dir is a second channel of the same table
@@ -676,8 +682,9 @@ void tangents(bool quick, Section& out) {
 // ---- soap bubble thin film ----------------------------------------------------------------------
 void thinFilm(bool quick, Section& out) {
   out = {"thin-film",
-         "Soap bubble: thin-film colour table against 1 nm spectral sampling",
-         "400 wavelength samples (1 nm) at a 32 x 32 sub-grid of the timed table's own texels",
+         "Soap bubble: thin-film colour table against the spectral quadrature, films of 0-1000 nm and 99-100 um",
+         "the spectral integral by Gauss-Legendre quadrature resolving every fringe (filmColorReference) at a 32 x 32 "
+         "sub-grid of the timed table's own texels",
          "mean CIE76 ΔE*ab",
          quick ? "ms per 64² table (median)" : "ms per 256² table (median)",
          "wavelength samples",
@@ -686,14 +693,18 @@ void thinFilm(bool quick, Section& out) {
          {}};
   for (int w : quick ? std::vector<int>{3, 8, 16}
                      : std::vector<int>{3, 4, 5, 6, 8, 11, 16, 23, 32, 45, 64, 81, 128, 200, 400}) {
-    bb::ThinFilmOptions o;
-    o.width = o.height = quick ? 64 : 256;
-    o.wavelengths = w;
-    o.measureError = false;
-    const Timing time = timeMs(quick ? 3 : 5, [&] { (void)bb::thinFilmTable(o); });
-    o.measureError = true;  // the same table: its texels at a 32 x 32 sub-grid against 1 nm
-    auto t = bb::thinFilmTable(o);
-    out.points.push_back(pointOf("Airy + CIE 1931", std::to_string(w), time, t.value().meanDeltaE, fmt(t.value().maxDeltaE, 3)));
+    for (const bool thick : {false, true}) {
+      bb::ThinFilmOptions o;
+      o.width = o.height = quick ? 64 : 256;
+      o.wavelengths = w;
+      if (thick) o.thicknessMinNm = 99000, o.thicknessMaxNm = 100000;  // fringes finer than 1 nm
+      o.measureError = false;
+      const Timing time = timeMs(quick ? 3 : 5, [&] { (void)bb::thinFilmTable(o); });
+      o.measureError = true;  // the same table: its texels at a 32 x 32 sub-grid against the reference
+      auto t = bb::thinFilmTable(o);
+      out.points.push_back(pointOf(thick ? "Airy bands, 99-100 um" : "Airy bands, 0-1000 nm", std::to_string(w), time,
+                                   t.value().meanDeltaE, fmt(t.value().maxDeltaE, 3)));
+    }
   }
 }
 
@@ -731,7 +742,8 @@ void conclude(std::vector<Section>& sections) {
         const std::string grid = p.series.substr(std::string("fast calibrated ").size());
         c << " " << grid << " " << fmt(p.error, 2);
         for (const auto& q : s.points)
-          if (q.series == "fast paper " + grid && q.setting.rfind("variant paper", 0) == 0) c << " (" << fmt(q.error, 2) << ")";
+          if (q.series == "fast paper " + grid && q.setting.rfind("variant paper", 0) == 0)
+            c << " (" << fmt(q.error, 2) << ")";
         c << ";";
       }
       // Per DBM curve: the loosest tolerance from which |D - D_ref| stays within 0.03.
@@ -775,7 +787,8 @@ void conclude(std::vector<Section>& sections) {
     } else if (s.id == "fog-conventions") {
       c << "For one scene with the same parameters:";
       for (const auto& p : s.points)
-        if (p.series != "effectd") c << " " << p.series << "'s " << p.setting << " is up to " << fmt(p.error) << " from effectd's;";
+        if (p.series != "effectd")
+          c << " " << p.series << "'s " << p.setting << " is up to " << fmt(p.error) << " from effectd's;";
       c << " the engines' start distance and glow differ (docs/effects.md §2.4); all three cost about the same.";
     } else if (s.id == "fog-height-march") {
       const Point* exact = &s.points.front();
@@ -818,14 +831,17 @@ void conclude(std::vector<Section>& sections) {
       const Point* far = nullptr;
       for (const auto& p : s.points)
         if (p.setting != "reference" && std::isfinite(p.error) && (!far || p.error > far->error)) far = &p;
-      if (far) c << " " << far->series << " " << far->setting << " (" << fmt(far->error, 3) << " standard errors: " << far->note << ").";
+      if (far)
+        c << " " << far->series << " " << far->setting << " (" << fmt(far->error, 3)
+          << " standard errors: " << far->note << ").";
       c << " The calibrated tables stay the fast method's default: no law measured meets DBM in every geometry. "
            "Seven shape measures per geometry and the laws tried: docs/lightning-shape.md.";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
       if (jnd)
-        c << "Fewest samples with a mean ΔE below 1 (about one just-noticeable difference): " << jnd->setting
-          << " wavelengths at " << fmt(jnd->ms) << " ms per table; effectd's default is 16.";
+        c << "Fewest bands with a mean ΔE below 1 (about one just-noticeable difference): " << jnd->setting << " ("
+          << jnd->series << ") at " << fmt(jnd->ms) << " ms per table; effectd's default is 16. "
+          << "At 99-100 um every count is the incoherent grey within ΔE 1: the band means do not alias.";
     }
     s.conclusion = c.str();
   }
@@ -846,7 +862,8 @@ std::vector<const Point*> paretoFront(const Section& s, const std::string& group
   std::vector<const Point*> pts;
   for (const auto& p : s.points)
     if (p.group == group && p.ms > 0 && std::isfinite(p.error)) pts.push_back(&p);
-  std::sort(pts.begin(), pts.end(), [](const Point* a, const Point* b) { return a->ms < b->ms || (a->ms == b->ms && a->error < b->error); });
+  std::sort(pts.begin(), pts.end(),
+            [](const Point* a, const Point* b) { return a->ms < b->ms || (a->ms == b->ms && a->error < b->error); });
   // Slower but tied in time (interquartile ranges overlap) and closer: it takes the faster's place.
   std::vector<const Point*> front;
   for (const Point* p : pts) {
@@ -862,7 +879,8 @@ struct Budget {
   const char* name;
   double ms;
 };
-constexpr Budget kBudgets[] = {{"interactive (≤ 1 ms)", 1.0}, {"loading screen (≤ 100 ms)", 100.0}, {"offline (any time)", INFINITY}};
+constexpr Budget kBudgets[] = {
+    {"interactive (≤ 1 ms)", 1.0}, {"loading screen (≤ 100 ms)", 100.0}, {"offline (any time)", INFINITY}};
 
 // The closest point of a group whose median time fits the budget (ties in error: the faster).
 const Point* choiceWithin(const Section& s, const std::string& group, double budgetMs) {
@@ -887,7 +905,8 @@ std::vector<std::string> groupsOf(const Section& s) {
 std::string summaryMarkdown(const std::vector<Section>& sections) {
   std::ostringstream md;
   md << "## Summary: what to choose\n\n"
-     << "Per section and what a client fixes first (a grid, a fog type, a mesh): the **Pareto front** (no other setting is as fast and closer to the reference), fastest "
+     << "Per section and what a client fixes first (a grid, a fog type, a mesh): the **Pareto front** (no other "
+        "setting is as fast and closer to the reference), fastest "
         "first, and the closest setting whose median time fits each budget. Times are per the section's unit; "
         "error 0 is the reference itself. Computed from the tables below by the generator, not written by hand.\n\n"
      << "| section | error metric | Pareto front (time, error) |";
@@ -924,8 +943,10 @@ std::string wrapped(const std::string& text, size_t width) {
   for (size_t i = 0; i < text.size();) {
     size_t end = text.find(' ', i);
     if (end == std::string::npos) end = text.size();
-    if (line > 0 && line + (end - i) > width) out += "\\n", line = 0;
-    else if (line > 0) out += ' ', ++line;
+    if (line > 0 && line + (end - i) > width)
+      out += "\\n", line = 0;
+    else if (line > 0)
+      out += ' ', ++line;
     out.append(text, i, end - i);
     line += end - i;
     i = end + 1;
@@ -937,7 +958,8 @@ void plot(const Section& s, const fs::path& dir) {
   std::map<std::string, std::vector<const Point*>> series;
   double floorError = INFINITY;
   for (const auto& p : s.points)
-    if (p.ms > 0 && p.error > 0 && std::isfinite(p.error)) series[p.series].push_back(&p), floorError = std::min(floorError, p.error);
+    if (p.ms > 0 && p.error > 0 && std::isfinite(p.error))
+      series[p.series].push_back(&p), floorError = std::min(floorError, p.error);
   // Error 0 (a reference, an exact method) has no place on a log axis: drawn at the floor, a
   // decade under the smallest nonzero error, with its own marker.
   std::vector<const Point*> exact;
@@ -978,14 +1000,19 @@ void plot(const Section& s, const fs::path& dir) {
     << "set xlabel \"" << s.timeName << ", log scale\"\nset ylabel \"" << wrapped(s.errorName + ", log scale", 40)
     << "\"\n"
     << "set format y '%.0e'\n";
-  if (!exact.empty()) g << "set arrow from graph 0, first " << floorAt << " to graph 1, first " << floorAt << " nohead dt 3 lc rgb 'gray'\n";
+  if (!exact.empty())
+    g << "set arrow from graph 0, first " << floorAt << " to graph 1, first " << floorAt
+      << " nohead dt 3 lc rgb 'gray'\n";
   g << "plot ";
   int i = 0;
   for (const auto& [name, pts] : series) {
     // gnuplot cycles 8 colours: past them, another point shape and dashes tell curves apart.
     const int round = i / 8;
     g << (i ? ", " : "") << "'" << data.string() << "' index " << i << " with linespoints lc " << (i % 8 + 1) << " pt "
-      << (round == 0 ? 7 : round == 1 ? 5 : 9) << " dt " << (round + 1) << " ps 0.8 title '" << name << "'";
+      << (round == 0   ? 7
+          : round == 1 ? 5
+                       : 9)
+      << " dt " << (round + 1) << " ps 0.8 title '" << name << "'";
     ++i;
   }
   for (size_t k = 0; k < exact.size(); ++k, ++i)
@@ -1016,8 +1043,7 @@ void drawSheet(const Sheet& sheet, const fs::path& dir) {
   std::ofstream g(script);
   g << "set terminal pngcairo noenhanced background rgb 'black' size " << w << "," << h << " font 'sans,9'\n"
     << "set output '" << (dir / (sheet.id + ".png")).string() << "'\n"
-    << "set multiplot layout " << rows << "," << sheet.columns << " title \"" << sheet.caption
-    << "\" tc rgb 'white'\n"
+    << "set multiplot layout " << rows << "," << sheet.columns << " title \"" << sheet.caption << "\" tc rgb 'white'\n"
     << "unset key\nunset tics\nset border lc rgb '#404040'\nset size ratio -1\nset lmargin 0.5\nset rmargin 0.5\n"
     << "set xrange [0:" << sheet.width << "]\nset yrange [" << sheet.height << ":0]\n";
   for (const auto& o : sheet.obstacles)  // objects stay for every panel of the multiplot
@@ -1067,22 +1093,23 @@ std::string sectionMarkdown(const Section& s, bool withPlot, const std::vector<S
       budgets[group][b.name] = c ? json(c->series + " " + c->setting) : json();
     }
   }
-  entry = {{"title", s.title},      {"errorMetric", s.errorName}, {"reference", s.reference}, {"points", pts},
-           {"conclusion", s.conclusion}, {"pareto", front},        {"budgets", budgets}};
+  entry = {{"title", s.title},  {"errorMetric", s.errorName}, {"reference", s.reference},
+           {"points", pts},     {"conclusion", s.conclusion}, {"pareto", front},
+           {"budgets", budgets}};
   return md.str();
 }
 
 // Writes the whole report from this run's sections.
-void write(const std::vector<Section>& sections, const std::vector<Sheet>& sheets, const fs::path& out, bool quick, bool plots,
-           const std::string& stamp) {
+void write(const std::vector<Section>& sections, const std::vector<Sheet>& sheets, const fs::path& out, bool quick,
+           bool plots, const std::string& stamp) {
   fs::create_directories(out / "error-vs-time");
   json j = json::object();
-  std::string md = std::string("# Error against run time\n\n") +
-                   (stamp.empty() ? "Generated by `build/bench/error_report" + std::string(quick ? " --quick" : "") + "`."
-                                  : stamp) +
-                   " One run: every number below comes from it. Times are the median over repeats (or, for bolts, "
-                   "over seeds) with the interquartile range in brackets; two times whose ranges overlap are a tie. "
-                   "Errors are measured on the configuration that is timed, against each section's reference.\n\n";
+  std::string md =
+      std::string("# Error against run time\n\n") +
+      (stamp.empty() ? "Generated by `build/bench/error_report" + std::string(quick ? " --quick" : "") + "`." : stamp) +
+      " One run: every number below comes from it. Times are the median over repeats (or, for bolts, "
+      "over seeds) with the interquartile range in brackets; two times whose ranges overlap are a tie. "
+      "Errors are measured on the configuration that is timed, against each section's reference.\n\n";
   md += summaryMarkdown(sections);
   j["stamp"] = stamp;
   for (const Section& s : sections) {
