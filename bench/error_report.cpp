@@ -548,8 +548,10 @@ void fog(bool quick, Section& tables, Section& march) {
   // One series: tables of every size for `f` (height fog's are 2-D, n x n linear or n x n/2
   // warped, up to the 65 536-entry bound), timed without and measured with the error pass.
   using Layout = fg::TableOptions::Layout;
+  // A warped series joins its linear twin's group: the summary picks between layouts.
   auto series = [&](const fg::Fog& f, const std::string& name, Layout layout = Layout::kLinear,
                     double cameraHeight = 5) {
+    const std::string group = layout == Layout::kWarped ? name.substr(0, name.rfind(" warped")) : name;
     const bool twoD = f.type == fg::FogType::kHeight;
     for (size_t n : sizes) {
       fg::TableOptions o;
@@ -564,7 +566,7 @@ void fog(bool quick, Section& tables, Section& march) {
       auto table = fg::buildTable(f, o);
       tables.points.push_back(pointOf(name, std::to_string(n) + (twoD ? " × " + std::to_string(o.elevations) : ""), t,
                                       table.ok() ? table.value().maxError : NAN));
-      tables.points.back().group = name;
+      tables.points.back().group = group;
     }
   };
   for (fg::FogType t : {fg::FogType::kX3dLinear, fg::FogType::kX3dExponential, fg::FogType::kGlLinear,
@@ -704,6 +706,7 @@ void thinFilm(bool quick, Section& out) {
       auto t = bb::thinFilmTable(o);
       out.points.push_back(pointOf(thick ? "Airy bands, 99-100 um" : "Airy bands, 0-1000 nm", std::to_string(w), time,
                                    t.value().meanDeltaE, fmt(t.value().maxDeltaE, 3)));
+      out.points.back().group = thick ? "films of 99-100 um" : "films of 0-1000 nm";  // a client's film fixes it
     }
   }
 }
@@ -882,11 +885,38 @@ struct Budget {
 constexpr Budget kBudgets[] = {
     {"interactive (≤ 1 ms)", 1.0}, {"loading screen (≤ 100 ms)", 100.0}, {"offline (any time)", INFINITY}};
 
-// The closest point of a group whose median time fits the budget (ties in error: the faster).
+// Past these a setting is beyond use, however fast: a budget is not met by it. Per section (its
+// error metric), with the reason.
+struct UseLimit {
+  const char* section;
+  double error;
+  const char* why;
+};
+constexpr UseLimit kUseLimits[] = {
+    {"fog-tables", 0.02, "a fog weight 0.02 off is 5 steps of 8-bit colour"},
+    {"fog-conventions", 0.02, "as fog tables"},
+    {"fog-height-march", 0.02, "as fog tables"},
+    {"lightning-tv", 0.5, "half of every step's choice elsewhere than the reference would put it"},
+    {"lightning3d-tv", 0.5, "as lightning-tv"},
+    {"lightning-fd", 0.1, "|D - D_ref| 0.1: visibly sparser or bushier"},
+    {"lightning3d-fd", 0.1, "as lightning-fd"},
+    {"lightning-shape", 3.0, "3 standard errors: a bolt that seeds' noise does not explain"},
+    {"tangents", 5.0, "a mean 5 degree tilt shows in normal-mapped highlights"},
+    {"thin-film", 2.3, "mean Delta E 2.3, one just-noticeable difference"},
+};
+double useLimit(const Section& s) {
+  for (const UseLimit& u : kUseLimits)
+    if (s.id == u.section) return u.error;
+  return INFINITY;
+}
+
+// The closest point of a group whose median time fits the budget (ties in error: the faster),
+// within the section's limit of use.
 const Point* choiceWithin(const Section& s, const std::string& group, double budgetMs) {
   const Point* best = nullptr;
+  const double limit = useLimit(s);
   for (const auto& p : s.points)
-    if (p.group == group && p.ms > 0 && p.ms <= budgetMs && std::isfinite(p.error) &&
+    if (p.group == group && p.ms > 0 && p.ms <= budgetMs && std::isfinite(p.error) && p.error <= limit &&
         (!best || p.error < best->error || (p.error == best->error && p.ms < best->ms)))
       best = &p;
   return best;
@@ -908,7 +938,9 @@ std::string summaryMarkdown(const std::vector<Section>& sections) {
      << "Per section and what a client fixes first (a grid, a fog type, a mesh): the **Pareto front** (no other "
         "setting is as fast and closer to the reference), fastest "
         "first, and the closest setting whose median time fits each budget. Times are per the section's unit; "
-        "error 0 is the reference itself. Computed from the tables below by the generator, not written by hand.\n\n"
+        "error 0 is the reference itself. Computed from the tables below by the generator, not written by hand. "
+        "A setting beyond its section's limit of use (listed below the table) is never a budget's choice: where "
+        "every setting that fits is beyond it, the cell says so.\n\n"
      << "| section | error metric | Pareto front (time, error) |";
   for (const Budget& b : kBudgets) md << " " << b.name << " |";
   md << "\n|---|---|---|";
@@ -927,12 +959,20 @@ std::string summaryMarkdown(const std::vector<Section>& sections) {
       md << " |";
       for (const Budget& b : kBudgets) {
         const Point* c = choiceWithin(s, group, b.ms);
-        md << " " << (c ? show(c) : std::string("nothing fits")) << " |";
+        bool fits = false;  // something fits the time, but none within the limit of use
+        for (const auto& p : s.points) fits = fits || (p.group == group && p.ms > 0 && p.ms <= b.ms);
+        md << " "
+           << (c      ? show(c)
+               : fits ? "nothing within use (error ≤ " + fmt(useLimit(s)) + ") fits"
+                      : std::string("nothing fits"))
+           << " |";
       }
       md << "\n";
     }
   }
-  md << "\n";
+  md << "\nLimits of use (error beyond which a setting is no budget's choice):";
+  for (const UseLimit& u : kUseLimits) md << " " << u.section << " " << fmt(u.error) << " (" << u.why << ");";
+  md << "\n\n";
   return md.str();
 }
 

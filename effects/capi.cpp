@@ -69,7 +69,8 @@ effects_status fail(effects_error** error, effects_status status, const char* fi
     return EFFECTS_OUT_OF_MEMORY;
   }
 }
-effects_status fail(effects_error** error, effects_status status, const std::string& field, const std::string& message) noexcept {
+effects_status fail(effects_error** error, effects_status status, const std::string& field,
+                    const std::string& message) noexcept {
   return fail(error, status, field.c_str(), message.c_str());
 }
 
@@ -112,7 +113,8 @@ constexpr size_t kMaxTableEntries = size_t(1) << 24;
 effects_status toFog(const effects_fog* c, effects::fog::Fog& f, effects_error** error) {
   namespace fg = effects::fog;
   if (!c) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "fog is NULL");
-  if (!sized(c->size, sizeof(effects_fog))) return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_fog)");
+  if (!sized(c->size, sizeof(effects_fog)))
+    return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_fog)");
   if (c->type < int32_t(EFFECTS_FOG_X3D_LINEAR) || c->type > int32_t(EFFECTS_FOG_ATMOSPHERIC))
     return fail(error, EFFECTS_INVALID_ARGUMENT, "/fogType", "is not an effects_fog_type");
   if (c->convention < int32_t(EFFECTS_FOG_EFFECTD) || c->convention > int32_t(EFFECTS_FOG_UNREAL))
@@ -133,7 +135,8 @@ effects_status toFog(const effects_fog* c, effects::fog::Fog& f, effects_error**
   f.startDistance = c->start_distance;
   f.maxOpacity = c->max_opacity;
   f.cutoffDistance = c->cutoff_distance > 0 ? c->cutoff_distance : std::numeric_limits<double>::infinity();
-  if (c->has_second_layer) f.secondLayer = fg::HeightLayer{c->second_density, c->second_height_falloff, c->second_base_height};
+  if (c->has_second_layer)
+    f.secondLayer = fg::HeightLayer{c->second_density, c->second_height_falloff, c->second_base_height};
   if (c->has_directional) {
     fg::Directional d;
     d.color = vec(c->directional_color);
@@ -245,7 +248,8 @@ effects_status effects_fog_factor(const effects_fog* fog, double originY, double
     if (effects_status s = toFog(fog, f, error)) return s;
     if (!out) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "f is NULL");
     if (!std::isfinite(originY) || !(dirY >= -1.0 && dirY <= 1.0) || !(distance >= 0.0) || !std::isfinite(distance))
-      return fail(error, EFFECTS_INVALID_ARGUMENT, "/ray", "origin_y finite, dir_y in [-1, 1], distance finite and >= 0");
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/ray",
+                  "origin_y finite, dir_y in [-1, 1], distance finite and >= 0");
     *out = effects::fog::factorAtElevation(f, originY, dirY, distance);
     return EFFECTS_OK;
   });
@@ -261,7 +265,8 @@ void effects_fog_table_options_defaults(effects_fog_table_options* c) {
   c->max_size = o.maxSize;
   c->elevations = o.elevations;
   c->camera_height = o.cameraHeight;
-  c->layout = int32_t(EFFECTS_FOG_LAYOUT_LINEAR);
+  c->layout = int32_t(o.layout == effects::fog::TableOptions::Layout::kWarped ? EFFECTS_FOG_LAYOUT_WARPED
+                                                                              : EFFECTS_FOG_LAYOUT_LINEAR);
 }
 
 effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog_table_options* c,
@@ -381,11 +386,13 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
     lt::Params sides = p;
     if (sides.targets.empty() && c->target_region) sides.targets.push_back(sides.start);
     if (auto e = lt::validate(sides)) return fail(error, *e);
-    const size_t limit = p.method == lt::Method::kFast ? kMaxGridCells : p.depth ? kMaxSolverVolumeCells : kMaxSolverGridCells;
+    const size_t limit = p.method == lt::Method::kFast ? kMaxGridCells
+                         : p.depth                     ? kMaxSolverVolumeCells
+                                                       : kMaxSolverGridCells;
     if (cellsOf(p) > limit)
       return fail(error, EFFECTS_LIMIT_EXCEEDED, "/grid",
-                  "grid of " + std::to_string(cellsOf(p)) + " cells exceeds the limit of " + std::to_string(limit) + " for " +
-                      lt::toString(p.method));
+                  "grid of " + std::to_string(cellsOf(p)) + " cells exceeds the limit of " + std::to_string(limit) +
+                      " for " + lt::toString(p.method));
     if (c->obstacles) p.obstacles.assign(c->obstacles, c->obstacles + cellsOf(p));
     if (c->target_region) p.targetRegion.assign(c->target_region, c->target_region + cellsOf(p));
     if (c->calibrated) {
@@ -456,10 +463,12 @@ effects_status effects_bolt_lines_make(const effects_bolt* bolt, const effects_b
     s.branchWidth = c->branch_width;
     s.branchIntensity = c->branch_intensity;
     s.branchFalloff = c->branch_falloff;
-    if (!(s.jitter >= 0 && s.jitter <= 1)) return fail(error, EFFECTS_INVALID_ARGUMENT, "/shape/jitter", "must be in [0, 1]");
+    if (!(s.jitter >= 0 && s.jitter <= 1))
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/shape/jitter", "must be in [0, 1]");
     if (!(s.branchWidth > 0 && s.branchWidth <= 1e6) || !(s.branchIntensity >= 0 && s.branchIntensity <= 1) ||
         !(s.branchFalloff > 0 && s.branchFalloff <= 1e9))
-      return fail(error, EFFECTS_INVALID_ARGUMENT, "/shape", "branch width in (0, 1e6], intensity in [0, 1], falloff in (0, 1e9]");
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/shape",
+                  "branch width in (0, 1e6], intensity in [0, 1], falloff in (0, 1e9]");
     const std::vector<lt::Polyline> lines = lt::polylines(bolt->bolt, s);
     auto* made = new effects_bolt_lines;
     std::unique_ptr<effects_bolt_lines> owner(made);
@@ -498,7 +507,9 @@ static const effects_bolt_lines::Line* lineAt(const effects_bolt_lines* l, size_
   return l && k < l->lines.size() ? &l->lines[k] : nullptr;
 }
 int effects_bolt_line_is_main(const effects_bolt_lines* l, size_t k) { return lineAt(l, k) && lineAt(l, k)->main; }
-float effects_bolt_line_width(const effects_bolt_lines* l, size_t k) { return lineAt(l, k) ? lineAt(l, k)->width : 0.0f; }
+float effects_bolt_line_width(const effects_bolt_lines* l, size_t k) {
+  return lineAt(l, k) ? lineAt(l, k)->width : 0.0f;
+}
 size_t effects_bolt_line_vertex_count(const effects_bolt_lines* l, size_t k) {
   return lineAt(l, k) ? lineAt(l, k)->steps.size() : 0;
 }
@@ -530,12 +541,14 @@ effects_status effects_tangents_generate(const effects_mesh_in* c, int32_t mode,
   return guarded(error, [&] {
     if (out) *out = nullptr;
     if (!c || !out) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "mesh or result is NULL");
-    if (!sized(c->size, sizeof(effects_mesh_in))) return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_mesh_in)");
+    if (!sized(c->size, sizeof(effects_mesh_in)))
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_mesh_in)");
     if (mode < int32_t(EFFECTS_TANGENTS_MIKKTSPACE) || mode > int32_t(EFFECTS_TANGENTS_PER_VERTEX))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/mode", "is not an effects_tangent_mode");
     tg::Options o;
     if (c->vertex_count > o.maxVertices) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/positions", "too many vertices");
-    if (c->index_count > 3 * o.maxTriangles) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/indices", "too many triangles");
+    if (c->index_count > 3 * o.maxTriangles)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/indices", "too many triangles");
     if ((c->vertex_count && (!c->positions || !c->uvs)) || (c->index_count && !c->indices))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/positions", "positions, uvs and indices must not be NULL");
     tg::Mesh m;
@@ -547,7 +560,8 @@ effects_status effects_tangents_generate(const effects_mesh_in* c, int32_t mode,
     }
     if (c->normals) {
       m.normals.resize(c->vertex_count);
-      for (size_t i = 0; i < c->vertex_count; ++i) m.normals[i] = {c->normals[3 * i], c->normals[3 * i + 1], c->normals[3 * i + 2]};
+      for (size_t i = 0; i < c->vertex_count; ++i)
+        m.normals[i] = {c->normals[3 * i], c->normals[3 * i + 1], c->normals[3 * i + 2]};
     }
     m.indices.assign(c->indices, c->indices + c->index_count);
     o.mode = tg::Mode(int(mode));
@@ -587,7 +601,8 @@ void effects_bubble_params_defaults(effects_bubble_params* c) {
   c->wobble = o.wobble;
 }
 
-effects_status effects_bubble_mesh_make(const effects_bubble_params* c, effects_bubble_mesh** out, effects_error** error) {
+effects_status effects_bubble_mesh_make(const effects_bubble_params* c, effects_bubble_mesh** out,
+                                        effects_error** error) {
   return guarded(error, [&] {
     if (out) *out = nullptr;
     if (!out) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "mesh is NULL");
@@ -604,12 +619,22 @@ effects_status effects_bubble_mesh_make(const effects_bubble_params* c, effects_
 void effects_bubble_mesh_free(effects_bubble_mesh* m) { delete m; }
 size_t effects_bubble_mesh_vertex_count(const effects_bubble_mesh* m) { return m ? m->mesh.positions.size() : 0; }
 // glm's vectors are arrays of their components: a vector of them is the flat array C wants.
-const float* effects_bubble_mesh_positions(const effects_bubble_mesh* m) { return m && !m->mesh.positions.empty() ? &m->mesh.positions[0].x : nullptr; }
-const float* effects_bubble_mesh_normals(const effects_bubble_mesh* m) { return m && !m->mesh.normals.empty() ? &m->mesh.normals[0].x : nullptr; }
-const float* effects_bubble_mesh_uvs(const effects_bubble_mesh* m) { return m && !m->mesh.uvs.empty() ? &m->mesh.uvs[0].x : nullptr; }
-const float* effects_bubble_mesh_tangents(const effects_bubble_mesh* m) { return m && !m->mesh.tangents.empty() ? &m->mesh.tangents[0].x : nullptr; }
+const float* effects_bubble_mesh_positions(const effects_bubble_mesh* m) {
+  return m && !m->mesh.positions.empty() ? &m->mesh.positions[0].x : nullptr;
+}
+const float* effects_bubble_mesh_normals(const effects_bubble_mesh* m) {
+  return m && !m->mesh.normals.empty() ? &m->mesh.normals[0].x : nullptr;
+}
+const float* effects_bubble_mesh_uvs(const effects_bubble_mesh* m) {
+  return m && !m->mesh.uvs.empty() ? &m->mesh.uvs[0].x : nullptr;
+}
+const float* effects_bubble_mesh_tangents(const effects_bubble_mesh* m) {
+  return m && !m->mesh.tangents.empty() ? &m->mesh.tangents[0].x : nullptr;
+}
 size_t effects_bubble_mesh_index_count(const effects_bubble_mesh* m) { return m ? m->mesh.indices.size() : 0; }
-const uint32_t* effects_bubble_mesh_indices(const effects_bubble_mesh* m) { return m ? m->mesh.indices.data() : nullptr; }
+const uint32_t* effects_bubble_mesh_indices(const effects_bubble_mesh* m) {
+  return m ? m->mesh.indices.data() : nullptr;
+}
 
 effects_status effects_bubble_uniforms(const effects_bubble_params* c, double t, double* top, double* bottom,
                                        double flow[2], effects_error** error) {

@@ -11,7 +11,8 @@ A row is "right" only when its check passes; --check exits 1 when one does not.
 --mutations); the report (scripts/report.sh) runs the full sizes and the property sweep.
 --mutations shows that every check can fail: each row also has a mutation, a plausible wrong
 answer made from the real ones (a fog factor 1 % off or the naive overflow's 1, a bolt cell moved
-off its tree, a mesh vertex nudged, a tangent frame flipped, a 4xx naming another field, ...),
+off its tree, a mesh vertex nudged, a tangent frame flipped, a 4xx naming another field, a linear
+table's entries under a warped table's axes, a preview's bubble 20 % brighter or moved 3 pixels, ...),
 fed to the same check, which must reject it ("caught"); with --check a mutation that is NOT
 caught fails the run like a failed row.
 """
@@ -21,10 +22,12 @@ import datetime
 import json
 import math
 import os
+import struct
 import subprocess
 import sys
 import tempfile
 import time
+import zlib
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, os.path.join(ROOT, "tests"))
@@ -58,6 +61,31 @@ def height_f(a, b, h, oy, dy, t, near_level=0.0):
         else:
             ltau += -x - lx
     return 0.0 if ltau > 709 else math.exp(-math.exp(ltau))
+
+
+LN2 = math.log(2.0)
+
+
+def unreal_f(f, camera, point):
+    """Unreal's GetExponentialHeightFog in effectd's units (docs/effects.md §2.4, U1-U4), one layer,
+    written out here: base 2 per world unit (A = a/ln²2, B = b/ln2); the observer lowered to 65536
+    units above the layer (U4), the ray from there to the point (its rise v_y grows by the drop);
+    the density at the observer with its exponent clamped to [−125, 126] (U3); F = max(−127, B·v_y)
+    (U3); I = A'·(1 − 2^−F)/F, or the Taylor term A'·(ln2 − ln²2·F/2) where |F| ≤ 0.01 (U2);
+    f = saturate(2^(−I·L)), L = |observer → point|. Components from half-differences (no overflow
+    at ±1e200); a product that overflows is ∞ and 2^−∞ = 0."""
+    a, b, h = f.get("density", 1), f.get("heightFalloff", 0.1), f.get("baseHeight", 0)
+    if a == 0:
+        return 1.0
+    A, B = a / (LN2 * LN2), b / LN2
+    observer = min(camera[1], h + 65536.0)
+    half = [0.5 * q - 0.5 * p for p, q in zip(camera, point)]
+    vy = 2 * half[1] + (camera[1] - observer)
+    length = math.hypot(2 * half[0], vy, 2 * half[2])
+    terms = A * 2.0 ** min(max(-B * (observer - h), -125.0), 126.0)
+    F = max(-127.0, B * vy)
+    line = terms * -math.expm1(-F * LN2) / F if abs(F) > 0.01 else terms * (LN2 - 0.5 * LN2 * LN2 * F)
+    return min(1.0, max(0.0, 2.0 ** -(line * length)))
 
 
 def exp_neg(*factors):
@@ -112,6 +140,8 @@ def fog_model(f, camera, point):
     elif t == "HEIGHT" and conv == "filament":  # m·d, m the whole ray's mean density (F2: sigma(c_y) near level)
         factor = height_f(f.get("density", 1), f.get("heightFalloff", 0.1), f.get("baseHeight", 0), camera[1], u[1], d,
                           near_level=0.00125)
+    elif t == "HEIGHT" and conv == "unreal":
+        factor = unreal_f(f, camera, point)
     elif t == "ATMOSPHERIC":
         tr = [exp_neg(b, d) for b in f.get("extinction", [0, 0, 0])]
         return (sum(tr) / 3, tr, [c * one_minus_exp_neg(b, d) for c, b in zip(color, f.get("inscattering", [0, 0, 0]))])
@@ -120,6 +150,8 @@ def fog_model(f, camera, point):
     sun = f.get("directional")
     if sun is None:
         return factor, None, None
+    if conv != "effectd":
+        raise ValueError(f"fog_model: directional in convention {conv}")
     if sun.get("startDistance", 0) != 0:
         raise ValueError("fog_model: directional.startDistance")
     cos = sum(a * b for a, b in zip(u, ray([0, 0, 0], sun.get("direction", [0, 0, -1]))[1])) if d > 0 else 0.0
@@ -685,7 +717,389 @@ def regrown(body, text):
     return mutation(text, change)
 
 
-# (effect, case, endpoint, bodies, check, what must hold[, mutation]); bodies may be a list (invariances).
+# ---- warped HEIGHT tables (docs/using/fog.md §4; fog.h WarpedAxes) -------------------------------
+def warped_row_y(axes, v):
+    """Row v in [0, 1] -> the ray's y: the inverse of v = 1/2 + asinh(k y)/(2 asinh k)."""
+    k = axes["k"]
+    return min(1.0, max(-1.0, math.sinh(math.asinh(k) * (2 * v - 1)) / k))
+
+
+def warped_span(axes, y, start):
+    """The column span of the row at y (common.json's fogTable.axes, written out)."""
+    full = max(axes["end"] - start, 0.0)
+    if not y < 0 or not axes["kappa"] > 0:
+        return full
+    big_k = axes["kappa"] * math.exp(axes["falloff"] * y * start)
+    x = -big_k * y
+    own = axes["lambda"] * big_k * (math.log1p(x) / x if x > 0 else 1.0)
+    lo, hi = min(full, own), max(full, own)
+    return lo * (1 + (lo / hi) ** 8) ** (-1 / 8) if hi > 0 else 0.0
+
+
+def warped_table(bodies):
+    """Every entry of warped HEIGHT tables against height_f at the (distance, y) that the answer's
+    axes put it at (row v_j = j/(rows − 1) -> y = sinh((2v − 1)·asinh k)/k; column u_i = i/(size − 1)
+    -> d = start + u·span(y)); the axes checked against the request where the request fixes them
+    (falloff, range, k in [1, 1e6]); and each row long enough: a lookup past its last column
+    clamps there, which is within 1/255 of the closed form out to the range's end (docs/using/fog.md
+    §5) only if f(last column) − f(end) ≤ 1/255 (f falls with d)."""
+    def check(answers):
+        seen, bad, n, errs, rels, lo = [], [], 0, [0.0], [0.0], math.inf
+        for body, (s, a) in zip(bodies, answers):
+            if s != 200:
+                return False, f"status {s}: {(a.get('errors') or [{}])[0].get('message', '')}"
+            f, req, t = body["fog"], body["table"], a["table"]
+            ax = t.get("axes") or {}
+            cam = req["cameraHeight"]
+            if t.get("layout") != "warped" or not ax:
+                return False, "no warped layout or axes in the answer"
+            start, end = t["range"]
+            if ax["falloff"] != f["heightFalloff"] or ax["factorStart"] != start or ax["end"] != end \
+                    or not 1 <= ax["k"] <= 1e6 or ("range" in req and t["range"] != req["range"]):
+                bad.append(f"axes {ax} against the request's falloff {f['heightFalloff']:g} and range {t['range']}")
+            width, rows = t["size"], t["elevations"]
+            fac = t["factor"]
+            if len(fac) != width * rows:
+                return False, f"{len(fac)} factors for {width} × {rows}"
+            for j in range(rows):
+                y = warped_row_y(ax, j / (rows - 1))
+                span = warped_span(ax, y, ax["factorStart"])
+                last = end if span >= end - ax["factorStart"] else ax["factorStart"] + span
+                for i in range(width):
+                    d = last if i == width - 1 else ax["factorStart"] + span * i / (width - 1)
+                    o, e = fac[j * width + i], height_f(f["density"], f["heightFalloff"], f.get("baseHeight", 0), cam, y, d)
+                    errs.append(abs(o - e))
+                    if e > 1e-30:
+                        rels.append(abs(o / e - 1))
+                    if not near(o, e):
+                        bad.append(f"row {j} (y {y:.6g}), column {i} (d {d:.6g}): f {o:.7g}, closed form {e:.7g}")
+                beyond = fac[j * width + width - 1] - height_f(f["density"], f["heightFalloff"], f.get("baseHeight", 0), cam, y, end)
+                if beyond > 1 / 255 + 2e-6:
+                    bad.append(f"row {j} (y {y:.6g}) ends at d = {last:.6g} with f {fac[j * width + width - 1]:.4g}: "
+                               f"{beyond:.4g} above the closed form at the range's end {end:.6g}")
+                lo = min(lo, span)
+            n += len(fac)
+            seen.append(f"{width} × {rows} (k {ax['k']:.4g}, κ {ax['kappa']:.4g}, λ {ax['lambda']:.4g}; f in "
+                        f"[{min(fac):.3g}, {max(fac):.3g}])")
+        text = (f"{'; '.join(seen)}: {n} entries at their warped (d, y), shortest span {lo:.3g}; max |f − closed form| "
+                f"{max(errs):.2g} (relative {max(rels):.2g} above 1e-30); past each row's last column f falls by at most 1/255")
+        return not bad, text if not bad else text + "; " + "; ".join(bad[:3])
+
+    def linear(answers):  # the same requests in the linear layout: its entries under warped axes
+        for k, body in enumerate(bodies):
+            lin = copy.deepcopy(body)
+            lin["table"]["layout"] = "linear"
+            s, a, _ = SERVER.post("/v1/fog", lin)
+            answers[k][1]["table"]["factor"] = a["table"]["factor"]
+    check.mutation = mutation("the linear table's entries (the layout ignored) under the warped axes", linear)
+    return check
+
+
+def warped(f, size, rows, camera_height, rng=None):
+    table = {"size": size, "elevations": rows, "cameraHeight": camera_height, "layout": "warped"}
+    if rng:
+        table["range"] = rng
+    return fog(f, table=table)
+
+
+def warped_rows():
+    w1 = [warped(HEIGHT, 64, 32, 2)]
+    w2 = [warped({**HEIGHT, "density": 1e300}, 32, 16, c, [0, 100]) for c in (3, -3)]
+    w3 = [warped({**HEIGHT, "heightFalloff": 100}, 32, 16, 0.5)]
+    w4 = [warped(HEIGHT, 32, 16, 300, [0, 1e5])]
+    return [
+        ("fog", "HEIGHT, warped 64 × 32, camera at 2", "fog", w1, warped_table(w1),
+         "every entry = height_f at the (d, y) its axes give, within 2e-6 and 1e-5 relative (float32); each row "
+         "out to its fog's completeness or the range's end"),
+        ("fog", "HEIGHT, warped, density 1e300, camera 3 above and 3 below the layer", "fog", w2, warped_table(w2),
+         "downward rows' columns 1e-299 long (κ at its e^−690 floor), f at each = height_f; level and rising rows "
+         "0 past d = 0; every row out to completeness"),
+        ("fog", "HEIGHT, warped, falloff 100 (a 1 cm layer), camera 0.5 above it", "fog", w3, warped_table(w3),
+         "κ = e^59: the straight-down row's columns end 0.89 away, past the layer; the level and rising rows reach "
+         "the default range's end (5.7e23, where the level ray's fog is complete); every entry = height_f"),
+        ("fog", "HEIGHT, warped, camera 300 above the layer, range [0, 1e5]", "fog", w4, warped_table(w4),
+         "σ at the camera e^−60·a: the downward rows' columns run past where they reach the layer; every entry = "
+         "height_f, none short of the fog's completeness"),
+    ]
+
+
+# ---- Unreal's convention (docs/effects.md §2.4, U1-U4) -------------------------------------------
+UNREAL = {"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 1e-4, "baseHeight": 0, "convention": "unreal"}
+
+
+def effectd_instead(f, camera, points):
+    """A mutation: each sample's f as effectd's exact integral would give it (the convention ignored)."""
+    ef = {k: v for k, v in f.items() if k != "convention"}
+
+    def change(answers):
+        for x, p in zip(answers[0][1]["samples"], points):
+            x["factor"] = fog_model(ef, camera, p)[0]
+    return mutation("effectd's exact integral (the convention ignored)", change)
+
+
+def unreal_rows():
+    high = (0, 1e6, 0)
+    high_pts = [[1e200, 1e199, 0], [3e199, 4e199, 0], [1e5, 1e6, 0], [0, 0, 0]]
+    steep = {**UNREAL, "density": 1e-42}
+    steep_pts = [[0, -1e6, 0], [0, -1e7, 0], [1e6, -1e6, 0], [5e41, 0, 0]]
+    ub = {**UNREAL, "density": 1e300}
+    ub_pts = [[1e-300, 0, 0], [0, 0, 2e-300], [1e200, 1e200, 0]]
+    ef = {k: v for k, v in UNREAL.items() if k != "convention"}
+    fu = ", ".join(f"{unreal_f(UNREAL, high, p):.3g}" for p in high_pts)
+    eu = ", ".join(f"{fog_model(ef, high, p)[0]:.3g}" for p in high_pts)
+    fs = ", ".join(f"{unreal_f(steep, (0, 0, 0), p):.3g}" for p in steep_pts)
+    es = ", ".join(f"{fog_model({**ef, 'density': 1e-42}, (0, 0, 0), p)[0]:.3g}" for p in steep_pts)
+    ut = {**UNREAL, "color": [0.7, 0.75, 0.8]}
+    return [
+        fog_points("HEIGHT in Unreal's convention, camera 1e6 above the layer, points to 1e200", UNREAL, high_pts,
+                   f"Unreal's f from its observer lowered to 65536 (U4): f = {fu} (effectd's from the camera: {eu})",
+                   camera=high, mutated=effectd_instead(UNREAL, high, high_pts)),
+        fog_points("HEIGHT in Unreal's convention, density 1e-42, falls of 1e6 and 1e7", steep, steep_pts,
+                   f"B·v_y clamped at −127 (U3) on the falls, the Taylor term on the level ray (U2): f = {fs} "
+                   f"(effectd: {es})",
+                   mutated=effectd_instead(steep, (0, 0, 0), steep_pts)),
+        fog_points("HEIGHT in Unreal's convention, density 1e300, points 1e-300 … 1.4e200 away", ub, ub_pts,
+                   "A'·L from 1e300·2^0 and 1e-300: f = " + ", ".join(f"{unreal_f(ub, (0, 0, 0), p):.3g}" for p in ub_pts),
+                   mutated=mutation("the farthest f in (0, 1) ×0.99", off_samples)),
+        ("fog", "HEIGHT in Unreal's convention: table, camera 1e5 (observer at 65536), range [0, 1e6]", "fog",
+         fog(ut, table={"size": 32, "elevations": 9, "cameraHeight": 1e5, "range": [0, 1e6], "layout": "linear"}),
+         fog_table(lambda d, dy: unreal_f(ut, (0, 1e5, 0), (d * math.sqrt(max(0.0, 1 - dy * dy)), 1e5 + d * dy, 0))),
+         "every entry = Unreal's f (U2-U4 written out here) within 2e-6 and 1e-5 relative (float32)"),
+    ]
+
+
+# ---- /v1/scene: each part as its own endpoint answers it ----------------------------------------
+def scene_parts(scene_body, parts, fog_check):
+    """The scene's answer holds exactly the parts asked for, each equal (as parsed JSON) to the
+    standalone endpoint's answer for the same body; the fog part also against its closed form, the
+    bolt a connected tree to its target."""
+    def check(answers):
+        if not ok_status(200, answers):
+            return False, "statuses " + ", ".join(str(s) for s, _ in answers)
+        scene = answers[0][1]
+        probs = [] if set(scene) == set(parts) else [f"parts {sorted(scene)}, asked for {sorted(parts)}"]
+        probs += [f"the scene's {p} differs from /v1/{p}'s" for p, (_, a) in zip(parts, answers[1:]) if scene.get(p) != a]
+        ok_fog, seen_fog = fog_check([(200, scene.get("fog", {}))])
+        if not ok_fog:
+            probs.append("fog against its closed form: " + seen_fog)
+        probs += tree_problems(scene_body["lightning"], scene["lightning"], cells_of(scene["lightning"]))
+        m = scene["bubble"]["mesh"]
+        seen = (f"fog, lightning ({len(cells_of(scene['lightning']))} cells) and bubble ({len(m['positions']) // 3} "
+                f"vertices) equal to /v1/fog's, /v1/lightning's and /v1/bubble's; fog: {seen_fog}")
+        return not probs, seen if not probs else "; ".join(probs[:3])
+
+    def nudge(answers):
+        p = answers[0][1]["bubble"]["mesh"]["positions"]
+        p[0] += 1e-6 * scene_body["bubble"]["mesh"]["radius"]
+    check.mutation = mutation("the scene's bubble: one vertex nudged by 1e-6 of its radius", nudge)
+    return check
+
+
+def scene_rows():
+    fr = fog_points("", {**HEIGHT, "density": 1e300, "heightFalloff": 1e300},
+                    [[3e-300, 5e-300, 0], [3e-300, -3e-300, 0], [5e-300, 1e-300, 0]], "", camera=(0, 1e-300, 0))
+    scene = {"fog": fr[3], "lightning": {**bolt(48, eta=50, seed=7), "include": ["cells", "tree"]},
+             "bubble": {"time": 1e9, "mesh": {"level": 2, "radius": 1e-6}, "include": ["mesh"]}}
+    parts = ["fog", "lightning", "bubble"]
+    return [("scene", "fog 1e300 over 5e-300, bolt at η 50, bubble of radius 1e-6 at t = 1e9", ["scene"] + parts,
+             [scene] + [scene[p] for p in parts], scene_parts(scene, parts, fr[4]),
+             "each part of the scene's answer equal (as parsed JSON) to its endpoint's answer for the same body; the "
+             "fog's f = height_f (0.64, 2e-11, 0.16); the bolt a connected tree to its target")]
+
+
+# ---- /v1/render: the preview's pixels against the reference renderer ----------------------------
+def png_decode(data):
+    """(width, height, channels, depth, rows): an 8- or 16-bit PNG (grey, RGB, grey + alpha or RGBA,
+    not interlaced) inflated with zlib and its five filter types undone; rows[y][x·channels + c] in
+    [0, 1]. The CRC of every chunk is checked."""
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError("not a PNG")
+    pos, idat, ihdr = 8, [], None
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        chunk = data[pos + 8:pos + 8 + n]
+        if zlib.crc32(kind + chunk) != struct.unpack(">I", data[pos + 8 + n:pos + 12 + n])[0]:
+            raise ValueError(f"bad CRC in {kind!r}")
+        if kind == b"IHDR":
+            ihdr = struct.unpack(">IIBBBBB", chunk)
+        elif kind == b"IDAT":
+            idat.append(chunk)
+        elif kind == b"IEND":
+            break
+        pos += 12 + n
+    w, h, depth, ctype, _, _, interlace = ihdr
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[ctype]
+    if depth not in (8, 16) or interlace:
+        raise ValueError(f"bit depth {depth}, interlace {interlace}: not decoded here")
+    bpp = channels * depth // 8  # bytes per pixel: the filters' left neighbour
+    stride = w * bpp
+    raw = zlib.decompress(b"".join(idat))
+    prev, rows = bytearray(stride), []
+    for y in range(h):
+        ftype, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b = prev[i]
+            c = prev[i - bpp] if i >= bpp else 0
+            if ftype == 1:
+                line[i] = (line[i] + a) & 255
+            elif ftype == 2:
+                line[i] = (line[i] + b) & 255
+            elif ftype == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif ftype == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+            elif ftype != 0:
+                raise ValueError(f"filter type {ftype}")
+        prev = line
+        rows.append([v / 255 for v in line] if depth == 8 else [v / 65535 for v in struct.unpack(f">{stride // 2}H", line)])
+    return w, h, channels, depth, rows
+
+
+def png_encode(w, h, channels, depth, rows):
+    """The inverse (filter 0 throughout): a mutation's edited image sent back through the check."""
+    top = 255 if depth == 8 else 65535
+    raw = bytearray()
+    for r in rows:
+        vals = [min(top, max(0, round(v * top))) for v in r]
+        raw += b"\x00" + (bytes(vals) if depth == 8 else struct.pack(f">{len(vals)}H", *vals))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    ctype = {1: 0, 3: 2, 2: 4, 4: 6}[channels]
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, ctype, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(bytes(raw))) + chunk(b"IEND", b""))
+
+
+def rgb_pixels(png):
+    w, h, c, _, rows = png_decode(png)
+    return w, h, [tuple(rows[y][x * c:x * c + 3]) for y in range(h) for x in range(w)]
+
+
+def sphere_pixels(scene):
+    """Which pixels' centre rays meet the bubble's sphere: the closed form, from the scene's camera
+    (look-at, fovY, the aspect), the bubble's radius and bubbleStyle.center."""
+    cam = scene["camera"]
+    eye, target = cam["position"], cam.get("target", [0, 0.5, 0])
+    w, h = scene["width"], scene["height"]
+
+    def unit(v):
+        n = math.hypot(*v)
+        return [x / n for x in v]
+
+    def cross(a, b):
+        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    fw = unit([b - a for a, b in zip(eye, target)])
+    right = unit(cross(fw, cam.get("up", [0, 1, 0])))
+    up = cross(right, fw)
+    ty = math.tan(math.radians(cam.get("fovY", 45)) / 2)
+    tx = ty * w / h
+    centre, r = scene.get("bubbleStyle", {}).get("center", [0, 0, 0]), scene["bubble"]["mesh"]["radius"]
+    oc = [(a - b) / r for a, b in zip(eye, centre)]  # in radii: the same sums at radius 1e-6 and 1e6
+    out = []
+    for y in range(h):
+        for x in range(w):
+            nx, ny = 2 * (x + 0.5) / w - 1, 1 - 2 * (y + 0.5) / h
+            d = unit([f + nx * tx * a + ny * ty * b for f, a, b in zip(fw, right, up)])
+            half = sum(a * b for a, b in zip(oc, d))
+            disc = half * half - (sum(a * a for a in oc) - 1)
+            out.append(disc > 0 and -half - math.sqrt(disc) > 0)
+    return out
+
+
+def delta_e(p, q):
+    """CIE76 ΔE*ab between two sRGB colours (D65), as docs/bubble-shading.md measures."""
+    def lab(rgb):
+        r, g, b = (c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in rgb)
+        xyz = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047, 0.2126 * r + 0.7152 * g + 0.0722 * b, \
+            (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883
+        fx, fy, fz = (t ** (1 / 3) if t > (6 / 29) ** 3 else t / (3 * (6 / 29) ** 2) + 4 / 29 for t in xyz)
+        return 116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)
+    return math.dist(lab(p), lab(q))
+
+
+RENDER_BOUND = 5 / 255  # mean |preview − reference| per channel over the sphere's pixels
+
+
+def render_matches_reference(scene, moved=None):
+    """Bodies: the preview (/v1/render), the reference (reference: true) and the backdrop alone (the
+    scene without its bubble). Silhouette: where each image differs from the backdrop (by 1.5/255 or
+    more on a channel) is the sphere's closed-form silhouette, but for pixels on its edge (a 3 × 3
+    neighbourhood that straddles it: the mesh's polygon outline). Colour: the mean |preview −
+    reference| per channel over the sphere's pixels at most RENDER_BOUND (5/255)."""
+    disk = sphere_pixels(scene)
+    w, h = scene["width"], scene["height"]
+    edge = [any(disk[yy * w + xx] != disk[y * w + x] for yy in range(max(0, y - 1), min(h, y + 2))
+                for xx in range(max(0, x - 1), min(w, x + 2))) for y in range(h) for x in range(w)]
+    inside = [i for i in range(w * h) if disk[i]]
+
+    def check(answers):
+        if not ok_status(200, answers) or not all(isinstance(a, bytes) for _, a in answers):
+            return False, "statuses " + ", ".join(str(s) for s, _ in answers)
+        (pw, ph, pre), (rw, rh, ref), (_, _, bg) = (rgb_pixels(a) for _, a in answers)
+        if (pw, ph, rw, rh) != (w, h, w, h):
+            return False, f"{pw} × {ph} and {rw} × {rh} pixels, {w} × {h} asked for"
+        masks = [[max(abs(p - q) for p, q in zip(img[i], bg[i])) >= 1.5 / 255 for i in range(w * h)] for img in (pre, ref)]
+        off = [sum(1 for i in range(w * h) if m[i] != disk[i] and not edge[i]) for m in masks]
+        apart = sum(1 for a, b in zip(*masks) if a != b)
+        mad = sum(abs(p - q) for i in inside for p, q in zip(pre[i], ref[i])) / (3 * len(inside))
+        de = sum(delta_e(pre[i], ref[i]) for i in inside) / len(inside)
+        ok = off == [0, 0] and 0 < mad <= RENDER_BOUND
+        return ok, (f"{len(inside)} pixels in the sphere's silhouette (closed form): preview and reference differ from "
+                    f"the backdrop there, off it {off[0]} and {off[1]} pixels away from its edge, {apart} apart (on the "
+                    f"edge); mean |preview − reference| {mad * 255:.2f}/255 per channel (bound "
+                    f"{RENDER_BOUND * 255:g}), mean ΔE*ab {de:.2f}")
+
+    def edit(text, fn):
+        def change(answers):
+            pw, ph, c, depth, rows = png_decode(answers[0][1])
+            fn(pw, ph, c, rows)
+            answers[0] = (answers[0][0], png_encode(pw, ph, c, depth, rows))
+        return mutation(text, change)
+
+    def brighter(pw, ph, c, rows):
+        for i in inside:
+            y, x = divmod(i, pw)
+            rows[y][x * c:x * c + 3] = [min(1.0, 1.2 * v) for v in rows[y][x * c:x * c + 3]]
+
+    def shifted(pw, ph, c, rows):
+        for r in rows:
+            r[moved * c:] = r[:len(r) - moved * c]
+
+    check.mutation = (edit("the preview's bubble ×1.2 brighter", brighter) if moved is None else
+                      edit(f"the preview moved {moved} pixels right", shifted))
+    return check
+
+
+def bubble_scene(radius=1.0, near=None, far=None, depth=8):
+    cam = {"position": [0, 0.3 * radius, 4 * radius], "target": [0, 0, 0], "fovY": 45}
+    if near:
+        cam.update(near=near, far=far)
+    return {"width": 96, "height": 96, "bitDepth": depth, "time": 7, "camera": cam,
+            "background": {"gradient": {"top": [0.18, 0.24, 0.2], "bottom": [0.08, 0.1, 0.07]}},
+            "environment": {"zenith": [0.35, 0.6, 1.0], "horizon": [1.0, 0.98, 0.95], "ground": [0.16, 0.18, 0.12]},
+            "bubble": {"mesh": {"level": 4, "radius": radius}, "film": {"seed": 3}, "features": {"wobble": False}}}
+
+
+def render_rows():
+    out = []
+    for name, scene, moved in (
+            ("examples/03's bubble, 96 × 96", bubble_scene(), None),
+            ("radius 1e-6 seen from 4e-6 (near 1e-7, far 1e-5), 16-bit PNG", bubble_scene(1e-6, 1e-7, 1e-5, 16), 3),
+            ("radius 1e6 seen from 4e6 (near 1e5, far 1e7)", bubble_scene(1e6, 1e5, 1e7), 3)):
+        backdrop = {k: v for k, v in scene.items() if k != "bubble"}
+        out.append(("render", f"preview against the reference: {name}", "render",
+                    [scene, {**scene, "reference": True}, backdrop], render_matches_reference(scene, moved),
+                    "the bubble on the sphere's closed-form silhouette in both (all but its edge pixels); mean "
+                    "|preview − reference| ≤ 5/255 per channel over it (measured 3.2; docs/bubble-shading.md: mean "
+                    "ΔE*ab 3.09 for this shading, about 1 level of 255 per ΔE here; a 1-pixel shift gives 6.2)"))
+    return out
+
+
+# (effect, case, endpoint, bodies, check, what must hold[, mutation]); bodies may be a list (invariances);
+# endpoint may be a list too, one per body.
 HEIGHT = {"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0}
 
 
@@ -842,36 +1256,36 @@ def cases(quick):
          fog_transmittance([1e-300, 1, 300]), "transmittance e^(−β·d) per channel: 1, e^−d, below 1e-40 from the second entry"),
         ("fog", "HEIGHT, falloff 0 (uniform density)", "fog",
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0, "baseHeight": 0},
-             table={"size": 64, "elevations": 16, "cameraHeight": 3}),
+             table={"size": 64, "elevations": 16, "cameraHeight": 3, "layout": "linear"}),
          fog_table(lambda d, dy: math.exp(-0.05 * d)), "the b → 0 limit: Beer–Lambert, exp(−a·d) on every ray"),
         ("fog", "HEIGHT, falloff 100", "fog",
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 100, "baseHeight": 0},
-             table={"size": 64, "elevations": 16, "cameraHeight": 3}),
+             table={"size": 64, "elevations": 16, "cameraHeight": 3, "layout": "linear"}),
          fog_table(lambda d, dy: height_f(0.05, 100, 0, 3, dy, d)),
          "the closed form: rays that stay up see almost no fog, rays that dive into the 1 cm layer are fogged"),
         ("fog", "HEIGHT, falloff 1e300 (a layer of zero thickness)", "fog",
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 1e300, "baseHeight": 0},
-             table={"size": 16, "elevations": 9, "cameraHeight": 3, "range": [0, 100]}),
+             table={"size": 16, "elevations": 9, "cameraHeight": 3, "range": [0, 100], "layout": "linear"}),
          fog_table(lambda d, dy: height_f(0.05, 1e300, 0, 3, dy, d)),
          "e^(−b·Δh) at b = 1e300: no fog on level and rising rays, all fog below the layer; no 0·∞"),
         ("fog", "HEIGHT, density 1e300", "fog",
          fog({"fogType": "HEIGHT", "density": 1e300, "heightFalloff": 0.2, "baseHeight": 0},
-             table={"size": 16, "elevations": 9, "cameraHeight": 3, "range": [0, 100]}),
+             table={"size": 16, "elevations": 9, "cameraHeight": 3, "range": [0, 100], "layout": "linear"}),
          fog_table(lambda d, dy: height_f(1e300, 0.2, 0, 3, dy, d)), "f = 0 for any d > 0, 1 at the camera"),
         ("fog", "GL_EXP2, density 1e150 (its square overflows)", "fog",
          fog({"fogType": "GL_EXP2", "density": 1e150}, table={"size": 16, "range": [0, 1]}),
          fog_table(lambda d: 1.0 if d == 0 else 0.0), "(density·d)² = ∞ past d = 0: f = 0 exactly, not NaN"),
         ("fog", "HEIGHT, camera 1e6 above the layer", "fog",
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
-             table={"size": 64, "elevations": 16, "cameraHeight": 1e6}),
+             table={"size": 64, "elevations": 16, "cameraHeight": 1e6, "layout": "linear"}),
          problem(422, "/table/range"), "most rays never reach 1/255: a 422 asking for an explicit range"),
         ("fog", "HEIGHT, camera 1e6 above the layer, range [0, 1e7]", "fog",
          fog({"fogType": "HEIGHT", "density": 0.05, "heightFalloff": 0.2, "baseHeight": 0},
-             table={"size": 64, "elevations": 16, "cameraHeight": 1e6, "range": [0, 1e7]}),
+             table={"size": 64, "elevations": 16, "cameraHeight": 1e6, "range": [0, 1e7], "layout": "linear"}),
          fog_table(lambda d, dy: height_f(0.05, 0.2, 0, 1e6, dy, d)), "the closed form with e^(−b·h) underflowing: f = 1 up high"),
         fog_points("HEIGHT, horizontal rays inside the layer", HEIGHT, [[1e3, 0, 0], [1e6, 0, 0], [0, 0, -50]],
                    "b·Δh → 0: exp(−a·d) at the camera's density (e^−50, 0, e^−2.5)"),
-    ] + fog_sample_rows() + [
+    ] + fog_sample_rows() + warped_rows() + unreal_rows() + [
         ("lightning", "η = 0 (uniform growth), 64², fast, dbm and charges", "lightning", uniform,
          bolts_equal(uniform, "the same bolt from fast, dbm and charges"),
          "η = 0 weighs every candidate alike whatever the field (0⁰ = 1, even where Φ underflows): the three methods "
@@ -1003,7 +1417,7 @@ def cases(quick):
          tangents_equal_at_scales({"mesh": QUAD}, [1e-30, 1e6, 1e38]),
          "tangents are directions: the same as at scale 1 within 1e-6, along ∂p/∂u at every scale"),
     ]
-    return out
+    return out + scene_rows() + render_rows()
 
 
 SERVER = None
@@ -1037,10 +1451,11 @@ def run_cases(server, quick, mutations=False):
         effect, name, endpoint, bodies, check, must = row[:6]
         mutated = row[6] if len(row) > 6 else getattr(check, "mutation", None) or DEFAULT_MUTATIONS.get(effect)
         bodies = bodies if isinstance(bodies, list) else [bodies]
+        endpoints = endpoint if isinstance(endpoint, list) else [endpoint] * len(bodies)  # a list: one per body
         answers, ms = [], []
-        for b in bodies:
-            status, answer, seconds = server.post("/v1/" + endpoint, b)
-            answers.append((status, answer if isinstance(answer, dict) else {}))
+        for e, b in zip(endpoints, bodies):
+            status, answer, seconds = server.post("/v1/" + e, b)
+            answers.append((status, answer if isinstance(answer, (dict, bytes)) else {}))  # bytes: a PNG
             ms.append(seconds * 1000)
         try:
             ok, seen = check(answers)
@@ -1054,7 +1469,7 @@ def run_cases(server, quick, mutations=False):
             mut = f"{text}: {'caught' if caught else 'NOT caught'}"
         else:
             mut = f"{mutated[0] if mutated else 'none'} (not run: --mutations)"
-        method = answers[0][1].get("method", "") if answers[0][0] == 200 else ""
+        method = answers[0][1].get("method", "") if answers[0][0] == 200 and isinstance(answers[0][1], dict) else ""
         msq = sorted(ms)[len(ms) // 2]
         rows.append((effect, name, "/".join(sorted({str(s) for s, _ in answers})), method, f"{msq:.1f}", must, seen,
                      mut, "✓" if ok else "✗ FAILED"))
@@ -1097,7 +1512,8 @@ def main():
           "wall-clock time from the client. Fog factors, transmittances and colours are compared within 2e-6 and, "
           "above 1e-30, within 1e-5 relative (so that e^−50 1 % off fails); a bolt's \"connected tree\" is checked "
           "cell by cell: rooted at the start, every parent grown before its child and a grid neighbour of it, no cell "
-          "twice, the main channel the parent chain from the start to the target. "
+          "twice, the main channel the parent chain from the start to the target. Render rows decode the PNGs here "
+          "(zlib) and compare the preview with the CPU reference over the sphere's closed-form silhouette. "
           "mutation: a plausible wrong answer made from the real ones and fed to "
           "the same check (`--mutations`), which must reject it (caught); with `--check` one it lets through fails "
           "the run too.",

@@ -19,6 +19,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Fog make(FogType t) { return fixtures::fogOf(t); }
 
+// Table options with the evenly spaced layout these tests check entries at (HEIGHT tables are
+// warped by default; the warped tests say so).
+TableOptions linear() {
+  TableOptions o;
+  o.layout = TableOptions::Layout::kLinear;
+  return o;
+}
+
 const FogType kAll[] = {FogType::kX3dLinear,  FogType::kX3dExponential, FogType::kGlLinear,         FogType::kGlExp,
                         FogType::kGlExp2,     FogType::kDistanceExp2,   FogType::kDistanceGaussian, FogType::kHeight,
                         FogType::kAtmospheric};
@@ -174,7 +182,7 @@ TEST(Fog, HeightTableEntriesEqualTheClosedForm) {
           f.density = a;
           f.heightFalloff = b;
           f.baseHeight = 1.0;
-          TableOptions o;
+          TableOptions o = linear();
           o.size = 513;
           o.elevations = 65;
           o.cameraHeight = cam;
@@ -326,7 +334,7 @@ TEST(Fog, EngineTermsInTables) {
   f.maxOpacity = 0.75;
   f.cutoffDistance = 30;
   f.secondLayer = HeightLayer{0.01, 0.02, 5};
-  TableOptions o;
+  TableOptions o = linear();
   o.size = 65;
   o.elevations = 9;
   o.cameraHeight = 1;
@@ -351,7 +359,7 @@ TEST(Fog, EngineTermsInTables) {
       c.density = 0.01;
       c.heightFalloff = 0.1;
       c.cutoffDistance = type == FogType::kGlExp ? 100.0 : 123.456;
-      TableOptions w;
+      TableOptions w = linear();
       w.size = width;
       w.elevations = type == FogType::kHeight ? 3 : 0;
       auto ct = buildTable(c, w);
@@ -365,7 +373,7 @@ TEST(Fog, EngineTermsInTables) {
   h.density = 0.05;
   h.heightFalloff = 0.2;
   h.cutoffDistance = 28.82184447501209;
-  TableOptions r;
+  TableOptions r = linear();
   r.size = 16;
   r.elevations = 3;
   r.cameraHeight = 2;
@@ -383,7 +391,7 @@ TEST(Fog, EngineTermsInTables) {
   EXPECT_NEAR(completeDistance(late), 100 + std::log(255.0) / 0.1, 1e-9);
   Fog g = make(FogType::kGlExp);
   g.maxOpacity = 0.5;
-  o = TableOptions{};
+  o = linear();
   o.maxError = 1e-3;
   auto s = buildTable(g, o);
   ASSERT_TRUE(s.ok()) << s.error().message;
@@ -456,7 +464,7 @@ TEST(Fog, DirectionalInscattering) {
   }
   EXPECT_GT(shade(f, obj, eye, {0, 1.5, -40}).r, shade(f, obj, eye, {0, 1.5, 40}).r);  // brighter towards the sun
   // Tables carry 1 - f_dir beside f, exactly, and their error covers it.
-  TableOptions o;
+  TableOptions o = linear();
   o.size = 33;
   o.elevations = 5;
   o.cameraHeight = 1;
@@ -530,7 +538,7 @@ TEST(Fog, AtmosphericPerChannel) {
   // Large tables (filled by a recurrence along the row) hold f, T and S to within one unit in
   // the last place of the stored float, through the start, the opacity cap and the cutoff.
   {
-    TableOptions big;
+    TableOptions big = linear();
     big.size = 4096;
     auto tb = buildTable(f, big);
     ASSERT_TRUE(tb.ok());
@@ -569,7 +577,7 @@ TEST(Fog, AtmosphericPerChannel) {
   ASSERT_TRUE(validate(g));
   EXPECT_EQ(validate(g)->field, "/extinction/1");
   // Tables carry T and S per channel, exactly.
-  TableOptions o;
+  TableOptions o = linear();
   o.size = 33;
   auto t = buildTable(f, o);
   ASSERT_TRUE(t.ok());
@@ -589,11 +597,11 @@ TEST(Fog, OffX3dFogNamesItsVisibilityRange) {
   for (FogType type : {FogType::kX3dLinear, FogType::kX3dExponential}) {
     Fog f = make(type);
     f.visibilityRange = 0;
-    auto t = buildTable(f, TableOptions{});
+    auto t = buildTable(f, linear());
     ASSERT_FALSE(t.ok());
     EXPECT_EQ(t.error().field, "/visibilityRange");
     EXPECT_EQ(t.error().kind, effects::ErrorKind::kUnsatisfiable);
-    TableOptions o;
+    TableOptions o = linear();
     o.rangeEnd = 10.0;
     o.size = 4;
     t = buildTable(f, o);
@@ -645,7 +653,7 @@ TEST(Fog, TableErrorShrinksWithSize) {
     Fog f = make(t);
     double prev = 1e9;
     for (size_t n : {16, 64, 256, 1024}) {
-      TableOptions o;
+      TableOptions o = linear();
       o.size = n;
       o.elevations = t == FogType::kHeight ? 16 : 0;
       auto table = buildTable(f, o);
@@ -667,7 +675,7 @@ TEST(Fog, SmallestSizeForErrorMeetsIt) {
       // A 2-D height table reaches ~4e-4 at the 256x256 entry limit.
       if (t == FogType::kHeight && target < 1e-3) continue;
       Fog f = make(t);
-      TableOptions o;
+      TableOptions o = linear();
       o.size = 0;
       o.maxError = target;
       auto table = buildTable(f, o);
@@ -748,7 +756,7 @@ TEST(Fog, WarpedHeightTablesMeetAHundredthAt64x32) {
     double linearError;  // below the 64 x 32 linear table's error (0.485 sunset, 0.0139 steep)
   };
   for (const Case& c : {Case{"sunset", sunsetFog(), 1.7, 0.4}, Case{"steep", steepFog(), 2.0, 0.0139}}) {
-    TableOptions o;
+    TableOptions o = linear();
     o.size = 64;
     o.elevations = 32;
     o.cameraHeight = c.cameraHeight;
@@ -774,7 +782,7 @@ TEST(Fog, WarpedTablesOfEachConventionAndTheSmallestForAnError) {
     Fog f = steepFog();
     f.convention = conv;
     f.startDistance = 4;
-    TableOptions o;
+    TableOptions o = linear();
     o.layout = TableOptions::Layout::kWarped;
     o.cameraHeight = 2;
     o.maxError = 0.01;
@@ -803,7 +811,7 @@ TEST(Fog, WarpedAxesStayFiniteOnStiffFogs) {
     f.density = c.density;
     f.heightFalloff = c.falloff;
     f.maxOpacity = c.maxOpacity;
-    TableOptions o;
+    TableOptions o = linear();
     o.layout = TableOptions::Layout::kWarped;
     o.size = 64;
     o.cameraHeight = c.camera;
@@ -822,7 +830,7 @@ TEST(Fog, WarpedAxesStayFiniteOnStiffFogs) {
 TEST(Fog, TableRangesAndLimits) {
   Fog f = make(FogType::kDistanceExp2);
   f.distanceCoefficient = 0;
-  TableOptions o;
+  TableOptions o = linear();
   o.size = 8;
   auto t = buildTable(f, o);
   ASSERT_FALSE(t.ok());
@@ -838,7 +846,7 @@ TEST(Fog, TableRangesAndLimits) {
   EXPECT_EQ(t.error().kind, ErrorKind::kLimitExceeded);
   // The default range ends where the fog is complete to 1/255.
   Fog e = make(FogType::kGlExp);
-  o = TableOptions{};
+  o = linear();
   o.size = 64;
   t = buildTable(e, o);
   ASSERT_TRUE(t.ok());

@@ -124,6 +124,7 @@ void expectFogMatchesTable(const TestServer& s, const json& fogDef, int elevatio
   if (elevations) {
     tableReq["table"]["elevations"] = elevations;
     tableReq["table"]["cameraHeight"] = cameraHeight;
+    tableReq["table"]["layout"] = "linear";  // its middle row is the horizontal ray
   }
   auto t = s.postJson("/v1/fog", tableReq);
   ASSERT_TRUE(t);
@@ -212,15 +213,17 @@ TEST(Render, FogInARenderMatchesTheFogTableColours) {
 // plus the glow, inscatter * colour * lobe(angle to the sun), from the same answer.
 TEST(Render, FogGlowsTowardsTheSun) {
   TestServer s;
-  const json fogDef = {{"fogType", "GL_EXP"},
-                       {"color", {0.25, 0.3, 0.4}},
-                       {"density", 0.04},
-                       {"startDistance", 3},
-                       {"directional", {{"color", {1.2, 0.6, 0.2}}, {"direction", {0.5, 0, -1}}, {"g", 0.5}, {"startDistance", 6}}}};
+  const json fogDef = {
+      {"fogType", "GL_EXP"},
+      {"color", {0.25, 0.3, 0.4}},
+      {"density", 0.04},
+      {"startDistance", 3},
+      {"directional", {{"color", {1.2, 0.6, 0.2}}, {"direction", {0.5, 0, -1}}, {"g", 0.5}, {"startDistance", 6}}}};
   const double range = 40;
   const int size = 9;
-  auto t = s.postJson("/v1/fog", json{{"fog", fogDef}, {"table", {{"size", size}, {"range", {0, range}}}},
-                                      {"objectColors", {{0.1, 0.1, 0.1}}}});
+  auto t = s.postJson(
+      "/v1/fog",
+      json{{"fog", fogDef}, {"table", {{"size", size}, {"range", {0, range}}}}, {"objectColors", {{0.1, 0.1, 0.1}}}});
   ASSERT_EQ(t->status, 200) << t->body;
   const json table = json::parse(t->body)["table"];
   const int W = 256, H = 128;
@@ -238,14 +241,17 @@ TEST(Render, FogGlowsTowardsTheSun) {
     const double ndcX = -0.85 + 1.7 * (i - 1) / (size - 2);
     const double angle = std::atan(ndcX * tanHalf * aspect);
     const glm::dvec3 dir(std::sin(angle), 0, -std::cos(angle)), c = dir * d;
-    scene["quads"].push_back({{"center", {c.x, c.y, c.z}}, {"normal", {-dir.x, 0, -dir.z}}, {"size", {0.02 * d, 0.02 * d}},
+    scene["quads"].push_back({{"center", {c.x, c.y, c.z}},
+                              {"normal", {-dir.x, 0, -dir.z}},
+                              {"size", {0.02 * d, 0.02 * d}},
                               {"color", {0.1, 0.1, 0.1}}});
     const double g = 0.5, cosT = glm::dot(dir, toSun), den = (1 - g) * (1 - g) + 2 * g * (1 - cosT);
     const double lobe = (1 - g) * (1 + g) / (den * std::sqrt(den));
     glm::dvec3 want;
     for (int k = 0; k < 3; ++k)
-      want[k] = table["finalColors"][0][size_t(i) * 3 + size_t(k)].get<double>() +
-                table["inscatter"][size_t(i)].get<double>() * fogDef["directional"]["color"][size_t(k)].get<double>() * lobe;
+      want[k] =
+          table["finalColors"][0][size_t(i) * 3 + size_t(k)].get<double>() +
+          table["inscatter"][size_t(i)].get<double>() * fogDef["directional"]["color"][size_t(k)].get<double>() * lobe;
     expected.emplace_back(int(std::floor((ndcX * 0.5 + 0.5) * W)), H / 2, want);
   }
   auto r = render(s, scene);
@@ -266,15 +272,16 @@ TEST(Render, FogConventionsDrawAsTheirSamples) {
   const double aspect = double(W) / H, tanHalf = std::tan(30.0 * M_PI / 180), cameraY = 2;
   const glm::dvec3 quadColor(0.9, 0.6, 0.2);
   for (const char* convention : {"filament", "unreal"}) {
-    const json fogDef = {{"fogType", "HEIGHT"},
-                         {"convention", convention},
-                         {"color", {0.55, 0.6, 0.7}},
-                         {"density", 0.06},
-                         {"heightFalloff", 0.3},
-                         {"startDistance", 4},
-                         {"maxOpacity", 0.9},
-                         {"directional",
-                          {{"color", {1.5, 0.8, 0.3}}, {"direction", {0.3, 0.2, -1}}, {"exponent", 6}, {"startDistance", 5}}}};
+    const json fogDef = {
+        {"fogType", "HEIGHT"},
+        {"convention", convention},
+        {"color", {0.55, 0.6, 0.7}},
+        {"density", 0.06},
+        {"heightFalloff", 0.3},
+        {"startDistance", 4},
+        {"maxOpacity", 0.9},
+        {"directional",
+         {{"color", {1.5, 0.8, 0.3}}, {"direction", {0.3, 0.2, -1}}, {"exponent", 6}, {"startDistance", 5}}}};
     json scene = {{"width", W},
                   {"height", H},
                   {"camera", {{"position", {0, cameraY, 0}}, {"target", {0, cameraY, -1}}, {"fovY", 60}}},
@@ -517,12 +524,12 @@ TEST(Render, ReferenceRenderAgreesWithTheFilmShader) {
   EXPECT_LT(outside, 1.5) << "the backdrop is the same picture";
   EXPECT_LT(sum / count, 4.0) << "mean Delta E*ab over the bubble";
 
-  for (auto [field, value, status] : {std::tuple{"/lightning",
-                                                  json{{"grid", {{"width", 16}, {"height", 16}}},
-                                                       {"start", {8, 0}},
-                                                       {"targets", json::array({json{8, 15}})}},
-                                                  422},
-                                      std::tuple{"/frames", json{{"count", 2}}, 422}}) {
+  for (auto [field, value, status] :
+       {std::tuple{
+            "/lightning",
+            json{{"grid", {{"width", 16}, {"height", 16}}}, {"start", {8, 0}}, {"targets", json::array({json{8, 15}})}},
+            422},
+        std::tuple{"/frames", json{{"count", 2}}, 422}}) {
     json bad = ref;
     bad[std::string(field).substr(1)] = value;
     json p = expectProblem(render(s, bad), status);
@@ -534,6 +541,39 @@ TEST(Render, ReferenceRenderAgreesWithTheFilmShader) {
   json big = ref;
   big["width"] = big["height"] = 1024;
   EXPECT_TRUE(hasPointer(expectProblem(render(s, big), 413), "/width"));
+}
+
+// measureError: the frame's bubble against the reference, in X-Effect-Error, with the reference's
+// time as Server-Timing's error stage; a scene the reference cannot trace is refused first.
+TEST(Render, MeasureErrorComparesTheFrameWithTheReference) {
+  TestServer s;
+  const int n = 64;
+  json scene = {{"width", n},
+                {"height", n},
+                {"time", 7},
+                {"measureError", true},
+                {"camera", {{"position", {0, 0, 4}}, {"target", {0, 0, 0}}, {"fovY", 45}}},
+                {"background", {{"gradient", {{"top", {0.2, 0.25, 0.2, 1}}, {"bottom", {0.05, 0.05, 0.05, 1}}}}}},
+                {"bubble", {{"mesh", {{"level", 5}}}, {"features", {{"wobble", false}}}}}};
+  auto r = render(s, scene);
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const std::string error = r->get_header_value("X-Effect-Error"), timing = r->get_header_value("Server-Timing");
+  ASSERT_NE(error.find("kind=measured"), std::string::npos) << error;
+  const double mean = std::stod(error.substr(error.find("meanDeltaE=") + 11));
+  EXPECT_GT(mean, 0.0) << error;  // a shader, not the trace itself
+  EXPECT_LT(mean, 4.0) << error;  // as ReferenceRenderAgreesWithTheFilmShader
+  EXPECT_NE(timing.find("error;dur="), std::string::npos) << timing;
+  json plain = scene;
+  plain.erase("measureError");
+  auto p = render(s, plain);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->get_header_value("X-Effect-Error"), "");
+  EXPECT_EQ(p->body, r->body);  // the same frame
+  json bad = scene;
+  bad["lightning"] = {
+      {"grid", {{"width", 16}, {"height", 16}}}, {"start", {8, 0}}, {"targets", json::array({json{8, 15}})}};
+  EXPECT_TRUE(hasPointer(expectProblem(render(s, bad), 422), "/lightning"));
 }
 
 // A cluster: every bubble drawn (far to near), each with its own age; /v1/scene answers each;
@@ -738,7 +778,8 @@ TEST(Render, BadScenesNameTheField) {
   problem({{"fog", {{"fog", {{"fogType", "GL_LINEAR"}, {"start", 5}, {"end", 1}}}}}}, 400, "/fog/fog/end");
   problem({{"bubble", {{"mesh", {{"level", 9}}}}}}, 400, "/bubble/mesh/level");
   problem({{"quads", {{{"center", {0, 0, 0}}, {"size", {1, 1}}, {"normal", {0, 0, 0}}}}}}, 400, "/quads/0/normal");
-  problem({{"quads", {{{"center", {0, 0, -5}}, {"size", {1, 1}}}}}, {"surfaceWave", {{"quad", 1}}}}, 422, "/surfaceWave/quad");
+  problem({{"quads", {{{"center", {0, 0, -5}}, {"size", {1, 1}}}}}, {"surfaceWave", {{"quad", 1}}}}, 422,
+          "/surfaceWave/quad");
 
   // A PNG larger than the pixel limit is refused from its header, before decoding.
   rd::Image big{1100, 1000, std::vector<float>(size_t(1100) * 1000 * 4, 0.5f)};
@@ -751,11 +792,18 @@ TEST(Render, BadScenesNameTheField) {
 // pixel the waves change lies on the quad, none in the sky above it or on a wall in front of it.
 TEST(Render, SurfaceWaveOnAQuadLightsOnlyThatQuad) {
   TestServer s;
-  const json water = {{"center", {0, -1, -10}}, {"normal", {0, 1, 0}}, {"up", {0, 0, -1}}, {"size", {40, 30}}, {"color", {0.1, 0.12, 0.18}}};
+  const json water = {{"center", {0, -1, -10}},
+                      {"normal", {0, 1, 0}},
+                      {"up", {0, 0, -1}},
+                      {"size", {40, 30}},
+                      {"color", {0.1, 0.12, 0.18}}};
   const json wall = {{"center", {0, -0.5, -4}}, {"size", {1, 1.5}}, {"color", {0.3, 0.3, 0.3}}};
-  json scene = {{"width", 96}, {"height", 96}, {"time", 5},
+  json scene = {{"width", 96},
+                {"height", 96},
+                {"time", 5},
                 {"camera", {{"position", {0, 1, 6}}, {"target", {0, 0.5, 0}}, {"fovY", 50}}},
-                {"background", {{"color", {0.05, 0.05, 0.1}}}}, {"quads", {water, wall}}};
+                {"background", {{"color", {0.05, 0.05, 0.1}}}},
+                {"quads", {water, wall}}};
   const rd::Image plain = decode(render(s, scene)->body);
   scene["surfaceWave"] = {{"strength", 2}, {"scale", 4}, {"quad", 0}};
   auto r = render(s, scene);

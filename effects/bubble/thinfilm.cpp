@@ -106,30 +106,46 @@ double airy(double F, double phi) {
   return F * s2 / (1 + F * s2);
 }
 
-// J(phi) = integral from 0 to phi of 1 / (1 + F sin^2 x) dx, continuous across the branches of tan.
-double airyPrimitive(double F, double phi) {
-  const double a = std::sqrt(1 + F), m = std::nearbyint(phi / kPi);
-  return (m * kPi + std::atan(a * std::tan(phi - m * kPi))) / a;
+// J(phi) = integral from 0 to phi of 1 / (1 + F sin^2 x) dx, continuous across the branches of
+// tan: (m pi + atan(a tan(phi - m pi))) / a, a = sqrt(1 + F), m = round(phi / pi); for s and p
+// at once (a per polarisation), as they share phi and so the tangent.
+glm::dvec2 airyPrimitive(const glm::dvec2& a, double phi) {
+  const double m = std::nearbyint(phi / kPi), t = std::tan(phi - m * kPi);
+  return {(m * kPi + std::atan(a.x * t)) / a.x, (m * kPi + std::atan(a.y * t)) / a.y};
 }
 
-// The mean of the Airy reflectance over phases [phi1, phi2] (phi1 <= phi2).
-double airyMean(double F, double phi1, double phi2) {
-  if (std::isinf(F)) return 1.0;
-  const double width = phi2 - phi1;
-  if (width < 1e-3)  // Simpson: the closed form's difference would cancel
-    return (airy(F, phi1) + 4 * airy(F, 0.5 * (phi1 + phi2)) + airy(F, phi2)) / 6;
-  return std::clamp(1 - (airyPrimitive(F, phi2) - airyPrimitive(F, phi1)) / width, 0.0, 1.0);
-}
-
-// The method: each bin's reflectance averaged over its phases (see the top of the file).
+// The method: each band's reflectance the mean of R over its phases (see the top of the file),
+// per polarisation. The bands share their edges, so J is taken once an edge: 1 - (J2 - J1) / (phi2
+// - phi1), or Simpson's rule where the phase width is below 1e-3 (the difference would cancel).
 glm::dvec3 color(const Sampling& s, double ior, double d, double cosTheta) {
   if (!(ior > 1)) return glm::dvec3(0);
   const Interfaces f = interfaces(ior, cosTheta);
-  const double C = 2 * kPi * ior * std::max(0.0, d) * f.cosT, half = 200.0 / double(s.nm.size());
+  if (std::isinf(f.F.x) && std::isinf(f.F.y)) return intoGamut(glm::dvec3(1));  // grazing: R = 1
+  const size_t n = s.nm.size();
+  const double C = 2 * kPi * ior * std::max(0.0, d) * f.cosT, width = 400.0 / double(n);
+  // Band k spans [380 + k width, 380 + (k + 1) width] nm: phases from C / its top to C / its bottom.
+  auto edge = [&](size_t k) { return C / (380.0 + width * double(k)); };
+  const glm::dvec2 a = glm::sqrt(1.0 + f.F);  // infinite at grazing: that polarisation is R = 1 below
+  auto primitive = [&](double phi) { return airyPrimitive(a, phi); };
+  double phiHi = edge(0);
+  glm::dvec2 J = primitive(phiHi);
   glm::dvec3 xyz(0);
-  for (size_t k = 0; k < s.nm.size(); ++k) {
-    const double phi1 = C / (s.nm[k] + half), phi2 = C / (s.nm[k] - half);
-    xyz += 0.5 * (airyMean(f.F.x, phi1, phi2) + airyMean(f.F.y, phi1, phi2)) * s.weight[k];
+  for (size_t k = 0; k < n; ++k) {
+    const double phiLo = edge(k + 1), span = phiHi - phiLo;
+    const glm::dvec2 Jnext = primitive(phiLo);
+    double R = 0;
+    for (int p = 0; p < 2; ++p) {
+      const double F = f.F[p];
+      if (std::isinf(F))
+        R += 0.5;  // this polarisation reflects everything
+      else if (span < 1e-3)
+        R += (airy(F, phiLo) + 4 * airy(F, 0.5 * (phiLo + phiHi)) + airy(F, phiHi)) / 12;
+      else
+        R += std::clamp(1 - (J[p] - Jnext[p]) / span, 0.0, 1.0) / 2;
+    }
+    xyz += R * s.weight[k];
+    J = Jnext;
+    phiHi = phiLo;
   }
   return intoGamut(xyzToLinearSrgb(xyz) / s.white);
 }

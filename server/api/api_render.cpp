@@ -1,5 +1,9 @@
 // POST /v1/render (scene -> image/png) and POST /v1/scene (scene -> each effect's JSON).
+#include <cstdio>
 #include <memory>
+#include <optional>
+
+#include <effects/bubble.h>
 
 #include "api/api_bubble.h"
 #include "api/api_common.h"
@@ -38,7 +42,8 @@ std::vector<std::pair<const json*, std::string>> sceneBubbles(const json& body) 
 // when it has them, as the render lights it.
 SceneRequest parseSceneRequest(const json& body, const RequestContext& ctx) {
   SceneRequest r;
-  if (body.contains("lightning")) r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
+  if (body.contains("lightning"))
+    r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
   if (body.contains("fog")) r.fog = parseFogRequest(body["fog"], partContext(ctx, "/fog"));
   for (const auto& [bubble, at] : sceneBubbles(body)) {
     json lit = *bubble;
@@ -58,6 +63,7 @@ JsonReply runScene(const SceneRequest& request, const json& body, const RequestC
       throw fieldError(422, at + "/format",
                        "a scene answers JSON: ask /v1/" + std::string(endpoint) + " itself for this binary format");
     reply.computeMs += r.computeMs;
+    reply.errorMs += r.errorMs;
     return std::move(r.body);
   };
   if (request.lightning)
@@ -82,6 +88,7 @@ RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
   RenderRequest r;
   r.scene = parseSceneRequest(body, ctx);
   r.reference = body.value("reference", r.reference);
+  r.measureError = body.value("measureError", r.measureError);
   const rd::Scene defaults;
   r.width = body.value("width", defaults.width);
   r.height = body.value("height", defaults.height);
@@ -90,28 +97,54 @@ RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
   return r;
 }
 
-// `reference: true`: the bubble ray traced on the CPU (render::referenceRender), a still of
-// at most kMaxReferencePixels.
-JsonReply referenceReply(const RenderRequest& request, const json& body, const RequestContext& ctx) {
+// The bubble ray traced on the CPU (render::referenceRender), a still of at most
+// kMaxReferencePixels: the answer of `reference: true` and what `measureError` compares with.
+rd::Reference traceReference(const RenderRequest& request, const rd::Scene& scene, const json& body,
+                             const RequestContext& ctx) {
   if (request.frames) throw fieldError(422, "/frames", "the reference is a still: leave frames out");
   const size_t pixels = size_t(request.width) * size_t(request.height);
   if (pixels > kMaxReferencePixels)
     throw fieldError(413, "/width",
                      "the reference traces " + std::to_string(rd::kReferenceWavelengths) +
                          " wavelengths per pixel: at most " + std::to_string(kMaxReferencePixels) + " pixels");
-  JsonReply reply;
-  reply.method = "reference";
-  rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
   auto r = rd::referenceRender(scene, ctx.parallel);
   // Its one bubble may be the first of "bubbles".
   if (!r.ok()) throwError(r.error(), "", {{"bubble", {body.contains("bubble") ? "/bubble" : "/bubbles/0/bubble"}}});
-  auto png = rd::encodePng(r.value().image, scene.bitDepth, ctx.parallel);
+  return std::move(r.value());
+}
+
+// X-Effect-Error of a frame measured against the reference: CIE76 Delta E*ab per pixel where the
+// reference's ray meets the bubble (the frame as its 8-bit PNG holds it).
+std::string frameError(const rd::Image& frame, const rd::Reference& ref) {
+  double sum = 0, worst = 0;
+  size_t n = 0;
+  for (size_t p = 0; p < ref.bubble.size(); ++p) {
+    if (!ref.bubble[p]) continue;
+    const float* b = &ref.image.rgba[p * 4];
+    const double de =
+        effects::bubble::deltaE({frame.at(p * 4), frame.at(p * 4 + 1), frame.at(p * 4 + 2)}, {b[0], b[1], b[2]});
+    sum += de, worst = std::max(worst, de), ++n;
+  }
+  char out[256];
+  std::snprintf(out, sizeof out,
+                "pass=bubble; meanDeltaE=%.4g; maxDeltaE=%.4g; pixels=%zu; kind=measured; "
+                "reference=\"CPU ray tracing, %d wavelengths\"",
+                n ? sum / double(n) : 0.0, worst, n, rd::kReferenceWavelengths);
+  return out;
+}
+
+JsonReply referenceReply(const RenderRequest& request, const json& body, const RequestContext& ctx) {
+  JsonReply reply;
+  reply.method = "reference";
+  rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+  auto r = traceReference(request, scene, body, ctx);
+  auto png = rd::encodePng(r.image, scene.bitDepth, ctx.parallel);
   if (!png.ok()) throwError(png.error());
   reply.binary = std::move(png.value());
   reply.contentType = "image/png";
-  reply.computeMs += r.value().ms;
-  reply.headers = {{"X-Renderer", "reference: CPU ray tracing, " + std::to_string(rd::kReferenceWavelengths) +
-                                      " wavelengths"}};
+  reply.computeMs += r.ms;
+  reply.headers = {
+      {"X-Renderer", "reference: CPU ray tracing, " + std::to_string(rd::kReferenceWavelengths) + " wavelengths"}};
   return reply;
 }
 
@@ -131,17 +164,22 @@ void addRenderEndpoints(Service& service) {
     reply.method = "render";
     Animation animation;
     rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
-    auto drawn = renderScene(std::move(scene), animation, ctx.parallel, [&pool](rd::Scene s, const rd::Sequence* sequence) {
-      auto job = sequence ? pool->submit(std::move(s), *sequence) : pool->submit(std::move(s));
-      if (!job)
-        throw ApiError{503,
-                       "render-queue-full",
-                       "Render queue full",
-                       "every render thread is busy and the queue is full; retry shortly (--render-queue)",
-                       {},
-                       {{"Retry-After", "1"}}};
-      return job->get();
-    });
+    std::optional<rd::Reference> reference;  // measureError: traced first, so that a scene it cannot
+    effects::Stopwatch measuring;            // trace is refused before the GPU works
+    if (request.measureError) reference = traceReference(request, scene, body, ctx);
+    const double referenceMs = measuring.ms();
+    auto drawn =
+        renderScene(std::move(scene), animation, ctx.parallel, [&pool](rd::Scene s, const rd::Sequence* sequence) {
+          auto job = sequence ? pool->submit(std::move(s), *sequence) : pool->submit(std::move(s));
+          if (!job)
+            throw ApiError{503,
+                           "render-queue-full",
+                           "Render queue full",
+                           "every render thread is busy and the queue is full; retry shortly (--render-queue)",
+                           {},
+                           {{"Retry-After", "1"}}};
+          return job->get();
+        });
     if (!drawn.ok()) throwError(drawn.error());
     const rd::Frame& f = drawn.value().frame;
     reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
@@ -151,11 +189,16 @@ void addRenderEndpoints(Service& service) {
     for (const auto& p : f.passes) metrics->count("render_passes", p);
     metrics->count("shader_variants_compiled", "render", f.variantsCompiled);
     const double encodeMs = drawn.value().encodeMs;
-    reply.stages = {{"scene", reply.computeMs}, {"queue", f.queueMs}, {"draw", f.drawMs},
-                    {"read", f.readMs},         {"encode", encodeMs}};
+    reply.stages = {
+        {"scene", reply.computeMs}, {"queue", f.queueMs}, {"draw", f.drawMs}, {"read", f.readMs}, {"encode", encodeMs}};
     reply.computeMs += f.ms + encodeMs;
     reply.runHeaders = {{"X-Shader-Variants-Compiled", std::to_string(f.variantsCompiled)},
                         {"X-Render-Ms", std::to_string(f.ms)}};
+    if (reference) {
+      effects::Stopwatch comparing;
+      reply.headers["X-Effect-Error"] = frameError(f.image, *reference);
+      reply.errorMs = referenceMs + comparing.ms();
+    }
     return reply;
   };
   service.addJsonEndpoint("/v1/render", "scene.json", twoSteps(parseRenderRequest, renderCost, run));

@@ -1,5 +1,7 @@
 #include "api/costs.h"
 
+#include "api/api_render.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -36,10 +38,9 @@ Cost lightningCost(const LightningRequest& r, const Config& config) {
   const lt::Params& p = r.params;
   const bool solver = p.method != lt::Method::kFast;
   const size_t depth = size_t(p.depth);
-  const size_t cells =
-      std::min(size_t(p.width) * size_t(p.height) * std::max<size_t>(depth, 1),
-               solver ? (depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells)
-                      : config.limits.maxGridCells);
+  const size_t cells = std::min(size_t(p.width) * size_t(p.height) * std::max<size_t>(depth, 1),
+                                solver ? (depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells)
+                                       : config.limits.maxGridCells);
   // Working set per cell: fast keeps the obstacle grid, candidate and potential state and
   // the boundary map; dbm keeps the multigrid hierarchy (fields, Galerkin stencils: 27-point
   // ones in 3-D). 3-D fast keeps its per-voxel state in pages of the voxels the bolt and the
@@ -52,7 +53,8 @@ Cost lightningCost(const LightningRequest& r, const Config& config) {
   // for targets before it) and the k-d tree fast measures eqn 5's P with, 13 bytes per surface
   // cell; at most 6 of 7 cells lie on a region's surface (a 3-D packing that leaves every
   // region cell a free neighbour), so 3 + 13 * 6/7 < 15 bytes per cell.
-  const size_t perCell = (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 15 : 0);
+  const size_t perCell =
+      (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 15 : 0);
   // dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = dbm && p.solver == lt::Solver::kCapacitance;
   const bool clamped = size_t(p.width) * size_t(p.height) > cells;  // refused by the parser
@@ -124,7 +126,8 @@ Cost sceneCost(const SceneRequest& r, const Config& config) {
 
 Cost renderCost(const RenderRequest& r, const Config& config) {
   Cost c = sceneCost(r.scene, config);
-  c.heavy = c.heavy || r.reference;  // seconds of CPU ray tracing
+  c.heavy = c.heavy || r.reference || r.measureError;  // seconds of CPU ray tracing
+  if (r.measureError) c.bytes += std::min(size_t(r.width) * size_t(r.height), kMaxReferencePixels) * 17;
   const size_t pixels = std::min(size_t(r.width) * size_t(r.height), config.limits.maxRenderPixels);
   // Render targets and read-back (RGBA float), the converted 8/16-bit image, the PNG; a
   // decoded background image.

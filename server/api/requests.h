@@ -46,9 +46,9 @@ struct FogRequest {
 
 struct LightningRequest {
   Includes include{nlohmann::json::object(), kLightningIncludes};
-  bool glb = false;                             // "format": "glb"
-  std::string variant = "calibrated";           // or "paper"
-  effects::lightning::Params params;            // obstacles, calibration: added by the run step
+  bool glb = false;                    // "format": "glb"
+  std::string variant = "calibrated";  // or "paper"
+  effects::lightning::Params params;   // obstacles, calibration: added by the run step
   effects::lightning::ShapeParams shape;
   effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
   World world;                                  // 3-D: where the grid lies ("world")
@@ -84,7 +84,8 @@ struct SceneRequest {
 // /v1/render: the scene's parts, and the frame.
 struct RenderRequest {
   SceneRequest scene;
-  bool reference = false;  // CPU ray tracing instead of the GPU
+  bool reference = false;     // CPU ray tracing instead of the GPU
+  bool measureError = false;  // the frame against the CPU reference (its bubble pass)
   int width = 0, height = 0;  // render::Scene's defaults unless given
   std::optional<int> frames;  // "frames.count"; none: a still
   bool backgroundImage = false;

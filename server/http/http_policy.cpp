@@ -25,7 +25,8 @@ namespace {
 // (tests/api_tangents_test.cpp EveryXHeaderIsExposedToAllowedOrigins).
 constexpr const char* kExposedHeaders =
     "ETag, Server-Timing, Retry-After, X-Request-ID, X-Effect-Method, X-Memory-Reserved, X-Renderer, "
-    "X-Render-Passes, X-Render-Ms, X-Shader-Cache, X-Shader-Compile-Ms, X-Shader-Variants-Compiled, X-Tangents, "
+    "X-Render-Passes, X-Render-Ms, X-Effect-Error, X-Shader-Cache, X-Shader-Compile-Ms, X-Shader-Variants-Compiled, "
+    "X-Tangents, "
     "X-Frame-Count, X-Frame-Rate, X-Flipbook-Columns, X-Flipbook-Rows, X-Content-Type-Options, RateLimit, "
     "RateLimit-Policy, WWW-Authenticate";
 constexpr const char* kAllowedRequestHeaders = "Authorization, Content-Type, If-None-Match, X-Request-ID";
@@ -217,7 +218,9 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
   }
   const bool effect = route->json || !route->binary.empty();
   if (effect && req.method != "POST" && req.target.size() > config_.limits.maxUrlBytes)
-    return fail({414, "uri-too-long", "URI Too Long",
+    return fail({414,
+                 "uri-too-long",
+                 "URI Too Long",
                  "the URL has " + std::to_string(req.target.size()) + " bytes, over the limit of " +
                      std::to_string(config_.limits.maxUrlBytes) + " (--max-url-bytes): POST the body instead",
                  {},
@@ -287,7 +290,7 @@ void Service::finishRequest(const httplib::Request& req, const httplib::Response
   metrics_.requestFinished(tl.route, req.method.empty() ? "-" : req.method, res.status, seconds);
   if (config_.accessLog) writeAccessLog(req, res, tl.requestId, tl.keyId, seconds);
   const bool reserved = tl.bodyTicket.bytes() + tl.workTicket.bytes() > 0;  // GETs (/metrics) reserve none
-  tl = RequestState{};  // releases the reservations: the answer has been written
+  tl = RequestState{};                      // releases the reservations: the answer has been written
   if (reserved) idleTrim_->noteFinished();  // its memory goes back once the server is idle (idle_trim.h)
 }
 

@@ -105,7 +105,7 @@ distance_only("ATMOSPHERIC rgba16f", {"fogType": "ATMOSPHERIC", "color": [0.5, 0
 
 # 5. Height fog, 2-D (the page's example): rows over the ray's y, for a camera at cameraHeight.
 height = {"fog": {"fogType": "HEIGHT", "color": [0.7, 0.75, 0.8], "density": 0.05, "heightFalloff": 0.2},
-          "table": {"size": 64, "elevations": 16, "cameraHeight": 3, "encoding": "rgba16f"}}
+          "table": {"size": 64, "elevations": 16, "cameraHeight": 3, "layout": "linear", "encoding": "rgba16f"}}
 table, _ = server.post("/v1/fog", height)
 distances, ys = measured_points(table["table"], 4)
 camera = (0.0, 3.0, 0.0)
@@ -149,9 +149,14 @@ for encoding in ("json", "rgba16f"):
     check(worst <= bound, f"warped {encoding}: the page's lookup within maxError + rounding",
           f"{worst:.3g} > {bound:.3g}")
     print(f"warped sunset {encoding}: 3000 random rays, worst {worst:.3g} (maxError {table['maxError']:.3g})")
-# Without layout the table is the linear one, as before.
-linear, _ = server.post("/v1/fog", {"fog": sunset, "table": {"size": 64, "elevations": 32, "cameraHeight": 1.7}})
-check("layout" not in linear["table"] and linear["table"]["maxError"] > 0.4, "no layout: the linear table",
+# Without layout the table is the warped one (the default since 2026-11-28); layout linear is the
+# old one, far off at the horizon.
+default, _ = server.post("/v1/fog", {"fog": sunset, "table": {"size": 64, "cameraHeight": 1.7}})
+check(default["table"].get("layout") == "warped" and default["table"]["maxError"] <= 0.01, "no layout: the warped table",
+      default["table"]["maxError"])
+linear, _ = server.post("/v1/fog", {"fog": sunset, "table": {"size": 64, "elevations": 32, "cameraHeight": 1.7,
+                                                             "layout": "linear"}})
+check("layout" not in linear["table"] and linear["table"]["maxError"] > 0.4, "layout linear: the linear table",
       linear["table"]["maxError"])
 
 server.close()

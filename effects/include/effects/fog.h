@@ -218,10 +218,11 @@ struct TableOptions {
   bool measureError = true;                    // dense-sampling error measurement (~8 evaluations/entry); false: an
                                                // estimate from the table's second differences (size tables only:
                                                // maxError's search is made of measurements)
-  // kHeight only. kLinear: rows even in the ray's y, columns even in distance (the layout of
-  // every table before it). kWarped: rows dense near the horizon and each row's columns over
-  // its own span, so that f is smooth along both axes (WarpedAxes). Other fog types ignore it.
-  enum class Layout { kLinear, kWarped } layout = Layout::kLinear;
+  // kHeight only. kWarped (the default since 2026-11-28): rows dense near the horizon and each
+  // row's columns over its own span, so that f is smooth along both axes (WarpedAxes). kLinear:
+  // rows even in the ray's y, columns even in distance (simpler to look up, but a 16 x 16 table
+  // is 0.73 off at the horizon). Other fog types ignore it.
+  enum class Layout { kLinear, kWarped } layout = Layout::kWarped;
 };
 const char* toString(TableOptions::Layout layout);  // "linear", "warped"
 std::optional<TableOptions::Layout> layoutFromString(const std::string& name);
