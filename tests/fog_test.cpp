@@ -902,5 +902,21 @@ TEST(Fog, RegionsOfExtremeSizeHoldWhatTheyShould) {
   EXPECT_LT(logVolume(tiny), logVolume(big));
 }
 
+// A falloff down in the denormals: 1 / falloff is beyond the doubles, so the warped axes are the
+// uniform fog's (finite, no infinite lambda), and the table is exp(-a d) on every row.
+TEST(Fog, WarpedAxesOfADenormalFalloffAreFinite) {
+  Fog f = make(FogType::kHeight);
+  f.density = 0.05;
+  f.heightFalloff = 5e-324;
+  const WarpedAxes a = warpedAxes(f, 2, 0, 100);
+  for (double v : {a.rowK, a.falloff, a.kappa, a.lambda, a.end}) EXPECT_TRUE(std::isfinite(v));
+  TableOptions o;  // the default, warped
+  o.size = 16;
+  o.cameraHeight = 2;
+  auto t = buildTable(f, o);
+  ASSERT_TRUE(t.ok());
+  EXPECT_LT(t.value().maxError, 0.02);  // 16 entries of exp(-0.05 d) to completeness: h^2 a^2 / 8 = 0.017
+}
+
 }  // namespace
 }  // namespace effects::fog

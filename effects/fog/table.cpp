@@ -28,10 +28,15 @@ WarpedAxes warpedAxes(const Fog& fog, double cameraHeight, double rangeStart, do
   };
   add(fog.density, fog.heightFalloff, fog.baseHeight);
   if (fog.secondLayer) add(fog.secondLayer->density, fog.secondLayer->heightFalloff, fog.secondLayer->baseHeight);
-  if (!(a.falloff > 0.0) || !std::isfinite(logDensity)) return a;  // no height dependence: even columns, rows
+  constexpr double kSpanOverComplete = 1.5;  // columns reach 1.5x the distance where f is complete
+  // No height dependence (or a falloff so small, down to the denormals, that 1 / falloff is
+  // beyond the doubles: the fog is uniform on any scale a double holds): even columns, rows.
+  if (!(a.falloff > 0.0) || !std::isfinite(logDensity) || !std::isfinite(kSpanOverComplete / a.falloff)) {
+    a.falloff = 0.0;
+    return a;
+  }
   // q: the optical depth at which the fog is complete, f = max(1/255, 1 - maxOpacity).
   const double q = -std::log(std::max(1.0 / 255.0, 1.0 - fog.maxOpacity));
-  constexpr double kSpanOverComplete = 1.5;  // columns reach 1.5x the distance where f is complete
   a.kappa = std::exp(std::clamp(std::log(q * a.falloff) - logDensity, -690.0, 69.0));
   a.lambda = kSpanOverComplete / a.falloff;
   // At the far end a point's fog changes with elevation on the scale 1 / (falloff span); rows
