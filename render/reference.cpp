@@ -166,4 +166,14 @@ Result<Reference> referenceRender(const Scene& scene, Parallel* parallel) {
   return out;
 }
 
+std::vector<double> bubbleDeltaE(const Image& frame, const Reference& reference) {
+  std::vector<double> out;
+  for (size_t p = 0; p < reference.bubble.size(); ++p) {
+    if (!reference.bubble[p]) continue;
+    const float* r = &reference.image.rgba[p * 4];
+    out.push_back(bubble::deltaE({frame.at(p * 4), frame.at(p * 4 + 1), frame.at(p * 4 + 2)}, {r[0], r[1], r[2]}));
+  }
+  return out;
+}
+
 }  // namespace effects::render

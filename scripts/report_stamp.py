@@ -14,7 +14,7 @@ import sys
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 # What each report measures: a change in these paths makes it stale.
 MEASURES = {
-    "error-vs-time.md": ["effects", "fixtures", "bench/error_report.cpp"],
+    "error-vs-time.md": ["effects", "fixtures", "render", "server", "bench/error_report.cpp", "bench/timings.h"],
     "stability.md": ["effects", "server", "proto", "scripts/stability-report.py", "tests/sweep_test.py"],
 }
 

@@ -1010,7 +1010,7 @@ def sphere_pixels(scene):
 
 
 def delta_e(p, q):
-    """CIE76 ΔE*ab between two sRGB colours (D65), as docs/bubble-shading.md measures."""
+    """CIE76 ΔE*ab between two sRGB colours (D65), as docs/error-vs-time.md measures the render previews."""
     def lab(rgb):
         r, g, b = (c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in rgb)
         xyz = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047, 0.2126 * r + 0.7152 * g + 0.0722 * b, \
@@ -1093,8 +1093,8 @@ def render_rows():
         out.append(("render", f"preview against the reference: {name}", "render",
                     [scene, {**scene, "reference": True}, backdrop], render_matches_reference(scene, moved),
                     "the bubble on the sphere's closed-form silhouette in both (all but its edge pixels); mean "
-                    "|preview − reference| ≤ 5/255 per channel over it (measured 3.2; docs/bubble-shading.md: mean "
-                    "ΔE*ab 3.09 for this shading, about 1 level of 255 per ΔE here; a 1-pixel shift gives 6.2)"))
+                    "|preview − reference| ≤ 5/255 per channel over it (measured 3.2; docs/error-vs-time.md: mean "
+                    "ΔE*ab about 3 for this shading, about 1 level of 255 per ΔE here; a 1-pixel shift gives 6.2)"))
     return out
 
 

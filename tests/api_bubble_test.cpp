@@ -41,6 +41,13 @@ TEST(BubbleApi, DefaultsAreTheFilmsUniformsAndShaderOnly) {
   json big = json::parse(s.postJson("/v1/bubble", json{{"mesh", {{"radius", 2}}}, {"include", {"uniforms"}}})->body);
   EXPECT_NEAR(big["uniforms"]["uWobbleAmplitude"].get<double>(), 0.06, 1e-12);
   EXPECT_NEAR(big["uniforms"]["uWobbleFrequency"].get<double>(), 1.5, 1e-12);
+  // The variant's error, said to be the report's estimate; the paper's model is further off.
+  EXPECT_EQ(j["shadingError"]["kind"], "estimate");
+  EXPECT_EQ(j["shadingError"]["variant"], "film + far side + highlight (default)");
+  const double paper = json::parse(s.postJson("/v1/bubble", json{{"shading", "paper"}})->body)["shadingError"]["meanDeltaE"];
+  EXPECT_GT(paper, 2 * j["shadingError"]["meanDeltaE"].get<double>());
+  // Without the shader or its uniforms there is no shading to judge.
+  EXPECT_FALSE(json::parse(s.postJson("/v1/bubble", json{{"include", {"mesh"}}})->body).contains("shadingError"));
 }
 
 TEST(BubbleApi, PaperModelUniformsAndShader) {

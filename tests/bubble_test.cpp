@@ -408,7 +408,7 @@ TEST(ThinFilm, KnownColourOrderWithGrowingThickness) {
 
 TEST(ThinFilm, AnalyticFormFollowsSamplingWithinItsFitError) {
   // Belcour & Barla's closed form against 1 nm sampling: the same film colours within the error
-  // of its Gaussian fits (docs/bubble-shading.md: mean 3.7); no film, no reflection.
+  // of its Gaussian fits (docs/error-vs-time.md, thin-film section: mean 3.6); no film, no reflection.
   EXPECT_LT(glm::length(filmColorAnalytic(1.33, 0, 1.0)), 0.01);
   EXPECT_EQ(filmColorAnalytic(1.0, 300, 0.5), glm::dvec3(0));
   double sum = 0;

@@ -489,7 +489,7 @@ TEST(Render, FilmBubbleShowsBandsOfColourOverItsFace) {
 }
 
 // reference: true ray traces the bubble on the CPU; the GPU's film shading stays close to it
-// (docs/bubble-shading.md measures every variant), and what it cannot trace is refused.
+// (docs/error-vs-time.md measures every variant), and what it cannot trace is refused.
 TEST(Render, ReferenceRenderAgreesWithTheFilmShader) {
   TestServer s;
   const int n = 96;
@@ -568,12 +568,32 @@ TEST(Render, MeasureErrorComparesTheFrameWithTheReference) {
   plain.erase("measureError");
   auto p = render(s, plain);
   ASSERT_TRUE(p);
-  EXPECT_EQ(p->get_header_value("X-Effect-Error"), "");
+  // Not measured: the shading variant's figure from the error report, said to be an estimate.
+  const std::string estimate = p->get_header_value("X-Effect-Error");
+  EXPECT_EQ(estimate.find("kind=measured"), std::string::npos) << estimate;
+  EXPECT_NE(estimate.find("pass=bubble; meanDeltaE=3.09; kind=estimate"), std::string::npos) << estimate;
   EXPECT_EQ(p->body, r->body);  // the same frame
   json bad = scene;
   bad["lightning"] = {
       {"grid", {{"width", 16}, {"height", 16}}}, {"start", {8, 0}}, {"targets", json::array({json{8, 15}})}};
   EXPECT_TRUE(hasPointer(expectProblem(render(s, bad), 422), "/lightning"));
+  // Every effect drawn has its entry, in the scene's order of kinds; a backdrop alone has none.
+  json all = bad;
+  all.erase("measureError");
+  all["fog"] = {{"fog", {{"fogType", "GL_EXP2"}, {"density", 0.05}}}};
+  auto a = render(s, all);
+  ASSERT_TRUE(a);
+  ASSERT_EQ(a->status, 200) << a->body;
+  const std::string entries = a->get_header_value("X-Effect-Error");
+  const size_t bubble = entries.find("pass=bubble;"), fog = entries.find(", pass=fog; maxSteps8bit=2; kind=estimate"),
+               bolt = entries.find(", pass=lightning; maxOffsetPx=1.75; kind=bound");
+  EXPECT_TRUE(bubble == 0 && fog != std::string::npos && bolt != std::string::npos && bubble < fog && fog < bolt)
+      << entries;
+  json backdrop = plain;
+  backdrop.erase("bubble");
+  auto b = render(s, backdrop);
+  ASSERT_TRUE(b);
+  EXPECT_FALSE(b->has_header("X-Effect-Error"));
 }
 
 // A cluster: every bubble drawn (far to near), each with its own age; /v1/scene answers each;

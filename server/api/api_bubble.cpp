@@ -293,6 +293,14 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
     const glm::dvec2 off = bb::flowOffset(params, t);  // eqn 9, for clients that offset on the CPU
     out["flowOffset"] = {off.x, off.y};
   }
+  if (include.has("uniforms") || include.has("shader")) {
+    const bb::ShadingError e = bb::shadingErrorEstimate(features);
+    out["shadingError"] = {{"meanDeltaE", e.meanDeltaE},
+                           {"kind", "estimate"},
+                           {"variant", e.variant},
+                           {"reference", "the variant's frame against CPU ray tracing (400 wavelengths) on the error "
+                                         "report's scene (docs/error-vs-time.md, Render previews)"}};
+  }
   if (!include.has("shader")) return;
   const bool filmModel = features.shading == bb::Shading::kFilm;
   json shader = {{"language", language},

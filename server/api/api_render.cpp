@@ -116,20 +116,38 @@ rd::Reference traceReference(const RenderRequest& request, const rd::Scene& scen
 // X-Effect-Error of a frame measured against the reference: CIE76 Delta E*ab per pixel where the
 // reference's ray meets the bubble (the frame as its 8-bit PNG holds it).
 std::string frameError(const rd::Image& frame, const rd::Reference& ref) {
+  const std::vector<double> de = rd::bubbleDeltaE(frame, ref);
   double sum = 0, worst = 0;
-  size_t n = 0;
-  for (size_t p = 0; p < ref.bubble.size(); ++p) {
-    if (!ref.bubble[p]) continue;
-    const float* b = &ref.image.rgba[p * 4];
-    const double de =
-        effects::bubble::deltaE({frame.at(p * 4), frame.at(p * 4 + 1), frame.at(p * 4 + 2)}, {b[0], b[1], b[2]});
-    sum += de, worst = std::max(worst, de), ++n;
-  }
+  for (double d : de) sum += d, worst = std::max(worst, d);
   char out[256];
   std::snprintf(out, sizeof out,
                 "pass=bubble; meanDeltaE=%.4g; maxDeltaE=%.4g; pixels=%zu; kind=measured; "
                 "reference=\"CPU ray tracing, %d wavelengths\"",
-                n ? sum / double(n) : 0.0, worst, n, rd::kReferenceWavelengths);
+                de.empty() ? 0.0 : sum / double(de.size()), worst, de.size(), rd::kReferenceWavelengths);
+  return out;
+}
+
+// X-Effect-Error's entries for what a frame draws besides a measured bubble: each bubble's
+// shading estimate, the fog's and the bolt's figures, all as the error report and the render
+// tests hold them (docs/rendering.md).
+std::vector<std::string> passEstimates(const rd::Scene& scene, bool bubbleMeasured) {
+  std::vector<std::string> out;
+  char e[320];
+  if (!bubbleMeasured)
+    for (const rd::Bubble& b : scene.bubbles) {
+      const effects::bubble::ShadingError s = effects::bubble::shadingErrorEstimate(b.features);
+      std::snprintf(e, sizeof e,
+                    "pass=bubble; meanDeltaE=%.3g; kind=estimate; variant=\"%s\"; "
+                    "reference=\"CPU ray tracing, %d wavelengths, on the error report's scene\"",
+                    s.meanDeltaE, s.variant, rd::kReferenceWavelengths);
+      out.push_back(e);
+    }
+  if (scene.fog)
+    out.push_back("pass=fog; maxSteps8bit=2; kind=estimate; reference=\"the fog's closed form in double "
+                  "(fog::sampleAt), within 2 steps of 8-bit colour in the error report\"");
+  if (scene.lightning)
+    out.push_back("pass=lightning; maxOffsetPx=1.75; kind=bound; reference=\"the answer's own polyline: the main "
+                  "channel's pixels lie within lightningStyle.coreWidth + 1.75 px of it (the glow spreads by design)\"");
   return out;
 }
 
@@ -164,6 +182,7 @@ void addRenderEndpoints(Service& service) {
     reply.method = "render";
     Animation animation;
     rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
+    std::vector<std::string> estimates = passEstimates(scene, request.measureError);
     std::optional<rd::Reference> reference;  // measureError: traced first, so that a scene it cannot
     effects::Stopwatch measuring;            // trace is refused before the GPU works
     if (request.measureError) reference = traceReference(request, scene, body, ctx);
@@ -196,9 +215,12 @@ void addRenderEndpoints(Service& service) {
                         {"X-Render-Ms", std::to_string(f.ms)}};
     if (reference) {
       effects::Stopwatch comparing;
-      reply.headers["X-Effect-Error"] = frameError(f.image, *reference);
+      estimates.insert(estimates.begin(), frameError(f.image, *reference));
       reply.errorMs = referenceMs + comparing.ms();
     }
+    std::string error;
+    for (const std::string& e : estimates) error += (error.empty() ? "" : ", ") + e;
+    if (!error.empty()) reply.headers["X-Effect-Error"] = error;
     return reply;
   };
   service.addJsonEndpoint("/v1/render", "scene.json", twoSteps(parseRenderRequest, renderCost, run));

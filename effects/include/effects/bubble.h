@@ -186,6 +186,16 @@ struct ShaderSource {
 // in scope); both see vWorld.
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
                     const std::string& fragmentFinish = "");
+// What a shading variant costs in accuracy: the mean CIE76 Delta E*ab of its frame against the
+// physical reference (render::referenceRender), as the error report measures it on its one
+// scene (docs/error-vs-time.md, "Render previews"; tests/report_test.cpp holds these figures to
+// the report's). An estimate for any other scene, not a measurement of it: /v1/render's
+// measureError measures a scene's own frame.
+struct ShadingError {
+  double meanDeltaE;
+  const char* variant;  // the report's row
+};
+ShadingError shadingErrorEstimate(const Features& f);
 // What tells shader variants apart: the model and one bit per feature ("film:101101111"), for
 // the caches of compiled or translated variants.
 std::string variantKey(const Features& f);
@@ -223,7 +233,7 @@ double deltaE(const glm::dvec3& a, const glm::dvec3& b);
 // Belcour & Barla 2017's analytic alternative: the Airy series to its second order, each order
 // integrated against Gaussian fits of the CIE colour matching functions in closed form (their
 // "evalSensitivity"), unpolarised Fresnel: linear sRGB without sampling wavelengths. Compared
-// with the table in docs/bubble-shading.md (build/bench/bubble_shading).
+// with the table in docs/error-vs-time.md (the thin-film section).
 glm::dvec3 filmColorAnalytic(double ior, double thicknessNm, double cosTheta);
 // Linear sRGB reflectance colour under D65 in `wavelengths` equal bands over 380-780 nm, each
 // band's reflectance the mean of the Airy function over the band's phases (a film whose fringes

@@ -229,7 +229,7 @@ class Renderer {
 // per wavelength (400, 1 nm: Airy for s and p, at the exact traced thickness of each point):
 // the front film's reflection, the light through both films, and the far film's reflection
 // seen back through the near one; lights as in the film shader. What the shading variants are
-// measured against (docs/bubble-shading.md). A scene with anything but a backdrop and a
+// measured against (docs/rendering.md, docs/error-vs-time.md). A scene with anything but a backdrop and a
 // bubble is refused (kUnsatisfiable naming the field).
 struct Reference {
   Image image;                 // opaque, straight alpha
@@ -238,6 +238,9 @@ struct Reference {
 };
 inline constexpr int kReferenceWavelengths = 400;
 Result<Reference> referenceRender(const Scene& scene, Parallel* parallel = nullptr);
+// CIE76 Delta E*ab of a frame against the reference, per pixel where the reference's ray meets
+// the bubble (in pixel order), the frame as it holds its values (an 8-bit frame: its bytes).
+std::vector<double> bubbleDeltaE(const Image& frame, const Reference& reference);
 
 // The film's thickness field at b.time as a frame draws it; prepareThickness stores it in b
 // (film model with the thickness feature; nothing otherwise).
