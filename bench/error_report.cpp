@@ -1138,7 +1138,8 @@ void conclude(std::vector<Section>& sections) {
       for (const auto& p : s.points)
         if (p.error > 0 && (!best || p.error < best->error)) best = &p;
       if (best)
-        c << "Closest to the physical bubble: " << show(*best) << ", about "
+        c << "Closest to the physical bubble: " << best->series << " (" << fmt(best->ms) << " ms, mean ΔE "
+          << fmt(best->error, 3) << "), about "
           << fmt(s.points.back().ms / std::max(best->ms, 1e-9), 2)
           << "× faster than the reference. The paper's model is a look, not a film: its refraction bends the backdrop "
              "as solid water would, and its film table is added without taking transmitted light away. The film "

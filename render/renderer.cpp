@@ -3,7 +3,9 @@
 // lightning with its glow, camera blend); a pass runs only when the scene has what it draws.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gpu.h"
@@ -12,13 +14,66 @@ namespace effects::render {
 
 namespace detail {
 
+namespace {
+
+// The depth range the frame needs: the camera's near and far planes, narrowed to what the scene
+// holds in the world (bubbles, the part of each quad in view, a world bolt) with room to spare.
+// Near the far plane a depth buffer resolves about far/near / 2^24 of the range: near 1e-7 and
+// far 1e7 put everything at depth 1, and the depth test dropped a bubble at 4. Narrowing never clips what
+// the camera's planes would not: near only rises to half the nearest content's depth, far only
+// falls to twice the farthest's.
+glm::dvec2 depthRange(const Scene& s) {
+  const Camera& c = s.camera;
+  const glm::dvec3 forward = glm::normalize(c.target - c.position);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, c.up)), up = glm::cross(right, forward);
+  const double ty = std::tan(c.fovYDeg * kPi / 360), tx = ty * s.width / s.height;
+  double lo = INFINITY, hi = -INFINITY;
+  auto add = [&](const glm::dvec3& p, double radius) {
+    const double z = glm::dot(p - c.position, forward);
+    lo = std::min(lo, z - radius), hi = std::max(hi, z + radius);
+  };
+  for (const Bubble& b : s.bubbles) add(b.center, 2 * b.radius);  // the wobble stays within the radius
+  // A quad (a floor may pass under the camera): its part inside the frustum's four sides, in
+  // camera space (x right, y up, z ahead), clipped plane by plane.
+  for (const Quad& q : s.quads) {
+    const glm::dvec3 side = glm::normalize(glm::cross(q.up, q.normal)) * (0.5 * q.size.x),
+                     along = glm::normalize(q.up) * (0.5 * q.size.y);
+    std::vector<glm::dvec3> poly;
+    for (const glm::dvec3& p : {q.center - side - along, q.center + side - along, q.center + side + along,
+                                q.center - side + along})
+      poly.push_back({glm::dot(p - c.position, right), glm::dot(p - c.position, up), glm::dot(p - c.position, forward)});
+    for (const glm::dvec3 plane : {glm::dvec3(-1, 0, tx), glm::dvec3(1, 0, tx), glm::dvec3(0, -1, ty),
+                                   glm::dvec3(0, 1, ty)}) {  // inside: dot(plane, p) >= 0
+      std::vector<glm::dvec3> kept;
+      for (size_t i = 0; i < poly.size(); ++i) {
+        const glm::dvec3 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+        const double da = glm::dot(plane, a), db = glm::dot(plane, b);
+        if (da >= 0) kept.push_back(a);
+        if ((da >= 0) != (db >= 0)) kept.push_back(a + (b - a) * (da / (da - db)));
+      }
+      poly = std::move(kept);
+    }
+    for (const glm::dvec3& p : poly) lo = std::min(lo, p.z), hi = std::max(hi, p.z);
+  }
+  if (s.lightning && s.lightning->world)
+    for (const auto& line : s.lightning->polylines)
+      for (const auto& v : line.vertices) add(glm::dvec3(v.x, v.y, v.z), 0);
+  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return {c.nearPlane, c.farPlane};
+  const double nearPlane = lo > 2 * c.nearPlane ? 0.5 * lo : c.nearPlane;
+  const double farPlane = std::max(nearPlane * 2, std::min(c.farPlane, 2 * hi));
+  return {nearPlane, farPlane};
+}
+
+}  // namespace
+
 View viewOf(const Scene& s) {
   View v;
   const Camera& c = s.camera;
   v.view = glm::lookAt(glm::vec3(c.position), glm::vec3(c.target), glm::vec3(c.up));
   const double aspect = double(s.width) / s.height;
   const double fov = c.fovYDeg * kPi / 180;
-  v.projection = glm::perspective(float(fov), float(aspect), float(c.nearPlane), float(c.farPlane));
+  const glm::dvec2 range = depthRange(s);
+  v.projection = glm::perspective(float(fov), float(aspect), float(range.x), float(range.y));
   v.viewProjection = v.projection * v.view;
   v.tanHalfFov = glm::vec2(std::tan(fov / 2) * aspect, std::tan(fov / 2));
   v.eye = glm::vec3(c.position);

@@ -6,7 +6,7 @@
 # (the times are medians with interquartile ranges, but a busy machine widens them), commit, and
 # commit the reports it wrote.
 #
-#   scripts/report.sh           the full configuration (21 min on 2 cores, 2026-11-27)
+#   scripts/report.sh           the full configuration (about 35 min on 2 cores, 2026-11-28)
 #   scripts/report.sh --quick   the reduced one, written to build/report-quick/ (a smoke run)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -807,6 +807,7 @@ def warped_rows():
     w2 = [warped({**HEIGHT, "density": 1e300}, 32, 16, c, [0, 100]) for c in (3, -3)]
     w3 = [warped({**HEIGHT, "heightFalloff": 100}, 32, 16, 0.5)]
     w4 = [warped(HEIGHT, 32, 16, 300, [0, 1e5])]
+    w5 = [warped(HEIGHT, 32, 16, 1000, [0, 1e5])]
     return [
         ("fog", "HEIGHT, warped 64 × 32, camera at 2", "fog", w1, warped_table(w1),
          "every entry = height_f at the (d, y) its axes give, within 2e-6 and 1e-5 relative (float32); each row "
@@ -820,6 +821,9 @@ def warped_rows():
         ("fog", "HEIGHT, warped, camera 300 above the layer, range [0, 1e5]", "fog", w4, warped_table(w4),
          "σ at the camera e^−60·a: the downward rows' columns run past where they reach the layer; every entry = "
          "height_f, none short of the fog's completeness"),
+        ("fog", "HEIGHT, warped, camera 1000 above the layer, range [0, 1e5]", "fog", w5, warped_table(w5),
+         "κ would be e^203, beyond a float: κ 0 (even columns), so every downward row runs to the range's end and "
+         "meets the fog (κ clamped at e^69 ended them short at f = 1); every entry = height_f"),
     ]
 
 
@@ -1088,7 +1092,8 @@ def render_rows():
     for name, scene, moved in (
             ("examples/03's bubble, 96 × 96", bubble_scene(), None),
             ("radius 1e-6 seen from 4e-6 (near 1e-7, far 1e-5), 16-bit PNG", bubble_scene(1e-6, 1e-7, 1e-5, 16), 3),
-            ("radius 1e6 seen from 4e6 (near 1e5, far 1e7)", bubble_scene(1e6, 1e5, 1e7), 3)):
+            ("radius 1e6 seen from 4e6 (near 1e5, far 1e7)", bubble_scene(1e6, 1e5, 1e7), 3),
+            ("radius 1 seen from 4, near 1e-7 and far 1e7 (a depth range of 1e14)", bubble_scene(1, 1e-7, 1e7), 3)):
         backdrop = {k: v for k, v in scene.items() if k != "bubble"}
         out.append(("render", f"preview against the reference: {name}", "render",
                     [scene, {**scene, "reference": True}, backdrop], render_matches_reference(scene, moved),

@@ -27,6 +27,11 @@ TEST(LightningApi, OnlyWhatIsIncluded) {
   ASSERT_TRUE(j.contains("polylines"));
   for (const char* absent : {"cells", "tree", "stats", "error", "fractalDimension", "guide"})
     EXPECT_FALSE(j.contains(absent)) << absent;
+  // Not measured, yet the answer says how far such a bolt is from DBM, and that it is the report's.
+  EXPECT_EQ(r->get_header_value("X-Effect-Error").rfind("meanTotalVariation=0.249; kind=estimate; row=\"fast "
+                                                         "calibrated 64², 8-nbhd, default\"", 0),
+            0u)
+      << r->get_header_value("X-Effect-Error");
   const json& main = j["polylines"][0];
   EXPECT_EQ(main["channel"], "main");
   EXPECT_EQ(main["points"].size(), 2 * main["step"].size());
@@ -413,6 +418,10 @@ TEST(LightningApi, ReferenceSolvesAreTheErrorStageNotCompute) {
   };
   json j = json::parse(r->body);
   EXPECT_EQ(j["error"]["kind"], "measured");
+  const std::string error = r->get_header_value("X-Effect-Error");
+  EXPECT_EQ(error.rfind("meanTotalVariation=", 0), 0u) << error;
+  EXPECT_NEAR(std::stod(error.substr(19)), j["error"]["meanTotalVariation"].get<double>(), 1e-3) << error;
+  EXPECT_NE(error.find("kind=measured"), std::string::npos) << error;
   EXPECT_GT(dur("error"), 5 * dur("compute")) << timing;
   EXPECT_NEAR(j["stats"]["errorMs"].get<double>(), dur("error"), 1e-3) << timing;
 }

@@ -31,6 +31,7 @@ TEST(TangentsApi, QuadDefaultsToMikkTSpace) {
   EXPECT_EQ(j["remap"], json({0, 1, 2, 3}));
   EXPECT_EQ(j["indices"], json({0, 1, 2, 0, 2, 3}));
   EXPECT_FALSE(j.contains("normals") || j.contains("stats") || j.contains("error"));  // not asked for
+  EXPECT_EQ(r->get_header_value("X-Effect-Error").rfind("meanAngleDeg=0; kind=exact", 0), 0u);  // the reference
 }
 
 TEST(TangentsApi, TopLeftUvOriginNegatesW) {
@@ -56,7 +57,12 @@ TEST(TangentsApi, PerTriangleWithErrorAndFrames) {
   EXPECT_EQ(j["triangleFrames"]["tangents"].size(), 6u);
   EXPECT_GT(j["error"]["meanAngleDeg"].get<double>(), 0.0);
   EXPECT_EQ(j["error"]["reference"], "mikktspace");
+  EXPECT_NE(r->get_header_value("X-Effect-Error").find("kind=measured"), std::string::npos);
   EXPECT_EQ(j["stats"]["method"], "perTriangle");
+  // Without include error: the report's figure for perTriangle, said to be an estimate.
+  auto e = s.postJson("/v1/tangents", json{{"mesh", mesh}, {"mode", "perTriangle"}});
+  EXPECT_EQ(e->get_header_value("X-Effect-Error").rfind("meanAngleDeg=0.496; kind=estimate", 0), 0u)
+      << e->get_header_value("X-Effect-Error");
   EXPECT_GT(j["vertexCount"].get<int>(), 4);  // shared vertices split between the two flat frames
 }
 

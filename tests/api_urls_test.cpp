@@ -1,5 +1,10 @@
 // Facing the internet (server/http/access.h): answers by GET URL, cacheable; signed URLs; API
 // keys with quotas.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -106,8 +111,15 @@ TEST(Urls, LimitsApplyToTheUrlAndTheDecodedBody) {
   EXPECT_NE(tooLong->body.find("--max-url-bytes"), std::string::npos);
   EXPECT_EQ(tooLong->get_header_value("Cache-Control"), "no-store");
   Config wide = c;
-  wide.limits.maxUrlBytes = 1 << 16;
+  wide.limits.maxUrlBytes = 8192;  // the most: cpp-httplib's compiled limit
   TestServer w(wide);
+  json huge = kFog;
+  huge["pad"] = std::string(9000, 'x');  // past cpp-httplib's own limit: its 414 is effectd's problem too
+  auto past = w.client().Get(url("/v1/fog", huge).c_str());
+  ASSERT_TRUE(past);
+  EXPECT_EQ(past->status, 414);
+  EXPECT_EQ(past->get_header_value("Cache-Control"), "no-store");
+  EXPECT_NE(past->body.find("uri-too-long"), std::string::npos) << past->body;
   big["pad"] = std::string(3000, 'x');  // decodes to more than 2048 bytes
   auto tooBig = w.client().Get(url("/v1/fog", big).c_str());
   ASSERT_TRUE(tooBig);
@@ -158,6 +170,63 @@ TEST(Urls, SignedUrlsWithTwoKeysExpiryAndConstantTimeChecks) {
   EXPECT_EQ(get(target + "&sig=" + UrlSigning::sign(keyOld, target))->status, 403);
   EXPECT_EQ(get(target + "&sig=" + UrlSigning::sign(keyNew, target))->status, 200);
   std::filesystem::remove(c.urlSigningKeyFile);
+}
+
+// One raw request (headers as given, NUL and all), its status.
+int rawStatus(int port, const std::string& request) {
+  httplib::Client probe("127.0.0.1", port);  // waits until the server listens
+  (void)probe.Get("/healthz");
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(uint16_t(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return ::close(fd), -1;
+  (void)::send(fd, request.data(), request.size(), 0);
+  char buf[64] = {};
+  const ssize_t n = ::recv(fd, buf, sizeof buf - 1, 0);
+  ::close(fd);
+  return n > 12 ? std::atoi(buf + 9) : -1;
+}
+
+// The edges of a key and a URL, each one way: a control character in any header is a 400 (a key
+// compared up to a NUL let "<secret>\0junk" in); several spaces after Bearer are one (RFC 9110: 1*SP);
+// r, exp and sig each once, and r without padding.
+TEST(Urls, StrictEdges) {
+  Config c = TestServer::quietConfig();
+  const std::string secret = "secret-of-the-edges";
+  c.apiKeysFile = writeFile(
+      "edge-keys",
+      json{{"keys", {{{"id", "edge"}, {"sha256", sha256Hex(secret)}, {"perMinute", 600}, {"burst", 100}}}}}.dump());
+  TestServer s(c);
+  const std::string body = kFog.dump();
+  auto post = [&](const std::string& auth) {
+    return rawStatus(s.port(), "POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nAuthorization: " +
+                                   auth + "\r\nContent-Length: " + std::to_string(body.size()) +
+                                   "\r\nConnection: close\r\n\r\n" + body);
+  };
+  EXPECT_EQ(post("Bearer " + secret), 200);
+  EXPECT_EQ(post("Bearer    " + secret), 200);
+  EXPECT_EQ(post("bearer " + secret), 200);
+  EXPECT_EQ(post("Bearer\t" + secret), 401);  // 1*SP, not HTAB
+  EXPECT_EQ(post("Bearer " + secret + std::string(1, '\0') + "junk"), 400);
+  EXPECT_EQ(post("Bearer " + secret + "\x01"), 400);
+  EXPECT_EQ(post("Bearer " + secret + "x"), 403);
+  EXPECT_EQ(post("Bearer "), 401);
+  std::filesystem::remove(c.apiKeysFile);
+
+  TestServer open;
+  const std::string target = url("/v1/fog", kFog), r = target.substr(target.find("r=") + 2);
+  auto get = [&](const std::string& t) { return open.client().Get(t.c_str()); };
+  EXPECT_EQ(get(target)->status, 200);
+  for (const auto& [t, pointer] : {std::pair{target + "&r=" + r, "?r"}, std::pair{target + "&exp=1&exp=2", "?exp"},
+                                   std::pair{target + "&sig=a&sig=b", "?sig"}, std::pair{target + "==", "?r"}}) {
+    auto a = get(t);
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->status, 400) << t;
+    EXPECT_EQ(json::parse(a->body)["errors"][0]["pointer"], pointer) << t << a->body;
+    EXPECT_EQ(a->get_header_value("Cache-Control"), "no-store");
+  }
 }
 
 TEST(Urls, ApiKeysAuthenticateAndQuotasChargeTheEstimatedCost) {

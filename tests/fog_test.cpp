@@ -918,5 +918,37 @@ TEST(Fog, WarpedAxesOfADenormalFalloffAreFinite) {
   EXPECT_LT(t.value().maxError, 0.02);  // 16 entries of exp(-0.05 d) to completeness: h^2 a^2 / 8 = 0.017
 }
 
+// A camera so far above the layer that its density there is e^-300 of the surface's: kappa, the
+// scale of a downward row's span, would be beyond any float. The rows stay warped, their columns
+// even (kappa 0), so that every downward row covers the whole range and meets the fog where it
+// is; kappa clamped instead ended those rows hundreds of metres short, held at f = 1 to the end
+// (maxError 1). The front a high camera looks down on is a few metres deep, finer than 64 even
+// columns: the table's measured maxError says so (0.75), and a larger table is the remedy.
+TEST(Fog, WarpedTableFromFarAboveTheLayerReachesTheFog) {
+  Fog f = make(FogType::kHeight);
+  f.density = 0.05;
+  f.heightFalloff = 0.5;
+  f.baseHeight = 0;
+  TableOptions o;  // the default, warped
+  o.size = 64;
+  o.cameraHeight = 600;
+  o.rangeEnd = 4000;
+  const WarpedAxes a = warpedAxes(f, o.cameraHeight, 0, *o.rangeEnd);
+  EXPECT_EQ(a.kappa, 0.0);
+  auto t = buildTable(f, o);
+  ASSERT_TRUE(t.ok());
+  EXPECT_LT(t.value().maxError, 0.9);
+  // Every downward row whose ray is fogged by the range's end says so in its last column.
+  const Table& table = t.value();
+  int fogged = 0;
+  for (size_t r = 0; r < table.height; ++r) {
+    const double y = warpedRowY(a, double(r) / double(table.height - 1));
+    if (factorAtElevation(f, o.cameraHeight, y, *o.rangeEnd) > 0.01) continue;
+    ++fogged;
+    EXPECT_LT(table.factor[r * table.width + table.width - 1], 0.02) << "row " << r << ", y " << y;
+  }
+  EXPECT_GE(fogged, 3);
+}
+
 }  // namespace
 }  // namespace effects::fog

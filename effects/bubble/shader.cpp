@@ -180,11 +180,4 @@ ShaderSource shader(const Features& f, Glsl version, const std::string& fragment
   return out;
 }
 
-ShadingError shadingErrorEstimate(const Features& f) {
-  if (f.shading == Shading::kPaper)
-    return f.iridescence ? ShadingError{12.15, "paper + film table"} : ShadingError{10.09, "paper (eqns 3-11)"};
-  if (!f.backFace) return {5.80, "film, near side"};
-  return f.highlight ? ShadingError{3.09, "film + far side + highlight (default)"} : ShadingError{3.12, "film + far side"};
-}
-
 }  // namespace effects::bubble

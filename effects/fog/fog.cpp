@@ -255,19 +255,26 @@ double lobe(const Directional& d, double cosTheta) {
   return (1.0 - g) * (1.0 + g) / (den * std::sqrt(den));
 }
 
+namespace {
+
+// The sun's glow along the ray from eye to point (d long, unit y component dirY): none without
+// a directional term.
+glm::dvec3 glow(const Fog& fog, const glm::dvec3& eye, const glm::dvec3& point, double d, double dirY) {
+  if (!fog.directional || !(d > 0.0)) return glm::dvec3(0.0);
+  // Unreal's lobe looks from its clamped observer height
+  const glm::dvec3 observer(eye.x, observerHeight(fog, eye.y), eye.z);
+  const glm::dvec3 view = detail::rayBetween(observer, point).direction;
+  const glm::dvec3 sun = fog.directional->direction / detail::length(fog.directional->direction);
+  return inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color * lobe(*fog.directional, glm::dot(view, sun));
+}
+
+}  // namespace
+
 glm::dvec3 shade(const Fog& fog, const glm::dvec3& object, const glm::dvec3& eye, const glm::dvec3& point) {
   const detail::Ray ray = detail::rayBetween(eye, point);
   const double d = ray.length;
   const double dirY = std::clamp(ray.direction.y, -1.0, 1.0);
-  glm::dvec3 c = object * transmittance(fog, eye.y, dirY, d) + scattered(fog, eye.y, dirY, d);
-  if (fog.directional && d > 0.0) {
-    // Unreal's lobe looks from its clamped observer height
-    const glm::dvec3 observer(eye.x, observerHeight(fog, eye.y), eye.z);
-    const glm::dvec3 view = detail::rayBetween(observer, point).direction;
-    const glm::dvec3 sun = fog.directional->direction / detail::length(fog.directional->direction);
-    c += inscatterWeight(fog, eye.y, dirY, d) * fog.directional->color * lobe(*fog.directional, glm::dot(view, sun));
-  }
-  return c;
+  return object * transmittance(fog, eye.y, dirY, d) + scattered(fog, eye.y, dirY, d) + glow(fog, eye, point, d, dirY);
 }
 
 double factor(const Fog& fog, const glm::dvec3& origin, const glm::dvec3& direction, double distance) {
@@ -387,10 +394,13 @@ Sample sampleAt(const Fog& global, const std::vector<Region>& regions, const glm
   s.region = regionAt(regions, point);
   const Fog& f = s.region < 0 ? global : regions[size_t(s.region)].fog;
   const detail::Ray ray = detail::rayBetween(camera, point);
-  const double dirY = std::clamp(ray.direction.y, -1.0, 1.0);
-  s.factor = f.type == FogType::kHeight ? factorAtElevation(f, camera.y, dirY, ray.length) : factor(f, ray.length);
-  s.transmittance = transmittance(f, camera.y, dirY, ray.length);
-  s.fogColor = shade(f, glm::dvec3(0), camera, point);
+  const double d = ray.length, dirY = std::clamp(ray.direction.y, -1.0, 1.0);
+  // One evaluation of the weight; transmittance and colour follow from it (ATMOSPHERIC's per
+  // channel), as shade() has them for a black object.
+  s.factor = factorAtElevation(f, camera.y, dirY, d);
+  const bool channels = f.type == FogType::kAtmospheric;
+  s.transmittance = channels ? transmittance(f, camera.y, dirY, d) : glm::dvec3(s.factor);
+  s.fogColor = (channels ? scattered(f, camera.y, dirY, d) : (1.0 - s.factor) * f.color) + glow(f, camera, point, d, dirY);
   return s;
 }
 

@@ -37,8 +37,12 @@ WarpedAxes warpedAxes(const Fog& fog, double cameraHeight, double rangeStart, do
   }
   // q: the optical depth at which the fog is complete, f = max(1/255, 1 - maxOpacity).
   const double q = -std::log(std::max(1.0 / 255.0, 1.0 - fog.maxOpacity));
-  a.kappa = std::exp(std::clamp(std::log(q * a.falloff) - logDensity, -690.0, 69.0));
+  const double logKappa = std::log(q * a.falloff) - logDensity;
   a.lambda = kSpanOverComplete / a.falloff;
+  // A camera so far above the fog that kappa would leave a float's range (a client computes
+  // K x in float): clamping it would end downward rows far short of the fog, at f = 1. Even
+  // columns instead (kappa 0: span = end - start), the rows still warped.
+  a.kappa = logKappa > 69.0 ? 0.0 : std::exp(std::max(logKappa, -690.0));
   // At the far end a point's fog changes with elevation on the scale 1 / (falloff span); rows
   // spaced by asinh(K y) are 2 asinh(K) / (K (rows - 1)) apart there.
   a.rowK = std::clamp(0.5 * a.falloff * (rangeEnd - a.factorStart), 1.0, 1e6);

@@ -13,6 +13,7 @@
 #include "api/api_common.h"
 #include "api/bubble_glb.h"
 #include "api/costs.h"
+#include "api/error_estimates.h"
 #include "api/shader_targets.h"
 #include "contract/codec.h"
 
@@ -294,10 +295,10 @@ void addShaderParts(const json& body, const Includes& include, const bb::Params&
     out["flowOffset"] = {off.x, off.y};
   }
   if (include.has("uniforms") || include.has("shader")) {
-    const bb::ShadingError e = bb::shadingErrorEstimate(features);
-    out["shadingError"] = {{"meanDeltaE", e.meanDeltaE},
+    const ErrorEstimate e = shadingErrorEstimate(features);
+    out["shadingError"] = {{"meanDeltaE", e.value},
                            {"kind", "estimate"},
-                           {"variant", e.variant},
+                           {"variant", e.row},
                            {"reference", "the variant's frame against CPU ray tracing (400 wavelengths) on the error "
                                          "report's scene (docs/error-vs-time.md, Render previews)"}};
   }

@@ -9,6 +9,7 @@
 #include "api/api_lightning.h"
 #include "api/bolt_ribbons.h"
 #include "api/costs.h"
+#include "api/error_estimates.h"
 #include "contract/codec.h"
 
 namespace effectd {
@@ -262,6 +263,27 @@ LightningRequest parseLightningRequest(const json& body, const RequestContext& c
   return parseLightning(body, ctx.config, ctx.at);
 }
 
+namespace {
+
+// X-Effect-Error: the bolt's mean TV distance per step from DBM's converged distribution,
+// measured (include "error") or the error report's figure for the method.
+std::string errorHeader(const lt::Params& p, const lt::Bolt& bolt) {
+  char out[256];
+  if (p.measureError) {
+    std::snprintf(out, sizeof out, "meanTotalVariation=%.4g; kind=measured; reference=\"%s\"",
+                  bolt.stats.error.value_or(0.0), bolt.stats.reference.c_str());
+  } else {
+    const ErrorEstimate e = lightningErrorEstimate(p);
+    std::snprintf(out, sizeof out,
+                  "meanTotalVariation=%.3g; kind=estimate; row=\"%s, %s\"; reference=\"DBM's converged per-step "
+                  "distribution, in the error report; include error measures this bolt\"",
+                  e.value, e.row.c_str(), e.setting.c_str());
+  }
+  return out;
+}
+
+}  // namespace
+
 JsonReply runLightning(const LightningRequest& request, const json& body, const RequestContext& ctx) {
   const Includes& include = request.include;
   const bool glbFormat = request.glb;  // include: only timeline applies
@@ -272,6 +294,7 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;  // the method's own: the reference's solves are errorMs
   reply.errorMs = bolt.stats.errorMs;
+  reply.headers["X-Effect-Error"] = errorHeader(p, bolt);
   json out = {{"method", bolt.stats.method},
               {"grid", p.depth ? json::array({p.width, p.height, p.depth}) : json::array({p.width, p.height})}};
   if (request.world.given) out["world"] = {{"origin", request.world.origin}, {"cellSize", request.world.cellSize}};

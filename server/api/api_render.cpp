@@ -11,6 +11,7 @@
 #include "api/api_lightning.h"
 #include "api/api_render.h"
 #include "api/costs.h"
+#include "api/error_estimates.h"
 #include "api/movie.h"
 #include "api/scene.h"
 
@@ -64,6 +65,11 @@ JsonReply runScene(const SceneRequest& request, const json& body, const RequestC
                        "a scene answers JSON: ask /v1/" + std::string(endpoint) + " itself for this binary format");
     reply.computeMs += r.computeMs;
     reply.errorMs += r.errorMs;
+    // A part's error header, named by its pointer (the body carries the rest: tables, shading).
+    if (const auto e = r.headers.find("X-Effect-Error"); e != r.headers.end()) {
+      std::string& all = reply.headers["X-Effect-Error"];
+      all += (all.empty() ? "" : ", ") + ("part=" + at + "; " + e->second);
+    }
     return std::move(r.body);
   };
   if (request.lightning)
@@ -135,11 +141,11 @@ std::vector<std::string> passEstimates(const rd::Scene& scene, bool bubbleMeasur
   char e[320];
   if (!bubbleMeasured)
     for (const rd::Bubble& b : scene.bubbles) {
-      const effects::bubble::ShadingError s = effects::bubble::shadingErrorEstimate(b.features);
+      const ErrorEstimate s = shadingErrorEstimate(b.features);
       std::snprintf(e, sizeof e,
                     "pass=bubble; meanDeltaE=%.3g; kind=estimate; variant=\"%s\"; "
                     "reference=\"CPU ray tracing, %d wavelengths, on the error report's scene\"",
-                    s.meanDeltaE, s.variant, rd::kReferenceWavelengths);
+                    s.value, s.row.c_str(), rd::kReferenceWavelengths);
       out.push_back(e);
     }
   if (scene.fog)

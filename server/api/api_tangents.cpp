@@ -1,4 +1,5 @@
 // POST /v1/tangents — indexed triangle mesh (JSON) or binary glTF -> vertex tangents.
+#include <cstdio>
 #include <map>
 
 #include <effects/tangents.h>
@@ -6,6 +7,7 @@
 #include "api/api_common.h"
 #include "api/api_tangents.h"
 #include "api/costs.h"
+#include "api/error_estimates.h"
 #include "api/glb.h"
 
 namespace effectd {
@@ -73,6 +75,20 @@ JsonReply runTangents(const TangentsRequest& request, const json& body, const Re
   reply.method = out.stats.method;
   reply.computeMs = out.stats.elapsedMs;
   reply.errorMs = out.stats.errorMs;
+  {  // X-Effect-Error: the mean angle from MikkTSpace's tangents, measured, exact, or the report's
+    const ErrorEstimate e = tangentsErrorEstimate(opt.mode);
+    char h[256];
+    if (out.stats.error)
+      std::snprintf(h, sizeof h, "meanAngleDeg=%.4g; kind=measured; reference=\"MikkTSpace\"", *out.stats.error);
+    else if (opt.mode == tg::Mode::kMikkTSpace)
+      std::snprintf(h, sizeof h, "meanAngleDeg=0; kind=exact; reference=\"MikkTSpace (this is it)\"");
+    else
+      std::snprintf(h, sizeof h,
+                    "meanAngleDeg=%.3g; kind=estimate; row=\"%s\"; reference=\"MikkTSpace on the error report's "
+                    "meshes (the worse of two); include error measures this mesh\"",
+                    e.value, e.row.c_str());
+    reply.headers["X-Effect-Error"] = h;
+  }
   json res = {{"method", reply.method}, {"vertexCount", out.remap.size()}};
   if (include.has("tangents")) res["tangents"] = flat<4>(out.tangents);
   if (include.has("remap")) res["remap"] = out.remap;

@@ -59,7 +59,9 @@ std::optional<ApiError> Access::check(const httplib::Request& req, const std::st
       for (char& c : t) c = char(std::tolower(static_cast<unsigned char>(c)));
       return t;
     };
-    if (lower(auth.substr(0, 7)) != "bearer " || auth.size() <= 7) {  // the scheme is case-insensitive (RFC 9110)
+    // The scheme is case-insensitive, and one or more spaces may follow it (RFC 9110 §11.4).
+    const size_t token = auth.find_first_not_of(' ', 6);
+    if (lower(auth.substr(0, 7)) != "bearer " || token == std::string::npos) {
       refused("unauthenticated");
       return ApiError{401,
                       "unauthenticated",
@@ -69,7 +71,7 @@ std::optional<ApiError> Access::check(const httplib::Request& req, const std::st
                       {},
                       {{"WWW-Authenticate", "Bearer realm=\"effectd\""}}};
     }
-    key = keys_.find(auth.substr(7));
+    key = keys_.find(auth.substr(token));
     if (!key) {
       refused("unknown-key");
       return forbidden("the API key is not known here");

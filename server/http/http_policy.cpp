@@ -37,14 +37,19 @@ httplib::Server::HandlerResponse answerBareStatus(const httplib::Request&, httpl
   if (!res.body.empty()) return httplib::Server::HandlerResponse::Handled;
   if (tl.requestId.empty()) tl.requestId = newRequestId();
   std::string detail = statusTitle(res.status);
+  std::map<std::string, std::string> headers;
   if (res.status == 413) detail = "request body exceeds the configured limit (--max-body-bytes)";
+  if (res.status == 414) {  // cpp-httplib's own, before any route: the same problem as effectd's
+    detail = "the URL is over 8192 bytes, the most --max-url-bytes allows: POST the body instead";
+    headers["Cache-Control"] = "no-store";
+  }
   writeProblem(res,
                {res.status,
-                res.status == 404 ? "not-found" : "http-" + std::to_string(res.status),
+                res.status == 404 ? "not-found" : res.status == 414 ? "uri-too-long" : "http-" + std::to_string(res.status),
                 statusTitle(res.status),
                 detail,
                 {},
-                {}},
+                headers},
                tl.requestId);
   return httplib::Server::HandlerResponse::Handled;
 }
@@ -201,6 +206,17 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
     writeProblem(res, p, tl.requestId);
     return true;
   };
+  // RFC 9110 §5.5: a field value holds no NUL, CR, LF or other control character but HTAB.
+  // cpp-httplib keeps them; a key compared up to a NUL would let "<secret>\0junk" in.
+  for (const auto& [name, value] : req.headers)
+    if (std::any_of(value.begin(), value.end(),
+                    [](unsigned char c) { return (c < 0x20 && c != '\t') || c == 0x7F; }))
+      return fail({400,
+                   "invalid-header",
+                   "Bad Request",
+                   "the " + name + " header holds a control character (RFC 9110 §5.5 allows none but HTAB)",
+                   {{"header " + name, "control character"}},
+                   {{"Cache-Control", "no-store"}}});
   if (!route) return fail({404, "not-found", "Not Found", "no resource at " + req.path, {}, {}});
   tl.route = route->path;
   const std::string allow = allowHeader(route->methods);

@@ -330,6 +330,32 @@ void Service::handleGet(const Route& route, const httplib::Request& req, httplib
     writeProblem(res, e, tl.requestId);
     res.set_header("Cache-Control", "no-store");
   };
+  // Each of r, exp and sig once, and no '=' in a value: cpp-httplib keeps the first of a repeated
+  // name and cuts a value at its next '=' (base64 padding would pass silently). From the raw
+  // query, as sent.
+  const size_t question = req.target.find('?');
+  std::map<std::string, int> given;
+  for (size_t at = question == std::string::npos ? req.target.size() : question + 1; at < req.target.size();) {
+    const size_t end = std::min(req.target.find('&', at), req.target.size());
+    const std::string part = req.target.substr(at, end - at);
+    const size_t eq = part.find('=');
+    const std::string name = httplib::detail::decode_url(part.substr(0, eq), true);
+    if (eq != std::string::npos && part.find('=', eq + 1) != std::string::npos)
+      return refuse({400,
+                     "invalid-query",
+                     "Malformed query parameter",
+                     name + "'s value holds '=': base64url here has no padding (RFC 4648 §5, §3.2)",
+                     {{"?" + name, "holds '='"}},
+                     {}});
+    if (++given[name] == 2)
+      return refuse({400,
+                     "invalid-query",
+                     "Repeated query parameter",
+                     name + " is given more than once: a GET takes each of r, exp and sig once",
+                     {{"?" + name, "repeated"}},
+                     {}});
+    at = end + 1;
+  }
   for (const auto& [name, value] : req.params)
     if (name != "r" && name != "exp" && name != "sig")
       return refuse({400,

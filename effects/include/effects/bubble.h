@@ -186,16 +186,6 @@ struct ShaderSource {
 // in scope); both see vWorld.
 ShaderSource shader(const Features& f, Glsl version, const std::string& fragmentPrelude = "",
                     const std::string& fragmentFinish = "");
-// What a shading variant costs in accuracy: the mean CIE76 Delta E*ab of its frame against the
-// physical reference (render::referenceRender), as the error report measures it on its one
-// scene (docs/error-vs-time.md, "Render previews"; tests/report_test.cpp holds these figures to
-// the report's). An estimate for any other scene, not a measurement of it: /v1/render's
-// measureError measures a scene's own frame.
-struct ShadingError {
-  double meanDeltaE;
-  const char* variant;  // the report's row
-};
-ShadingError shadingErrorEstimate(const Features& f);
 // What tells shader variants apart: the model and one bit per feature ("film:101101111"), for
 // the caches of compiled or translated variants.
 std::string variantKey(const Features& f);

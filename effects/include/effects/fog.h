@@ -241,7 +241,10 @@ size_t tableRows(const TableOptions& options, size_t size);
 // distance at which the steepest layer alone, from its density at the start, would reach the
 // table's completeness level
 // (f = max(1/255, 1 - maxOpacity)) along that ray: a downward row's columns end where its fog
-// is done, however near. rowK puts rows about 1/(falloff span) apart at the horizon, the
+// is done, however near. kappa is 0 (even columns) for a fog without height dependence, and for
+// a camera so far above the fog that kappa would pass e^69 (beyond a float in K x): there the
+// downward rows' front is sharper than any column spacing, and the table's maxError says how
+// much. rowK puts rows about 1/(falloff span) apart at the horizon, the
 // scale on which a distant point's fog changes with elevation.
 struct WarpedAxes {
   double rowK = 1.0;
