@@ -19,9 +19,9 @@ namespace {
 // The depth range the frame needs: the camera's near and far planes, narrowed to what the scene
 // holds in the world (bubbles, the part of each quad in view, a world bolt) with room to spare.
 // Near the far plane a depth buffer resolves about far/near / 2^24 of the range: near 1e-7 and
-// far 1e7 put everything at depth 1, and the depth test dropped a bubble at 4. Narrowing never clips what
-// the camera's planes would not: near only rises to half the nearest content's depth, far only
-// falls to twice the farthest's.
+// far 1e7 put everything at depth 1, and the depth test dropped a bubble at 4. Narrowing never
+// clips what the camera's planes would not: near only rises to half the nearest content's
+// depth, far only falls to twice the farthest's.
 glm::dvec2 depthRange(const Scene& s) {
   const Camera& c = s.camera;
   const glm::dvec3 forward = glm::normalize(c.target - c.position);
@@ -36,11 +36,8 @@ glm::dvec2 depthRange(const Scene& s) {
   // A quad (a floor may pass under the camera): its part inside the frustum's four sides, in
   // camera space (x right, y up, z ahead), clipped plane by plane.
   for (const Quad& q : s.quads) {
-    const glm::dvec3 side = glm::normalize(glm::cross(q.up, q.normal)) * (0.5 * q.size.x),
-                     along = glm::normalize(q.up) * (0.5 * q.size.y);
     std::vector<glm::dvec3> poly;
-    for (const glm::dvec3& p : {q.center - side - along, q.center + side - along, q.center + side + along,
-                                q.center - side + along})
+    for (const glm::dvec3& p : quadCorners(q))  // as the quads pass draws it
       poly.push_back({glm::dot(p - c.position, right), glm::dot(p - c.position, up), glm::dot(p - c.position, forward)});
     for (const glm::dvec3 plane : {glm::dvec3(-1, 0, tx), glm::dvec3(1, 0, tx), glm::dvec3(0, -1, ty),
                                    glm::dvec3(0, 1, ty)}) {  // inside: dot(plane, p) >= 0

@@ -629,6 +629,18 @@ TEST(Render, ExtremeNearAndFarPlanesKeepTheScene) {
   json cut = scene;
   cut["camera"]["far"] = 3.5;  // the far plane before the bubble's centre: its far half is gone
   EXPECT_NE(decode(render(s, cut)->body).rgba, a.rgba);
+  // A floor as most scenes give it, its up left at the default (along its normal): the range
+  // still holds all of it, so the floor far behind the bubble is the floor without the bubble.
+  json floor = scene;
+  floor["quads"] = {{{"center", {0, -1.2, -40}}, {"normal", {0, 1, 0}}, {"size", {200, 200}}}};
+  const rd::Image withBubble = decode(render(s, floor)->body);
+  floor.erase("bubble");
+  const rd::Image alone = decode(render(s, floor)->body);
+  for (int x : {0, 3, 6, 57, 60, 63}) {  // beside the bubble (columns 11 to 52), the floor behind it
+    const glm::vec4 p = pixel(withBubble, x, 30), q = pixel(alone, x, 30);
+    EXPECT_NEAR(p.r, q.r, 1.5 / 255) << "x " << x;
+    EXPECT_NEAR(p.g, q.g, 1.5 / 255) << "x " << x;
+  }
 }
 
 // A cluster: every bubble drawn (far to near), each with its own age; /v1/scene answers each;
