@@ -29,9 +29,10 @@ TEST(LightningApi, OnlyWhatIsIncluded) {
     EXPECT_FALSE(j.contains(absent)) << absent;
   // Not measured, yet the answer says how far such a bolt is from DBM, and that it is the report's.
   EXPECT_EQ(r->get_header_value("X-Effect-Error").rfind("meanTotalVariation=0.249; kind=estimate; row=\"fast "
-                                                         "calibrated 64², 8-nbhd, default\"", 0),
+                                                         "calibrated 64^2, 8-nbhd, default\"", 0),
             0u)
       << r->get_header_value("X-Effect-Error");
+  for (unsigned char c : r->get_header_value("X-Effect-Error")) EXPECT_LT(c, 0x80) << "header values are ASCII";
   const json& main = j["polylines"][0];
   EXPECT_EQ(main["channel"], "main");
   EXPECT_EQ(main["points"].size(), 2 * main["step"].size());

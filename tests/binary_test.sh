@@ -92,6 +92,27 @@ set +e
 rc=$?
 set -e
 [ "$rc" -eq 2 ] && grep -q 'renders a PNG' "$log" && [ ! -e "$gif" ] || { echo "still as .gif: exit $rc"; cat "$log"; exit 1; }
+# Nor is a .jpg name (the bytes would be PNG under a JPEG name).
+set +e
+"$bin" render "$scene" -o /tmp/effectd_render.$$.jpg 2>"$log"
+rc=$?
+set -e
+[ "$rc" -eq 2 ] && grep -q 'name the file .png' "$log" && [ ! -e /tmp/effectd_render.$$.jpg ] || { echo "still as .jpg: exit $rc"; cat "$log"; exit 1; }
+# A wrong flag says so in one line, not the whole help; a port in use says that.
+set +e
+"$bin" --no-such-flag 2>"$log"
+rc=$?
+set -e
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$log")" -eq 1 ] && grep -q 'unknown flag --no-such-flag' "$log" || { echo "bad flag: exit $rc"; cat "$log"; exit 1; }
+"$bin" --port 0 2>"$log" &
+holder=$!
+wait_for_port "$log"
+set +e
+timeout 10 "$bin" --port "$port" 2>"$log"
+rc=$?
+set -e
+kill "$holder"
+[ "$rc" -eq 1 ] && grep -q 'the port is in use' "$log" || { echo "port in use: exit $rc"; cat "$log"; exit 1; }
 # --version names the build ETags are made from.
 "$bin" --version | grep -Eq '^effectd [0-9]+\.[0-9]+\.[0-9]+\+[0-9a-f]+$' || { echo "--version: $("$bin" --version)"; exit 1; }
 echo "binary test ok (port $port)"

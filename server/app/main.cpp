@@ -6,7 +6,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -75,7 +78,7 @@ int renderToFile(const nlohmann::json& body, const effectd::Config& config, cons
       for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
       return tail == e;
     };
-    if (ends(".gif") != gif && (ends(".gif") || ends(".png"))) {
+    if (!(gif ? ends(".gif") : ends(".png"))) {
       std::fprintf(stderr, "effectd render: %s: this scene renders %s; name the file .%s%s\n", outPath.c_str(),
                    gif ? "an animated GIF" : "a PNG", gif ? "gif" : "png",
                    gif ? "" : " (an animated GIF needs \"frames\", without \"format\": \"flipbook\")");
@@ -157,7 +160,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!err.empty()) {
-    std::fprintf(stderr, "effectd: %s\n\n%s", err.c_str(), effectd::usage().c_str());
+    std::fprintf(stderr, "effectd: %s (effectd --help lists the flags)\n", err.c_str());
     return 2;
   }
 
@@ -185,11 +188,17 @@ int main(int argc, char** argv) {
   if (effectd::playgroundEnabled(config)) effectd::addPlayground(service, config.playgroundThree);
   int port = service.bind();
   if (port < 0) {
-    std::fprintf(stderr, "effectd: cannot listen on %s:%d\n", config.host.c_str(), config.port);
+    const int error = errno;
+    std::fprintf(stderr, "effectd: cannot listen on %s:%d%s: %s\n", config.host.c_str(), config.port,
+                 config.adminPort ? (" or its admin port " + std::to_string(config.adminPort)).c_str() : "",
+                 error == EADDRINUSE ? "the port is in use (another effectd? choose one with --port)" : std::strerror(error));
     return 1;
   }
-  std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"listening\",\"host\":\"%s\",\"port\":%d,\"threads\":%d,\"playground\":%s}\n",
-               config.host.c_str(), port, config.threads, effectd::playgroundEnabled(config) ? "true" : "false");
+  std::fprintf(stderr,
+               "{\"level\":\"info\",\"msg\":\"listening\",\"host\":\"%s\",\"port\":%d,\"adminPort\":%d,\"threads\":%d,"
+               "\"playground\":%s}\n",
+               config.host.c_str(), port, service.adminPort(), config.threads,
+               effectd::playgroundEnabled(config) ? "true" : "false");
 
   std::atomic<bool> signalled{false};
   std::thread waiter([&] {
@@ -201,7 +210,16 @@ int main(int argc, char** argv) {
                    error.empty() ? "" : ",\"why\":", error.empty() ? "" : effectd::jsonEscape(error).c_str());
     }
     signalled = true;
-    std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"shutting down\",\"signal\":%d}\n", sig);
+    std::fprintf(stderr, "{\"level\":\"info\",\"msg\":\"shutting down\",\"signal\":%d,\"graceS\":%d}\n", sig,
+                 config.shutdownGraceS);
+    // Requests being computed get --shutdown-grace to finish; past it the process exits anyway.
+    std::thread([&service, grace = config.shutdownGraceS] {
+      std::this_thread::sleep_for(std::chrono::seconds(grace));
+      std::fprintf(stderr, "{\"level\":\"warn\",\"msg\":\"shutdown grace passed: exiting with requests in progress\","
+                           "\"inFlight\":%zu}\n", service.openConnections());
+      std::fflush(stderr);
+      _exit(1);
+    }).detach();
     service.stop();
   });
   bool ok = service.run();

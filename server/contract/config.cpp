@@ -84,9 +84,17 @@ const std::vector<Option>& options() {
       {"threads", "EFFECTD_THREADS", "HTTP worker threads kept ready (default 8)", intField(&Config::threads, 1, 1024)},
       {"max-connections", "EFFECTD_MAX_CONNECTIONS",
        "connections served at once, one thread each, growing from --threads (default 512); slow clients cannot starve "
-       "the rest below it",
+       "the rest below it, and past it a new connection gets 503 at once",
        intField(&Config::maxConnections, 1, 65536)},
-      {"read-timeout", "EFFECTD_READ_TIMEOUT", "seconds to receive a request (default 10)",
+      {"admin-port", "EFFECTD_ADMIN_PORT",
+       "TCP port of an operations listener on --host serving /healthz, /readyz and /metrics, answered even when the "
+       "public port is full; /metrics then leaves the public port (default 0 = none)",
+       intField(&Config::adminPort, 0, 65535)},
+      {"shutdown-grace", "EFFECTD_SHUTDOWN_GRACE",
+       "seconds SIGTERM waits for requests being computed; connections idle or still sending close at once (default 20)",
+       intField(&Config::shutdownGraceS, 0, 3600)},
+      {"read-timeout", "EFFECTD_READ_TIMEOUT",
+       "seconds to receive a whole request, headers and body, from its first byte; later: 408 (default 10)",
        intField(&Config::readTimeoutS, 1, 3600)},
       {"write-timeout", "EFFECTD_WRITE_TIMEOUT", "seconds to send a response (default 10)",
        intField(&Config::writeTimeoutS, 1, 3600)},
@@ -172,6 +180,10 @@ const std::vector<Option>& options() {
          c.quotaRedis = s;
          return s.empty() || s.rfind("redis://", 0) == 0;
        }},
+      {"key-max-concurrent", "EFFECTD_KEY_MAX_CONCURRENT",
+       "an API key's requests in progress at once on this replica; more get 429 before their body is read (the key "
+       "file's maxConcurrent wins) (default 8)",
+       intField(&Config::keyMaxConcurrent, 1, 100000)},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
        "none)",
@@ -237,18 +249,14 @@ std::string parseConfig(const std::vector<std::string>& args, Config& config, bo
     if (eq != std::string::npos) {
       value = name.substr(eq + 1);
       name = name.substr(0, eq);
-    } else if (i + 1 < args.size()) {
+    }
+    const auto option = std::find_if(options().begin(), options().end(), [&](const Option& o) { return name == o.flag; });
+    if (option == options().end()) return "unknown flag --" + name;
+    if (eq == std::string::npos) {
+      if (i + 1 >= args.size()) return "flag --" + name + " needs a value";
       value = args[++i];
-    } else {
-      return "flag --" + name + " needs a value";
     }
-    bool known = false;
-    for (const auto& o : options()) {
-      if (name != o.flag) continue;
-      known = true;
-      if (!o.set(value, config)) return "invalid value for --" + name + ": '" + value + "'";
-    }
-    if (!known) return "unknown flag --" + name;
+    if (!option->set(value, config)) return "invalid value for --" + name + ": '" + value + "'";
   }
   return "";
 }

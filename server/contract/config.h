@@ -26,8 +26,10 @@ struct Config {
   std::string host = "127.0.0.1";
   int port = 8080;
   int threads = 8;           // HTTP threads kept ready
-  int maxConnections = 512;  // connections served at once (one thread each); more wait
-  int readTimeoutS = 10;
+  int maxConnections = 512;  // connections served at once (one thread each); more get 503 at once
+  int adminPort = 0;         // /healthz, /readyz and /metrics on their own listener; 0 = none
+  int shutdownGraceS = 20;   // SIGTERM: longest wait for requests being computed, then exit
+  int readTimeoutS = 10;     // a request's headers and body, all of them
   int writeTimeoutS = 10;
   int keepAliveTimeoutS = 5;
   int keepAliveMaxCount = 100;
@@ -44,6 +46,7 @@ struct Config {
   std::string urlSigningKeyFile;         // "" = GETs need no signature
   std::string apiKeysFile;               // "" = no API keys: the service is open
   std::string quotaRedis;                // redis://host:port: quotas shared by replicas; "" = per process
+  int keyMaxConcurrent = 8;              // an API key's requests in progress at once (per replica)
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
   // three.js's ES module the playground's live view imports (it draws through clients/three/).

@@ -91,32 +91,89 @@ std::optional<ApiError> Access::check(const httplib::Request& req, const std::st
   return std::nullopt;
 }
 
-void Access::charge(const ApiKey& key, double units, httplib::Response& res) {
-  const QuotaDecision d = quota_.charge(key, units);
+std::map<std::string, std::string> Access::rateLimitHeaders(const ApiKey& key, const QuotaDecision& d) {
   // draft-ietf-httpapi-ratelimit-headers: the policy (quota q per window w seconds) and what is
   // left of it now (r units, t seconds until the bucket is full).
-  const std::string policy = "\"key\";q=" + number(key.perMinute) + ";w=60";
-  const std::string state = "\"key\";r=" + number(std::max(0.0, std::floor(d.remaining))) +
-                            ";t=" + number(std::ceil(d.fullInS));
+  return {{"RateLimit-Policy", "\"key\";q=" + number(key.perMinute) + ";w=60"},
+          {"RateLimit", "\"key\";r=" + number(std::max(0.0, std::floor(d.remaining))) +
+                            ";t=" + number(std::ceil(d.fullInS))}};
+}
+
+ApiError Access::quotaExceeded(const ApiKey& key, const QuotaDecision& d, double units) const {
+  ApiError e{429,
+             "quota-exceeded",
+             "Too Many Requests",
+             "this request costs " + number(units) + " quota units (1 per MiB of its estimated peak memory); "
+             "the key '" + key.id + "' holds " + number(std::max(0.0, std::floor(d.remaining))) + " of its " +
+                 number(key.burst) + ", refilled at " + number(key.perMinute) + " a minute",
+             {},
+             rateLimitHeaders(key, d)};
+  e.headers["Retry-After"] = number(std::max(1.0, std::ceil(d.retryAfterS)));
+  return e;
+}
+
+std::optional<ApiError> Access::enter(const ApiKey& key, std::shared_ptr<void>& place) {
+  const int most = key.maxConcurrent > 0 ? key.maxConcurrent : config_.keyMaxConcurrent;
+  {
+    std::lock_guard lock(mutex_);
+    PerKey& k = perKey_[key.id];
+    if (k.inProgress >= most) {
+      ++k.busy;
+      return ApiError{429,
+                      "too-many-concurrent",
+                      "Too Many Requests",
+                      "the key '" + key.id + "' has " + std::to_string(k.inProgress) + " requests in progress, the most it may (" +
+                          (key.maxConcurrent > 0 ? "its maxConcurrent" : "--key-max-concurrent") + "): wait for one",
+                      {},
+                      {{"Retry-After", "1"}}};
+    }
+    ++k.inProgress;
+  }
+  place = std::shared_ptr<void>(nullptr, [this, id = key.id](void*) {
+    std::lock_guard lock(mutex_);
+    --perKey_[id].inProgress;
+  });
+  const QuotaDecision d = quota_.charge(key, 1, 1);
+  {
+    std::lock_guard lock(mutex_);
+    PerKey& k = perKey_[key.id];
+    if (d.allowed)
+      k.units += 1;
+    else
+      ++k.limited;
+  }
+  if (d.allowed) return std::nullopt;
+  place.reset();  // takes mutex_ itself
+  return quotaExceeded(key, d, 1);
+}
+
+void Access::charge(const ApiKey& key, double units, httplib::Response& res) {
+  // The bucket held min(units, burst) before the first unit: min(units, burst) - 1 after it.
+  const QuotaDecision d = quota_.charge(key, units - 1, std::min(units, key.burst) - 1);
   {
     std::lock_guard lock(mutex_);
     PerKey& k = perKey_[key.id];
     ++(d.allowed ? k.allowed : k.limited);
-    if (d.allowed) k.units += units;
+    if (d.allowed) k.units += units - 1;
   }
-  if (!d.allowed)
-    throw ApiError{429,
-                   "quota-exceeded",
-                   "Too Many Requests",
-                   "this request costs " + number(units) + " quota units (1 per MiB of its estimated peak memory); "
-                   "the key '" + key.id + "' holds " + number(std::max(0.0, std::floor(d.remaining))) + " of its " +
-                       number(key.burst) + ", refilled at " + number(key.perMinute) + " a minute",
-                   {},
-                   {{"Retry-After", number(std::max(1.0, std::ceil(d.retryAfterS)))},
-                    {"RateLimit-Policy", policy},
-                    {"RateLimit", state}}};
-  res.set_header("RateLimit-Policy", policy);
-  res.set_header("RateLimit", state);
+  if (!d.allowed) throw quotaExceeded(key, d, units);
+  for (const auto& [name, value] : rateLimitHeaders(key, d)) res.set_header(name, value);
+}
+
+void Access::refund(const ApiKey& key, double units) {
+  if (units <= 1) return;
+  quota_.charge(key, -(units - 1), Quota::kAlways);
+  std::lock_guard lock(mutex_);
+  perKey_[key.id].units -= units - 1;
+}
+
+void Access::chargeInvalid(const ApiKey& key, size_t bodyBytes) {
+  const double units = quotaUnits(bodyBytes);
+  if (units > 1) quota_.charge(key, units - 1, Quota::kAlways);
+  std::lock_guard lock(mutex_);
+  PerKey& k = perKey_[key.id];
+  ++k.invalid;
+  k.units += units - 1;
 }
 
 std::string Access::reload() {
@@ -139,12 +196,13 @@ std::string Access::reload() {
 std::string Access::metricsText() const {
   std::lock_guard lock(mutex_);
   std::string out =
-      "# HELP effectd_key_requests_total Requests made with each API key, by outcome (allowed, limited: 429).\n"
+      "# HELP effectd_key_requests_total Requests made with each API key, by outcome (allowed; limited: 429 "
+      "for quota; busy: 429 for maxConcurrent; invalid: 400, charged by body size).\n"
       "# TYPE effectd_key_requests_total counter\n";
-  for (const auto& [id, k] : perKey_) {
-    out += "effectd_key_requests_total{key=\"" + id + "\",outcome=\"allowed\"} " + std::to_string(k.allowed) + "\n";
-    out += "effectd_key_requests_total{key=\"" + id + "\",outcome=\"limited\"} " + std::to_string(k.limited) + "\n";
-  }
+  for (const auto& [id, k] : perKey_)
+    for (const auto& [outcome, n] : {std::pair{"allowed", k.allowed}, {"limited", k.limited}, {"busy", k.busy},
+                                     {"invalid", k.invalid}})
+      out += "effectd_key_requests_total{key=\"" + id + "\",outcome=\"" + outcome + "\"} " + std::to_string(n) + "\n";
   out += "# HELP effectd_key_units_total Quota units charged to each API key.\n# TYPE effectd_key_units_total counter\n";
   for (const auto& [id, k] : perKey_) out += "effectd_key_units_total{key=\"" + id + "\"} " + number(k.units) + "\n";
   out += "# HELP effectd_access_refused_total Requests refused before their body was read, by reason.\n"

@@ -60,6 +60,12 @@ std::string ApiKeys::read(const std::string& path, std::vector<ApiKey>& keys) {
         key.endpoints.push_back(e);
       }
     }
+    if (k.contains("maxConcurrent")) {
+      if (!k["maxConcurrent"].is_number_integer() || k["maxConcurrent"].get<long long>() < 1 ||
+          k["maxConcurrent"].get<long long>() > 100000)
+        return at + "/maxConcurrent must be an integer from 1 to 100000";
+      key.maxConcurrent = k["maxConcurrent"].get<int>();
+    }
     if (!ids.insert(key.id).second) return at + "/id repeats the id '" + key.id + "'";
     if (!hashes.insert(key.sha256).second) return at + "/sha256 repeats another key's secret";
     keys.push_back(std::move(key));

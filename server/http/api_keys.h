@@ -1,8 +1,10 @@
 // API keys (--api-keys FILE): who may ask, and how much. The file holds only each secret's
 // SHA-256, so that reading it gives no key away:
 //   {"keys": [{"id": "game-a", "sha256": "<64 hex digits>", "perMinute": 600, "burst": 120,
-//              "endpoints": ["/v1/fog", "/v1/lightning"]}]}
-// perMinute and burst are quota units (quota.h); endpoints is optional (absent = all).
+//              "endpoints": ["/v1/fog", "/v1/lightning"], "maxConcurrent": 4}]}
+// perMinute and burst are quota units (quota.h); endpoints is optional (absent = all);
+// maxConcurrent is optional (absent = --key-max-concurrent): the key's requests in progress at
+// once on one replica, so that one key cannot fill the admission queue and heavy slots.
 #pragma once
 
 #include <memory>
@@ -18,6 +20,7 @@ struct ApiKey {
   std::string sha256;  // of the secret, lower-case hex
   double perMinute = 0, burst = 0;
   std::vector<std::string> endpoints;  // empty = every endpoint
+  int maxConcurrent = 0;               // 0 = the server's --key-max-concurrent
 
   bool allows(const std::string& path) const;
 };

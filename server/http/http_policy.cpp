@@ -12,6 +12,7 @@
 
 #include "http/access.h"
 #include "http/access_log.h"
+#include "http/connections.h"
 #include "http/encoding.h"
 #include "http/request_state.h"
 #include "http/route.h"
@@ -175,7 +176,7 @@ void Service::installHttpPolicy() {
 
   s.set_error_handler(httplib::Server::HandlerWithResponse(answerBareStatus));
   s.set_exception_handler(answerException);
-  s.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) { postRoute(res); });
+  s.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) { postRoute(req, res); });
 
   s.set_logger([this](const httplib::Request& req, const httplib::Response& res) { finishRequest(req, res); });
 
@@ -247,7 +248,15 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
       if (req.method == "POST") problem->headers["Connection"] = "close";  // its body stays unread
       return fail(*problem);
     }
-    if (tl.key) tl.keyId = tl.key->id;
+    if (tl.key) {
+      tl.keyId = tl.key->id;
+      // A key that cannot pay, or has all its places taken, is refused before its body is read.
+      if (auto problem = access_->enter(*tl.key, tl.keyPlace)) {
+        problem->headers[req.method == "POST" ? "Connection" : "Cache-Control"] =
+            req.method == "POST" ? "close" : "no-store";
+        return fail(*problem);
+      }
+    }
   }
   if (req.method != "POST") return false;
   unsigned long long length = 0;
@@ -272,7 +281,14 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
 }
 
 // After the handler: request id, CORS, Vary, and coding of answers that are not cached.
-void Service::postRoute(httplib::Response& res) {
+void Service::postRoute(const httplib::Request& req, httplib::Response& res) {
+  // The connection after this answer: closed when it says so; a body left unread by a refusal
+  // before it was read (415, 405, 401...) is skipped, so that it is not taken for a request.
+  if (res.get_header_value("Connection") == "close") {
+    EdgeServer::closeAfterThisAnswer();
+  } else if (req.body.empty() && req.has_header("Content-Length")) {
+    EdgeServer::skipUnreadBody(std::strtoull(req.get_header_value("Content-Length").c_str(), nullptr, 10));
+  }
   if (!res.has_header("X-Request-ID")) res.set_header("X-Request-ID", tl.requestId);
   if (!tl.corsOrigin.empty()) {
     res.set_header("Access-Control-Allow-Origin", tl.corsOrigin);

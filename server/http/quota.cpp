@@ -21,32 +21,31 @@ namespace effectd {
 namespace {
 
 // What a charge leaves: allowed or not, and when the bucket fills (again) at `perSecond`.
-QuotaDecision decide(bool allowed, double tokens, double units, double burst, double perSecond) {
+QuotaDecision decide(bool allowed, double tokens, double need, double burst, double perSecond) {
   QuotaDecision d;
   d.allowed = allowed;
   d.remaining = tokens;
-  const double need = std::min(units, burst);
   d.retryAfterS = allowed ? 0.0 : std::max(0.0, (need - tokens) / perSecond);
   d.fullInS = std::max(0.0, (burst - tokens) / perSecond);
   return d;
 }
 
 // The bucket in Redis: refilled from its last charge by Redis's own clock, charged when it
-// holds min(units, burst), kept a minute past the time it takes to fill.
+// holds `need` (never above burst), kept a minute past the time it takes to fill.
 constexpr const char* kChargeScript = R"(
-local rate, burst, units = tonumber(ARGV[1]), tonumber(ARGV[2]), tonumber(ARGV[3])
+local rate, burst, units, need = tonumber(ARGV[1]), tonumber(ARGV[2]), tonumber(ARGV[3]), tonumber(ARGV[4])
 local t = redis.call('TIME')
 local now = tonumber(t[1]) + tonumber(t[2]) / 1000000
 local v = redis.call('HMGET', KEYS[1], 'tokens', 'at')
 local tokens, at = tonumber(v[1]) or burst, tonumber(v[2]) or now
 tokens = math.min(burst, tokens + math.max(0, now - at) * rate)
 local allowed = 0
-if tokens >= math.min(units, burst) then
-  tokens = tokens - units
+if tokens >= need then
+  tokens = math.min(burst, tokens - units)
   allowed = 1
 end
 redis.call('HSET', KEYS[1], 'tokens', tostring(tokens), 'at', tostring(now))
-redis.call('EXPIRE', KEYS[1], math.ceil((burst + units) / rate) + 60)
+redis.call('EXPIRE', KEYS[1], math.ceil((burst + math.max(0, units)) / rate) + 60)
 return {allowed, tostring(tokens)}
 )";
 
@@ -71,15 +70,16 @@ class Quota::Redis {
   ~Redis() { disconnect(); }
 
   // The script's {allowed, tokens}, or nullopt when Redis did not answer in time.
-  std::optional<std::pair<bool, double>> charge(const ApiKey& key, double units) {
+  std::optional<std::pair<bool, double>> charge(const ApiKey& key, double units, double need) {
     std::lock_guard lock(mutex_);
     const auto now = std::chrono::steady_clock::now();
     if (fd_ < 0 && now < retryAt_) return std::nullopt;
-    char rate[32], burst[32], n[32];
+    char rate[32], burst[32], n[32], least[32];
     std::snprintf(rate, sizeof rate, "%.17g", key.perMinute / 60.0);
     std::snprintf(burst, sizeof burst, "%.17g", key.burst);
     std::snprintf(n, sizeof n, "%.17g", units);
-    const std::vector<std::string> args = {"EVAL", kChargeScript, "1", "effectd:quota:" + key.id, rate, burst, n};
+    std::snprintf(least, sizeof least, "%.17g", need);
+    const std::vector<std::string> args = {"EVAL", kChargeScript, "1", "effectd:quota:" + key.id, rate, burst, n, least};
     std::string request = "*" + std::to_string(args.size()) + "\r\n";
     for (const auto& a : args) request += "$" + std::to_string(a.size()) + "\r\n" + a + "\r\n";
     if ((fd_ >= 0 || connect()) && send(request)) {
@@ -169,21 +169,22 @@ Quota::Quota(const std::string& redisUrl) {
 
 Quota::~Quota() = default;
 
-QuotaDecision Quota::charge(const ApiKey& key, double units) {
+QuotaDecision Quota::charge(const ApiKey& key, double units, double need) {
+  need = std::min(need, key.burst);
   const double perSecond = key.perMinute / 60.0;
   if (redis_) {
-    if (auto r = redis_->charge(key, units)) {
+    if (auto r = redis_->charge(key, units, need)) {
       std::lock_guard lock(mutex_);
       ++counts_.shared;
-      return decide(r->first, r->second, units, key.burst, perSecond);
+      return decide(r->first, r->second, need, key.burst, perSecond);
     }
     std::lock_guard lock(mutex_);
     ++counts_.fallbacks;
   }
-  return chargeLocal(key, units);
+  return chargeLocal(key, units, need);
 }
 
-QuotaDecision Quota::chargeLocal(const ApiKey& key, double units) {
+QuotaDecision Quota::chargeLocal(const ApiKey& key, double units, double need) {
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard lock(mutex_);
   auto [it, fresh] = buckets_.try_emplace(key.id, Bucket{key.burst, now});
@@ -192,9 +193,9 @@ QuotaDecision Quota::chargeLocal(const ApiKey& key, double units) {
   if (!fresh)
     b.tokens = std::min(key.burst, b.tokens + std::chrono::duration<double>(now - b.at).count() * perSecond);
   b.at = now;
-  const bool allowed = b.tokens >= std::min(units, key.burst);
-  if (allowed) b.tokens -= units;
-  return decide(allowed, b.tokens, units, key.burst, perSecond);
+  const bool allowed = b.tokens >= need;
+  if (allowed) b.tokens = std::min(key.burst, b.tokens - units);
+  return decide(allowed, b.tokens, need, key.burst, perSecond);
 }
 
 Quota::Counts Quota::counts() const {

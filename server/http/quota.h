@@ -1,8 +1,10 @@
 // Quotas of API keys: one token bucket per key, `burst` units deep, refilled at `perMinute`
 // units a minute. A request is charged its admission estimate in units (kQuotaUnitBytes each,
-// at least one), so a 4096² bolt costs more than a small fog table. A request is let in when
+// at least one), so a 4096^2 bolt costs more than a small fog table. A request is let in when
 // the bucket holds min(its units, burst): a request larger than the burst passes from a full
-// bucket and leaves it in debt, which the refill pays back before the next one.
+// bucket and leaves it in debt, which the refill pays back before the next one. How a request's
+// units are taken in steps (one before its body is read, the rest before admission, a refund
+// when admission refuses it, and invalid bodies by their size) is access.h's.
 //
 // The buckets live in this process, or with --quota-redis in Redis, shared by every replica
 // (one Lua script per charge, atomic there). Redis unreachable: the charge falls back to this
@@ -36,7 +38,10 @@ class Quota {
   // `redisUrl` "" = buckets in this process only.
   explicit Quota(const std::string& redisUrl);
   ~Quota();
-  QuotaDecision charge(const ApiKey& key, double units);
+  // Takes `units` (negative: gives them back, up to burst) when the bucket holds `need`
+  // (capped at burst; kAlways: whatever it holds, into debt if need be).
+  QuotaDecision charge(const ApiKey& key, double units, double need);
+  static constexpr double kAlways = -1e300;
   // Counters for /metrics: charges Redis answered, and charges it failed (served locally).
   struct Counts {
     unsigned long long shared = 0, fallbacks = 0;
@@ -49,7 +54,7 @@ class Quota {
     double tokens = 0;  // units; negative: in debt
     std::chrono::steady_clock::time_point at;
   };
-  QuotaDecision chargeLocal(const ApiKey& key, double units);
+  QuotaDecision chargeLocal(const ApiKey& key, double units, double need);
   class Redis;
   std::unique_ptr<Redis> redis_;
   mutable std::mutex mutex_;

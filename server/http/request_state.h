@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -23,6 +24,8 @@ struct RequestState {
   bool encoded = false;        // the answer's coding is chosen (and part of its ETag) already
   std::optional<ApiKey> key;   // the API key the request came with (access.h)
   std::string keyId;           // its id, for the access log
+  std::shared_ptr<void> keyPlace;  // one of the key's maxConcurrent places (Access::enter)
+  bool keyCharged = false;         // the key has paid the request's units (Access::charge)
   // Held until the answer has been written (the logger runs after that).
   Admission::Ticket bodyTicket, workTicket;
 };

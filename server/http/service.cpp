@@ -19,6 +19,7 @@
 #include "contract/json_writer.h"
 #include "contract/resources.h"
 #include "http/access.h"
+#include "http/connections.h"
 #include "http/elastic_pool.h"
 #include "http/encoding.h"
 #include "http/etag.h"
@@ -94,12 +95,27 @@ void sendAnswer(const CachedAnswer& a, const std::string& inm, httplib::Response
   res.set_content(a.body, a.contentType);
 }
 
+// A header value in ASCII (RFC 9110 §5.5 leaves other bytes opaque, and clients mangle them):
+// the report's row names write grids as 64², 32³, which go as 64^2, 32^3.
+std::string asciiHeader(std::string value) {
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\u00B2", "^2"}, {"\u00B3", "^3"}})
+    for (size_t at = value.find(from); at != std::string::npos; at = value.find(from, at + to.size()))
+      value.replace(at, from.size(), to);
+  for (char& c : value)
+    if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+  return value;
+}
+
+void addHeaders(std::map<std::string, std::string>& to, const std::map<std::string, std::string>& from) {
+  for (const auto& [name, value] : from) to.emplace(name, asciiHeader(value));
+}
+
 // Runs a binary body's handler into `answer`; returns its compute time.
 double answerBinary(const BinaryHandler& handler, const std::string& body, const RequestContext& ctx,
                     CachedAnswer& answer) {
   BinaryReply reply = handler(body, ctx);
   if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
-  answer.headers.insert(reply.headers.begin(), reply.headers.end());
+  addHeaders(answer.headers, reply.headers);
   answer.body = std::move(reply.body);
   answer.contentType = reply.contentType;
   return reply.computeMs;
@@ -123,8 +139,8 @@ void answerJson(const PreparedRequest& prepared, json& body, CachedAnswer& answe
   JsonReply reply = prepared.run();
   body = json();  // the request document is no longer needed
   if (!reply.method.empty()) answer.headers["X-Effect-Method"] = reply.method;
-  answer.headers.insert(reply.headers.begin(), reply.headers.end());
-  for (const auto& [name, value] : reply.runHeaders) res.set_header(name, value);
+  addHeaders(answer.headers, reply.headers);
+  for (const auto& [name, value] : reply.runHeaders) res.set_header(name, asciiHeader(value));
   if (!reply.contentType.empty()) {
     answer.body = std::move(reply.binary);
     answer.contentType = reply.contentType;
@@ -164,9 +180,15 @@ void answerReadiness(const Probes& readiness, const Probes& info, httplib::Respo
 
 // /v1/schemas/<name>: a contract document.
 void answerSchemaDocument(const httplib::Request& req, httplib::Response& res) {
-  auto it = resources().find("schemas/" + req.matches[1].str());
+  const std::string name = req.matches[1].str();
+  auto it = resources().find("schemas/" + name);
+  if (it == resources().end()) it = resources().find("schemas/" + name + ".json");  // /v1/schemas/fog
   if (it == resources().end()) {
-    writeProblem(res, {404, "not-found", "Not Found", "no such schema", {}, {}}, tl.requestId);
+    std::string known;
+    for (const auto& [path, data] : resources())
+      if (path.rfind("schemas/", 0) == 0) known += (known.empty() ? "" : ", ") + path.substr(8);
+    writeProblem(res, {404, "not-found", "Not Found", "no schema " + name + "; there are: " + known, {}, {}},
+                 tl.requestId);
     return;
   }
   res.set_content(std::string(it->second), "application/schema+json");
@@ -191,7 +213,7 @@ Service::Service(Config config)
     : config_(std::move(config)),
       admission_(std::make_unique<Admission>(admissionOptions(config_))),
       cache_(config_.responseCacheMb << 20),
-      http_(std::make_unique<httplib::Server>()),
+      http_(std::make_unique<EdgeServer>(config_.maxConnections)),
       compute_(std::make_unique<effects::ThreadPool>(effects::ThreadPool::besideCaller())),
       access_(std::make_unique<Access>(config_)),
       idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
@@ -221,7 +243,7 @@ const Service::Route* Service::findRoute(const std::string& path) const {
 void Service::installCore() {
   httplib::Server& s = *http_;
   const size_t threads = size_t(config_.threads), connections = size_t(config_.maxConnections);
-  s.new_task_queue = [threads, connections] { return new ElasticPool(threads, connections); };
+  s.new_task_queue = [threads, connections] { return new ElasticPool(threads, connections + kRefusalThreads); };
   s.set_payload_max_length(config_.limits.maxBodyBytes);
   s.set_read_timeout(config_.readTimeoutS, 0);
   s.set_write_timeout(config_.writeTimeoutS, 0);
@@ -249,14 +271,35 @@ void Service::installCore() {
     routes_.push_back(std::move(r));
     if (h) http_->Get(path, std::move(h));
   };
-  addGet("/healthz", [](const httplib::Request&, httplib::Response& res) {
+  // Operations: health and readiness on the public port (and the admin one), metrics on the
+  // admin port when there is one, else on the public port.
+  const httplib::Server::Handler healthz = [](const httplib::Request&, httplib::Response& res) {
     res.set_content("{\"status\":\"ok\"}", "application/json");
-  });
-  addGet("/readyz",
-         [this](const httplib::Request&, httplib::Response& res) { answerReadiness(readiness_, info_, res); });
-  addGet("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+  };
+  const httplib::Server::Handler readyz = [this](const httplib::Request&, httplib::Response& res) {
+    answerReadiness(readiness_, info_, res);
+  };
+  const httplib::Server::Handler metrics = [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
-  });
+  };
+  addGet("/healthz", healthz);
+  addGet("/readyz", readyz);
+  if (config_.adminPort == 0) addGet("/metrics", metrics);
+  addReadinessCheck("shutdown", [this] { return stopping_ ? std::string("shutting down") : std::string(); });
+  metrics_.addSource([this] { return http_->metricsText(); });
+  if (config_.adminPort != 0) {
+    admin_ = std::make_unique<EdgeServer>(64);
+    admin_->new_task_queue = [] { return new ElasticPool(2, 64 + kRefusalThreads); };
+    admin_->set_read_timeout(config_.readTimeoutS, 0);
+    admin_->set_write_timeout(config_.writeTimeoutS, 0);
+    admin_->set_socket_options([](int sock) {  // as the public port's: a port in use is an error
+      int yes = 1;
+      ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
+    admin_->Get("/healthz", healthz);
+    admin_->Get("/readyz", readyz);
+    admin_->Get("/metrics", metrics);
+  }
   addGet("/v1/openapi.yaml", [](const httplib::Request&, httplib::Response& res) {
     res.set_content(std::string(resources().at("openapi.yaml")), "application/yaml");
   });
@@ -424,7 +467,9 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
           : std::string();
   // A key's quota is charged the request's units: one for an answer already cached.
   auto charge = [&](size_t bytes) {
-    if (tl.key) access_->charge(*tl.key, bytes ? quotaUnits(bytes) : 1.0, res);
+    if (!tl.key) return;
+    access_->charge(*tl.key, bytes ? quotaUnits(bytes) : 1.0, res);
+    tl.keyCharged = true;
   };
   try {
     if (auto hit = cache_.byRequest(requestKey)) {
@@ -463,11 +508,18 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
     PreparedRequest prepared;
     if (!isBinary) prepared = route.json(body, ctx);
     const Cost cost = isBinary ? binary->second.cost(bodyText, config_) : prepared.cost;
-    // Admitted first: a request refused for memory (503, 413) costs its key nothing. Charged
-    // what X-Memory-Reserved says, the work's and the body's reservations together.
-    tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
-    res.set_header("X-Memory-Reserved", std::to_string(cost.bytes + tl.bodyTicket.bytes()));
-    charge(cost.bytes + tl.bodyTicket.bytes());
+    // Charged first, what X-Memory-Reserved says (the work's and the body's reservations
+    // together), so that a key that cannot pay never waits for admission; a request that
+    // admission then refuses (503, 413) gets its units back.
+    const size_t reserved = cost.bytes + tl.bodyTicket.bytes();
+    charge(reserved);
+    try {
+      tl.workTicket = admission_->admit(cost.bytes, cost.heavy);
+    } catch (const ApiError&) {
+      if (tl.key) access_->refund(*tl.key, quotaUnits(reserved));
+      throw;
+    }
+    res.set_header("X-Memory-Reserved", std::to_string(reserved));
 
     auto answer = std::make_shared<CachedAnswer>();
     answer->etag = tag;
@@ -480,6 +532,9 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
     sendAnswer(*answer, inm, res);
     if (!tag.empty()) cache_.put(std::move(answer), requestKey);
   } catch (const ApiError& e) {
+    // A body that fails parsing, the schema or the endpoint's checks is not free: its size.
+    if (tl.key && !tl.keyCharged && e.status >= 400 && e.status < 500 && e.status != 429)
+      access_->chargeInvalid(*tl.key, bodyText.size());
     res.headers.erase("ETag");  // problems are not cacheable representations
     res.headers.erase("Server-Timing");
     tl.encoded = false;
@@ -496,14 +551,31 @@ int Service::bind() {
   // wrk -c64 saw p99 1.4 s with p90 4.6 ms (nstat: TcpExtListenOverflows). Calling listen()
   // again on a listening socket sets its backlog (Linux), capped by net.core.somaxconn.
   if (port > 0 && listenSocket_ >= 0) ::listen(listenSocket_, SOMAXCONN);
+  if (port > 0 && admin_) {
+    if (!admin_->bind_to_port(config_.host, config_.adminPort)) return -1;
+    adminPort_ = config_.adminPort;
+  }
   return port;
 }
 
-bool Service::run() { return http_->listen_after_bind(); }
+size_t Service::openConnections() const { return http_->counts().open; }
+
+bool Service::run() {
+  if (admin_) adminThread_ = std::thread([this] { admin_->listen_after_bind(); });
+  const bool ok = http_->listen_after_bind();
+  if (adminThread_.joinable()) {
+    for (int i = 0; i < 2000 && !admin_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    admin_->stop();
+    adminThread_.join();
+  }
+  return ok;
+}
 
 void Service::stop() {
+  stopping_ = true;  // /readyz: not ready
   // stop() before the listen loop runs would be lost (cpp-httplib 0.11.4): wait for it.
   waitUntilRunning(std::chrono::milliseconds(2000));
+  http_->drain();
   http_->stop();
 }
 

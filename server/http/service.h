@@ -3,11 +3,13 @@
 // parsed, schema-validated body, and they report bad input by throwing ApiError.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -37,6 +39,7 @@ struct Response;
 namespace effectd {
 
 class Access;
+class EdgeServer;
 
 // Server-Timing entries (name;dur=ms), in order.
 using Stages = std::vector<std::pair<std::string, double>>;
@@ -140,9 +143,13 @@ class Service {
   // SIGHUP: rereads the URL signing keys and the API keys (access.h). "" or why the old stay.
   std::string reloadAccess();
 
-  int bind();   // binds host:port from the config; returns the port, or -1
-  bool run();   // serves until stop(); in-flight requests finish before it returns
-  void stop();  // safe from any thread, also before run() has started serving
+  int bind();       // binds host:port from the config; returns the port, or -1
+  int adminPort() const { return adminPort_; }  // after bind(): the admin listener's, or 0
+  size_t openConnections() const;                // on the public port
+  bool run();       // serves until stop(); in-flight requests finish before it returns
+  // Safe from any thread, also before run() has started serving: stops listening, closes the
+  // connections idle or still sending, lets the requests being computed finish.
+  void stop();
   bool waitUntilRunning(std::chrono::milliseconds timeout) const;
 
   const Config& config() const { return config_; }
@@ -156,7 +163,7 @@ class Service {
   void installCore();
   void installHttpPolicy();
   bool preRoute(const httplib::Request& req, httplib::Response& res);  // http_policy.cpp
-  void postRoute(httplib::Response& res);
+  void postRoute(const httplib::Request& req, httplib::Response& res);
   void finishRequest(const httplib::Request& req, const httplib::Response& res);
   void handlePost(const Route& route, const httplib::Request& req, httplib::Response& res);
   // GET <endpoint>?r=<base64url of the JSON body>: the POST's answer, cacheable by URL.
@@ -172,11 +179,15 @@ class Service {
   std::unique_ptr<Admission> admission_;
   ResponseCache cache_;
   std::unique_ptr<SchemaRegistry> schemas_;
-  std::unique_ptr<httplib::Server> http_;
+  std::unique_ptr<EdgeServer> http_;
+  std::unique_ptr<EdgeServer> admin_;  // --admin-port: health, readiness and metrics
+  std::thread adminThread_;
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
   std::unique_ptr<Access> access_;                // who may ask, and how much
   std::unique_ptr<IdleTrim> idleTrim_;
   int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
+  int adminPort_ = 0;
+  std::atomic<bool> stopping_{false};
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
 };
