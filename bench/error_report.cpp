@@ -1005,6 +1005,95 @@ bool fogPreviewErrors(bool quick, Section& out, rd::Renderer& renderer) {
   return true;
 }
 
+// ---- render previews: the lightning pass against its polylines --------------------------------
+struct BoltPreview {
+  std::string name;
+  int grid, frame;
+  double coreWidth;
+};
+std::vector<BoltPreview> boltPreviews(bool quick) {
+  if (quick) return {{"64 grid, core 1.5", 64, 128, 1.5}};
+  return {{"64 grid, core 1.5", 64, 256, 1.5}, {"64 grid, core 3", 64, 256, 3}, {"128 grid, core 1.5", 128, 512, 1.5}};
+}
+json boltScene(const BoltPreview& v) {
+  return {{"width", v.frame},
+          {"height", v.frame},
+          {"background", {{"color", {0, 0, 0}}}},
+          {"lightning",
+           {{"grid", {{"width", v.grid}, {"height", v.grid}}}, {"start", {v.grid / 2, 0}}, {"targets", {{v.grid / 2, v.grid - 1}}},
+            {"seed", 5}}},
+          {"lightningStyle", {{"coreWidth", v.coreWidth}, {"glowSigma", 0}}}};
+}
+
+void lightningPreviewTimes(bool quick, Section& out) {
+  out = {"render-lightning",
+         "Render previews: the lightning pass against its polylines",
+         "the answer's own polylines, mapped to pixels by the scene's rect: every bright pixel of the core (blue >= 64 "
+         "of 255, glow off) measured against the nearest segment",
+         "max over bright pixels of (distance to the nearest segment − coreWidth), px",
+         "ms per frame (median)",
+         "bolt",
+         "segment midpoints lit",
+         {},
+         {}};
+  for (const BoltPreview& v : boltPreviews(quick)) {
+    const size_t t = timings.add("render lightning " + v.name, [quick, scene = boltScene(v)] {
+      static auto renderer = rd::Renderer::create();
+      std::vector<double> ms;
+      if (!renderer.ok()) return ms;
+      const rd::Scene built = sceneOf(scene);
+      for (int i = 0; i <= (quick ? 2 : 7); ++i)
+        if (auto f = renderer.value()->render(built); f.ok() && i > 0) ms.push_back(f.value().ms);
+      return ms;
+    });
+    out.points.push_back(pointOf(v.name, std::to_string(v.frame) + "², GPU", t, NAN));
+    out.points.back().group = v.name;
+  }
+}
+
+bool lightningPreviewErrors(bool quick, Section& out, rd::Renderer& renderer) {
+  const std::vector<BoltPreview> variants = boltPreviews(quick);
+  for (size_t i = 0; i < variants.size(); ++i) {
+    const rd::Scene scene = sceneOf(boltScene(variants[i]));
+    auto f = renderer.render(scene);
+    if (!f.ok() || !scene.lightning)
+      return std::fprintf(stderr, "error_report: bolt %s did not render\n", variants[i].name.c_str()), false;
+    const rd::Lightning& l = *scene.lightning;
+    const int w = scene.width, h = scene.height;
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> segments;
+    auto pixel = [&](const lt::Vertex& p) {
+      return glm::dvec2((l.rect.x + p.x * (l.rect.z - l.rect.x) / l.gridWidth) * w,
+                        (l.rect.y + p.y * (l.rect.w - l.rect.y) / l.gridHeight) * h);
+    };
+    for (const auto& line : l.polylines)
+      for (size_t k = 1; k < line.vertices.size(); ++k)
+        segments.push_back({pixel(line.vertices[k - 1]), pixel(line.vertices[k])});
+    auto distance = [&](glm::dvec2 p) {
+      double best = INFINITY;
+      for (const auto& [a, b] : segments) {
+        const glm::dvec2 ab = b - a;
+        const double t = glm::dot(ab, ab) > 0 ? std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0) : 0.0;
+        best = std::min(best, glm::length(p - (a + t * ab)));
+      }
+      return best;
+    };
+    const std::vector<uint8_t> px = rd::bytes8(f.value().image);
+    auto blue = [&](int x, int y) { return px[(size_t(y) * size_t(w) + size_t(x)) * 4 + 2]; };
+    double worst = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (blue(x, y) >= 64) worst = std::max(worst, distance({x + 0.5, y + 0.5}) - l.coreWidth);
+    int lit = 0;
+    for (const auto& [a, b] : segments) {
+      const glm::dvec2 m = 0.5 * (a + b);
+      lit += blue(std::clamp(int(m.x), 0, w - 1), std::clamp(int(m.y), 0, h - 1)) >= 51;
+    }
+    out.points[i].error = worst;
+    out.points[i].note = fmt(100.0 * lit / double(std::max<size_t>(1, segments.size())), 3) + " %";
+  }
+  return true;
+}
+
 // ---- conclusions: read off the numbers ---------------------------------------------------------
 // The fastest point within `maxError` among the series starting with `series`.
 const Point* fastestWithin(const Section& s, double maxError, const std::string& series = "") {
@@ -1150,6 +1239,12 @@ void conclude(std::vector<Section>& sections) {
       c << "The fog pass is the closed form in float: every fog here within " << fmt(worst, 2)
         << " steps of 8-bit colour of the double-precision closed form at the quads' centres; its cost is the "
            "frame's.";
+    } else if (s.id == "render-lightning") {
+      double worst = 0;
+      for (const auto& p : s.points) worst = std::max(worst, p.error);
+      c << "Every bright pixel of the core lies within coreWidth + " << fmt(worst, 3)
+        << " px of the answer's polylines (the bound /v1/render states is 1.75 px: half a width of caps and one of "
+           "anti-aliasing); the lit share of segment midpoints shows the bolt is drawn, not just kept inside.";
     } else if (s.id == "thin-film") {
       const Point* jnd = fastestWithin(s, 1.0);
       if (jnd)
@@ -1220,6 +1315,7 @@ constexpr UseLimit kUseLimits[] = {
     {"tangents", 5.0, "a mean 5 degree tilt shows in normal-mapped highlights"},
     {"thin-film", 2.3, "mean Delta E 2.3, one just-noticeable difference"},
     {"render-fog", 2.0, "2 steps of 8-bit colour, a visible band"},
+    {"render-lightning", 1.75, "the bound /v1/render states: the core 1.75 px wider than coreWidth"},
     {"render-bubble", 5.0, "mean Delta E 5: the same colours side by side, but a visibly different bubble"},
 };
 double useLimit(const Section& s) {
@@ -1553,6 +1649,8 @@ int main(int argc, char** argv) {
   renderPreviewTimes(quick, sections.back());
   sections.emplace_back();
   fogPreviewTimes(quick, sections.back());
+  sections.emplace_back();
+  lightningPreviewTimes(quick, sections.back());
   step("timing");
   if (!timings.run(quick ? 2 : kTimingProcesses)) return 1;  // quick: the same path, cheaper
   for (Section& s : sections)
@@ -1567,8 +1665,9 @@ int main(int argc, char** argv) {
   step("render previews");
   auto renderer = rd::Renderer::create();  // after the timing processes: they cannot share it
   if (!renderer.ok()) return std::fprintf(stderr, "error_report: %s\n", renderer.error().message.c_str()), 1;
-  if (!renderPreviewErrors(quick, sections[sections.size() - 2], *renderer.value(), out / "error-vs-time") ||
-      !fogPreviewErrors(quick, sections.back(), *renderer.value()))
+  if (!renderPreviewErrors(quick, sections[sections.size() - 3], *renderer.value(), out / "error-vs-time") ||
+      !fogPreviewErrors(quick, sections[sections.size() - 2], *renderer.value()) ||
+      !lightningPreviewErrors(quick, sections.back(), *renderer.value()))
     return 1;
   conclude(sections);
   write(sections, sheets, out, quick, plots, stamp);
