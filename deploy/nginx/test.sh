@@ -39,6 +39,7 @@ lb=$(free_port)
 mkdir -p "$work/tmp" "$work/cache"
 sed -e "s/listen 8080;/listen 127.0.0.1:$lb;/" -e "s/127.0.0.1:8081/127.0.0.1:$a/" -e "s/127.0.0.1:8082/127.0.0.1:$b/" \
   "$here/nginx.conf" >"$work/nginx.conf"
+cp "$here/edge.conf" "$work/edge.conf"
 user=""
 [ "$(id -u)" -eq 0 ] && user="user root root;"  # workers must write the cache under $work
 nginx -p "$work" -c "$work/nginx.conf" -g "daemon off; $user" >/dev/null 2>"$work/nginx.log" &
@@ -71,4 +72,11 @@ post "$lb" 4
 code=$(curl -s --max-time 20 -o /dev/null -w '%{http_code}' -H "If-None-Match: $(header ETag a)" -H 'Content-Type: application/json' \
   -d '{"fog":{"fogType":"GL_EXP2","density":0.05},"table":{"size":64}}' "http://127.0.0.1:$a/v1/fog")
 [ "$code" = "304" ] || { echo "If-None-Match gave $code"; exit 1; }
+# The public edge (edge.conf): readiness, metrics and the playground are not served; health is.
+for path in /readyz /metrics / /index.html; do
+  code=$(curl -s --max-time 5 -o /dev/null -w '%{http_code}' "http://127.0.0.1:$lb$path")
+  [ "$code" = "404" ] || { echo "$path through nginx: $code, not 404"; exit 1; }
+done
+code=$(curl -s --max-time 5 -o /dev/null -w '%{http_code}' "http://127.0.0.1:$lb/healthz")
+[ "$code" = "200" ] || { echo "/healthz through nginx: $code"; exit 1; }
 echo "nginx test ok: replicas on $a and $b agree, cache MISS then HIT through $lb"

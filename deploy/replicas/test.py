@@ -8,7 +8,10 @@ from a client (ctest deploy_replicas):
   B. one API key's admissions over T seconds from 4 clients, spread over the replicas, within
      10 % of its quota (burst + perMinute/60 * T) summed over the replicas (Redis);
   C. a replica killed mid-load: the GETs in flight and after are retried by nginx, none fails;
-  D. Redis stopped: keyed requests still answered (fail open to per-replica buckets).
+  D. Redis stopped: keyed requests still answered (fail open to per-replica buckets);
+  E. the public path: readiness, metrics and the playground are not served through nginx (each
+     replica's admin port serves them), and with 2 x --max-connections clients trickling their
+     headers to nginx, /healthz through nginx and on a replica's admin port answers at once.
 
     deploy/replicas/test.py EFFECTD_BINARY
 """
@@ -32,6 +35,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SIGNING_KEY = "replicas-signing-key-0123456789"
 SECRET = "replicas-test-secret"
 PER_MINUTE, BURST = 600, 20
+MAX_CONNECTIONS = 32  # each replica's --max-connections; E opens twice as many slow connections
 
 
 def free_port():
@@ -51,6 +55,7 @@ def fog(i):
 
 
 def metric(port, pattern):
+    """A counter from a replica's /metrics, on its admin port."""
     c = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
     c.request("GET", "/metrics")
     text = c.getresponse().read().decode()
@@ -83,18 +88,22 @@ def main():
         open(os.path.join(work, "signing.txt"), "w").write(SIGNING_KEY + "\n")
         json.dump({"keys": [{"id": "load", "sha256": hashlib.sha256(SECRET.encode()).hexdigest(),
                              "perMinute": PER_MINUTE, "burst": BURST}]}, open(os.path.join(work, "keys.json"), "w"))
-        ports = []
+        ports, admin = [], {}
         for i in range(3):
             log = open(os.path.join(work, f"effectd{i}.log"), "w+")
+            admin_port = free_port()
+            # As README.md runs them: the playground off, operations on the admin port.
             procs[f"effectd{i}"] = subprocess.Popen(
                 [binary, "--port", "0", "--threads", "8", "--access-log", "0", "--quota-redis", f"redis://127.0.0.1:{redis_port}",
-                 "--api-keys", os.path.join(work, "keys.json"), "--url-signing-key-file", os.path.join(work, "signing.txt")],
+                 "--api-keys", os.path.join(work, "keys.json"), "--url-signing-key-file", os.path.join(work, "signing.txt"),
+                 "--playground", "off", "--admin-port", str(admin_port), "--max-connections", str(MAX_CONNECTIONS)],
                 stderr=log)
             for _ in range(200):
                 log.seek(0)
                 m = re.search(r'"port":(\d+)', log.read())
                 if m:
                     ports.append(int(m.group(1)))
+                    admin[ports[-1]] = admin_port
                     break
                 time.sleep(0.05)
         if not check(len(ports) == 3, "three replicas listening", ports):
@@ -106,6 +115,7 @@ def main():
         os.makedirs(os.path.join(work, "tmp"))
         os.makedirs(os.path.join(work, "cache"))
         open(os.path.join(work, "nginx.conf"), "w").write(conf)
+        shutil.copy(os.path.join(HERE, "..", "nginx", "edge.conf"), os.path.join(work, "edge.conf"))
         user = "user root root;" if os.getuid() == 0 else ""
         procs["nginx"] = subprocess.Popen(["nginx", "-p", work, "-c", os.path.join(work, "nginx.conf"), "-g",
                                            f"daemon off; {user}"], stderr=open(os.path.join(work, "nginx.log"), "w"))
@@ -133,7 +143,7 @@ def main():
                 r = get(conn, signed(fog(i)))
                 statuses.append(r.status)
                 hits += r.getheader("X-Cache-Status") == "HIT"
-        computed = [metric(p, "effectd_response_cache_misses_total") for p in ports]
+        computed = [metric(admin[p], "effectd_response_cache_misses_total") for p in ports]
         check(all(s == 200 for s in statuses), f"A: {n} distinct signed URLs x {1 + m} through nginx all answered",
               sorted(set(statuses)))
         check(sum(computed) == n and hits == n * m,
@@ -167,7 +177,7 @@ def main():
         limited = sum(s == 429 for _, s in results)
         span = max(t for t, _ in results) - start
         expected = BURST + PER_MINUTE / 60.0 * span
-        per_replica = [metric(p, 'effectd_key_requests_total{key="load",outcome="allowed"}') for p in ports]
+        per_replica = [metric(admin[p], 'effectd_key_requests_total{key="load",outcome="allowed"}') for p in ports]
         print(f"     B: {len(results)} requests in {span:.2f} s: {allowed} allowed, {limited} limited; quota over "
               f"the span {expected:.1f}; allowed per replica {per_replica}")
         check(abs(allowed - expected) <= 0.1 * expected,
@@ -175,6 +185,34 @@ def main():
         check(sum(per_replica) == allowed and sum(x > 0 for x in per_replica) >= 2,
               "B: the replicas' own counts add up to it, from more than one replica", per_replica)
         check(allowed + limited == len(results), "B: every other answer a 429", sorted(set(s for _, s in results)))
+
+        # E. The public path, and health with twice --max-connections trickling clients.
+        for path in ("/readyz", "/metrics", "/", "/index.html"):
+            conn = http.client.HTTPConnection("127.0.0.1", lb, timeout=10)
+            check(get(conn, path).status == 404, f"E: {path} is not served through nginx")
+        conn = http.client.HTTPConnection("127.0.0.1", admin[ports[0]], timeout=10)
+        check(get(conn, "/metrics").status == 200, "E: a replica's admin port serves /metrics")
+        conn = http.client.HTTPConnection("127.0.0.1", ports[0], timeout=10)
+        check(get(conn, "/metrics").status == 404, "E: a replica's public port does not")
+        slow = []
+        for _ in range(2 * MAX_CONNECTIONS):
+            sock = socket.create_connection(("127.0.0.1", lb))
+            sock.sendall(b"GET /healthz HTTP/1.1\r\nHost: x\r\n")  # and no more
+            slow.append(sock)
+        time.sleep(0.3)
+        waits = {"nginx": [], "admin": []}
+        for _ in range(10):
+            for name, port in (("nginx", lb), ("admin", admin[ports[0]])):
+                conn = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+                t0 = time.monotonic()
+                status = get(conn, "/healthz").status
+                waits[name].append((time.monotonic() - t0) * 1e3)
+                check(status == 200, f"E: /healthz on {name} with {len(slow)} trickling clients", status)
+        for sock in slow:
+            sock.close()
+        print(f"     /healthz with {2 * MAX_CONNECTIONS} clients trickling to nginx: through nginx max "
+              f"{max(waits['nginx']):.2f} ms, on the admin port max {max(waits['admin']):.2f} ms")
+        check(max(waits["nginx"] + waits["admin"]) < 1000, "E: ... each within a second")
 
         # C. A replica killed (SIGKILL) mid-load: the GETs that reach it afterwards, on nginx's
         # kept-alive connections or new ones, are retried on the next replica; none fails. The
@@ -217,7 +255,8 @@ def main():
             r = c.getresponse()
             r.read()
             statuses.append(r.status)
-        fallbacks = sum(metric(p, 'effectd_quota_charges_total{store="local-fallback"}') for i, p in enumerate(ports) if i != 1)
+        fallbacks = sum(metric(admin[p], 'effectd_quota_charges_total{store="local-fallback"}')
+                        for i, p in enumerate(ports) if i != 1)
         check(statuses == [200] * 5 and fallbacks >= 5,
               f"D: Redis stopped: keyed requests answered from per-replica buckets ({fallbacks:.0f} local charges)",
               statuses)

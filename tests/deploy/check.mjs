@@ -1,9 +1,13 @@
-// deploy/k8s must agree with the server it deploys: flags the binary accepts, the port it
-// listens on, probe paths it serves, the user and entrypoint of the Dockerfile. Starts the
-// binary with the Deployment's own arguments (port 0 instead) and calls its probes.
+// deploy/k8s must agree with the server it deploys: flags the binary accepts, the ports it
+// listens on, probe paths it serves, the user and entrypoint of the Dockerfile, and the edge
+// sidecar's nginx (its edge.conf the same bytes as deploy/nginx/edge.conf). Starts the binary
+// with the Deployment's own arguments (free ports instead) and the sidecar's nginx in front of
+// it, and calls both as the cluster would: probes on the admin port, clients through the edge.
 //   node check.mjs EFFECTD_BINARY REPO_ROOT
 import { spawn, spawnSync } from "node:child_process";
-import { readFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync, rmSync } from "node:fs";
+import { createServer } from "node:net";
+import { tmpdir } from "node:os";
 import yaml from "js-yaml";
 
 const [bin, root] = process.argv.slice(2);
@@ -14,8 +18,10 @@ const load = (f) => yaml.loadAll(readFileSync(`${root}/${f}`, "utf8"));
 const [deployment] = load("deploy/k8s/deployment.yaml");
 const [service] = load("deploy/k8s/service.yaml");
 const [hpa] = load("deploy/k8s/hpa.yaml");
+const [edgeConfig] = load("deploy/k8s/edge-config.yaml");
 const pod = deployment.spec.template.spec;
-const [container] = pod.containers;
+const container = pod.containers.find((c) => c.name === "effectd");
+const edge = pod.containers.find((c) => c.name === "edge");
 const dockerfile = readFileSync(`${root}/Dockerfile`, "utf8");
 const openapi = yaml.load(readFileSync(`${root}/proto/openapi.yaml`, "utf8"));
 
@@ -36,13 +42,24 @@ check(flagValue("host") === "0.0.0.0", "--host must be 0.0.0.0 inside a pod");
 check(dockerfile.includes(`EXPOSE ${port.containerPort}`), "Dockerfile EXPOSE differs from containerPort");
 check(new RegExp(`EFFECTD_PORT=${port.containerPort}\\b`).test(dockerfile), "Dockerfile EFFECTD_PORT differs");
 
-// Probes: paths the server serves (in its contract), on the named port.
+// Probes: paths the server serves (in its contract), on the admin port (--admin-port).
+const admin = container.ports.find((p) => p.name === "admin");
+check(admin && String(admin.containerPort) === flagValue("admin-port"), "the admin containerPort must be --admin-port");
+check(flagValue("playground") === "off", "--playground=off: the playground is not for the public");
 for (const [name, path] of [["startupProbe", "/readyz"], ["readinessProbe", "/readyz"], ["livenessProbe", "/healthz"]]) {
   const probe = container[name];
   check(probe && probe.httpGet.path === path, `${name} must GET ${path}`);
   check(probe && openapi.paths[probe.httpGet.path], `${name} path ${probe && probe.httpGet.path} is not in openapi.yaml`);
-  check(probe && probe.httpGet.port === "http", `${name} must use the http port`);
+  check(probe && probe.httpGet.port === "admin", `${name} must use the admin port`);
 }
+
+// The edge: nginx with edge.conf in front, the only port the Service reaches.
+const edgeConf = edgeConfig.data["edge.conf"], edgeNginx = edgeConfig.data["nginx.conf"];
+check(edgeConf === readFileSync(`${root}/deploy/nginx/edge.conf`, "utf8"), "edge-config.yaml's edge.conf must be deploy/nginx/edge.conf");
+const publicPort = edge?.ports.find((p) => p.name === "public");
+check(publicPort && edgeNginx.includes(`listen ${publicPort.containerPort};`), "the edge's public port must be its nginx's listen port");
+check(edgeNginx.includes(`server 127.0.0.1:${flagValue("port")};`), "the edge's upstream must be effectd's --port");
+check(pod.volumes.some((v) => v.configMap?.name === edgeConfig.metadata.name), "the edge's ConfigMap must be mounted");
 
 // Image: entrypoint and user as the Dockerfile builds them.
 check(/ENTRYPOINT \["\/usr\/local\/bin\/effectd"\]/.test(dockerfile), "Dockerfile ENTRYPOINT must be the effectd binary");
@@ -66,13 +83,18 @@ check(container.resources?.requests?.cpu, "a CPU request is required for the HPA
 const labels = deployment.spec.template.metadata.labels;
 for (const [k, v] of Object.entries(deployment.spec.selector.matchLabels)) check(labels[k] === v, `selector ${k} does not match the pod`);
 for (const [k, v] of Object.entries(service.spec.selector)) check(labels[k] === v, `Service selector ${k} does not match the pod`);
-check(service.spec.ports[0].targetPort === "http", "Service targetPort must be the named container port");
+check(service.spec.ports[0].targetPort === "public", "the Service must target the edge's public port, not effectd");
 check(hpa.spec.scaleTargetRef.kind === "Deployment" && hpa.spec.scaleTargetRef.name === deployment.metadata.name, "HPA target");
 check(hpa.spec.minReplicas >= 2 && hpa.spec.maxReplicas >= hpa.spec.minReplicas, "HPA replica bounds");
 check(pod.terminationGracePeriodSeconds >= 10, "grace period for in-flight requests");
 
 // The binary accepts these exact arguments and answers its probes.
-const runArgs = args.slice(1).map((a) => (a.startsWith("--port=") ? "--port=0" : a.startsWith("--host=") ? "--host=127.0.0.1" : a));
+const freePort = () => new Promise((resolve) => {
+  const s = createServer().listen(0, "127.0.0.1", () => { const p = s.address().port; s.close(() => resolve(p)); });
+});
+const adminPort = await freePort(), edgePort = await freePort();
+const runArgs = args.slice(1).map((a) => (a.startsWith("--port=") ? "--port=0" : a.startsWith("--host=") ? "--host=127.0.0.1"
+  : a.startsWith("--admin-port=") ? `--admin-port=${adminPort}` : a));
 const server = spawn(bin, runArgs, { env: { ...process.env, ...Object.fromEntries(container.env.map((e) => [e.name, e.value])) } });
 let log = "";
 server.stderr.on("data", (d) => (log += d));
@@ -85,11 +107,40 @@ const listening = await new Promise((resolve) => {
   setTimeout(() => { clearInterval(t); resolve(0); }, 10000);
 });
 check(listening > 0, `effectd did not start with the Deployment's arguments: ${log}`);
+let nginx;
 if (listening) {
-  for (const path of ["/healthz", "/readyz"]) {
-    const r = await fetch(`http://127.0.0.1:${listening}${path}`);
-    check(r.status === 200, `${path} answered ${r.status}`);
+  for (const path of ["/healthz", "/readyz", "/metrics"]) {
+    const r = await fetch(`http://127.0.0.1:${adminPort}${path}`);
+    check(r.status === 200, `${path} on the admin port answered ${r.status}`);
   }
+  check((await fetch(`http://127.0.0.1:${listening}/metrics`)).status === 404, "/metrics must not be on effectd's public port");
+  // The sidecar's nginx, as the pod runs it, in front of this effectd.
+  const dir = mkdtempSync(`${tmpdir()}/effectd-edge.`);
+  writeFileSync(`${dir}/edge.conf`, edgeConf);
+  writeFileSync(`${dir}/nginx.conf`, edgeNginx.replace(`listen ${publicPort.containerPort};`, `listen 127.0.0.1:${edgePort};`)
+    .replace(`server 127.0.0.1:${flagValue("port")};`, `server 127.0.0.1:${listening};`));
+  const asRoot = process.getuid() === 0 ? " user root root;" : "";
+  nginx = spawn("nginx", ["-p", `${dir}/`, "-e", "stderr", "-c", `${dir}/nginx.conf`, "-g", `daemon off;${asRoot}`]);
+  let nginxLog = "";
+  nginx.stderr.on("data", (d) => (nginxLog += d));
+  let up = false;
+  for (let i = 0; i < 100 && !up; ++i) {
+    up = await fetch(`http://127.0.0.1:${edgePort}/healthz`).then((r) => r.status === 200, () => false);
+    if (!up) await new Promise((r) => setTimeout(r, 50));
+  }
+  check(up, `the edge's nginx did not serve /healthz: ${nginxLog}`);
+  if (up) {
+    const fog = await fetch(`http://127.0.0.1:${edgePort}/v1/fog`, {
+      method: "POST", headers: { "Content-Type": "application/json" },
+      body: JSON.stringify({ fog: { fogType: "GL_EXP2", density: 0.05 }, table: { size: 16 } }) });
+    check(fog.status === 200, `POST /v1/fog through the edge answered ${fog.status}`);
+    for (const path of ["/readyz", "/metrics", "/"]) {
+      const r = await fetch(`http://127.0.0.1:${edgePort}${path}`);
+      check(r.status === 404, `${path} through the edge answered ${r.status}, not 404`);
+    }
+  }
+  nginx.kill("SIGTERM");
+  rmSync(dir, { recursive: true, force: true });
 }
 server.kill("SIGTERM");
 const code = await exited;
@@ -99,4 +150,4 @@ if (failures.length) {
   console.error("deploy/k8s disagrees with the server:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`deploy/k8s ok: port ${port.containerPort}, probes /readyz /healthz, ${args.length - 1} flags, user ${user}, memory budget ${budgetMb} of ${limitMb} MiB`);
+console.log(`deploy/k8s ok: port ${port.containerPort} behind the edge on ${publicPort.containerPort}, probes /readyz /healthz on admin ${admin.containerPort}, ${args.length - 1} flags, user ${user}, memory budget ${budgetMb} of ${limitMb} MiB`);
