@@ -9,8 +9,10 @@ WORKDIR /src
 COPY scripts/setup.sh scripts/setup.sh
 RUN [ "$PREBUILT" = 1 ] || { scripts/setup.sh && rm -rf /var/lib/apt/lists/*; }
 COPY . .
+# setup.sh again now that the tree is here: it installs the playground's three.js (npm ci, pinned
+# and integrity-checked), which the build embeds.
 RUN if [ "$PREBUILT" = 1 ]; then install -D -m 755 build/image/effectd /build/server/effectd; \
-    else BUILD_DIR=/build scripts/build.sh -DEFFECTD_TESTS=OFF -DEFFECTD_BENCH=OFF; fi
+    else scripts/setup.sh && BUILD_DIR=/build scripts/build.sh -DEFFECTD_TESTS=OFF -DEFFECTD_BENCH=OFF; fi
 
 # Every package effectd's libraries come from (OpenImageIO alone pulls GDAL, OpenVDB,
 # FFmpeg ...): a complete system to collect the runtime from, and `--target full` for

@@ -39,12 +39,20 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#PACKAGES[@]} packages present"
-  exit 0
+else
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# three.js for the playground's live view, built into effectd and served from its own origin:
+# the version server/playground/vendor/package-lock.json pins, checked against its integrity
+# hash by npm ci. Without it effectd still builds, and the playground says its live view is off.
+vendor="$(cd "$(dirname "$0")/.." && pwd)/server/playground/vendor"
+if [ -d "$vendor" ] && [ ! -f "$vendor/node_modules/three/build/three.module.js" ]; then
+  (cd "$vendor" && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "setup: three.js not installed (npm ci failed in $vendor): the playground's live view will be off"
+fi

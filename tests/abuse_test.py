@@ -7,6 +7,8 @@ and prints what it measured; docs/reliability.md quotes these lines.
 
   trickle     headers, then a body, sent a byte at a time: 408 once --read-timeout has passed in
               all (not per read), and the connection closed
+  pipelining  requests back to back on one connection, one refused with its body unread: all
+              answered in order
   overload    2 x --max-connections trickling connections: a new connection gets 503 at once,
               the admin port answers /healthz, /readyz and /metrics
   drain       SIGTERM with a trickling client and a request being computed: the computed one is
@@ -131,6 +133,27 @@ def trickle(binary):
             check(status_of(t.answer) == 408 and b"request-timeout" in t.answer,
                   f"a request whose {name} trickle in gets 408 request-timeout")
             check(1.9 <= t.seconds <= 3.5, f"... once --read-timeout 2 has passed in all ({t.seconds:.2f} s)")
+    finally:
+        p.terminate()
+        p.wait()
+
+
+def pipelining(binary):
+    """Requests sent back to back on one connection, the first refused before its body was
+    read: each is answered in order, the refused one's body skipped, not taken for a request."""
+    p, port = effectd_process.start(binary, "--access-log", "0")
+    try:
+        s = socket.create_connection(("127.0.0.1", port))
+        s.sendall(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n"
+                  b"POST /v1/fog HTTP/1.1\r\nHost: x\r\nContent-Type: text/plain\r\nContent-Length: 2\r\n\r\n{}"
+                  b"GET /healthz HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
+        answer, closed, seconds = read_answer(s, 5)
+        s.close()
+        statuses = [int(line.split(b" ")[1]) for line in answer.split(b"\r\n") if line.startswith(b"HTTP/1.1 ")]
+        print(f"      three pipelined requests (the second refused with its body unread): {statuses} "
+              f"in {seconds * 1e3:.1f} ms")
+        check(statuses == [200, 415, 200] and closed and seconds < 1,
+              "pipelined requests are answered in order; a refused body is skipped")
     finally:
         p.terminate()
         p.wait()
@@ -385,7 +408,7 @@ def quota(binary):
 
 def main():
     binary = sys.argv[1]
-    for probe in (trickle, overload, drain, quota):
+    for probe in (trickle, pipelining, overload, drain, quota):
         print(f"-- {probe.__name__}", flush=True)
         probe(binary)
     if failures:

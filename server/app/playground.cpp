@@ -42,10 +42,18 @@ std::string examplesIndex() {
 
 }  // namespace
 
-void addPlayground(Service& service, const std::string& threeUrl) {
-  // The origin three.js comes from (scheme://host[:port]), for the page's script-src.
-  const size_t host = threeUrl.find("//") + 2, end = threeUrl.find('/', host);
-  const std::string threeOrigin = threeUrl.substr(0, end);
+void addPlayground(Service& service, const std::string& givenThree) {
+  // three.js from this origin (the built-in copy; a 404 without one, which the page reports),
+  // or from --playground-three, whose origin the page's script-src then names.
+  std::string threeUrl = givenThree, threeOrigin;
+  if (threeUrl.empty()) {
+    threeUrl = "/playground/three.module.js";
+    for (const auto& [name, text] : builtInThree())
+      service.addStatic("/playground/" + name, "text/javascript; charset=utf-8", std::string(text));
+  } else {
+    const size_t host = threeUrl.find("//") + 2, end = threeUrl.find('/', host);
+    threeOrigin = threeUrl.substr(0, end);
+  }
   for (const auto& [key, text] : playgroundResources()) {
     std::string name;
     if (key.rfind("server/playground/", 0) == 0) name = key.substr(std::string("server/playground/").size());

@@ -198,11 +198,13 @@ const std::vector<Option>& options() {
          return true;
        }},
       {"playground-three", "EFFECTD_PLAYGROUND_THREE",
-       "URL of three.js's ES module (three.module.js, r187) that the playground's live view imports; the browser "
-       "fetches it, so offline point it at a copy you serve (default https://unpkg.com/three@0.187.0/build/three.module.js)",
+       "URL of three.js's ES module (three.module.js, r187) for the playground's live view, instead of the copy "
+       "built in; the page imports it as a module, so its server must send Access-Control-Allow-Origin (default "
+       "none: the built-in copy, from this server's own origin)",
        [](const std::string& s, Config& c) {
-         // http(s), and nothing that could leave the JavaScript string or the CSP it is put in.
-         const bool scheme = s.rfind("https://", 0) == 0 || s.rfind("http://", 0) == 0;
+         // http(s) or "" (the built-in copy), and nothing that could leave the JavaScript string
+         // or the CSP it is put in.
+         const bool scheme = s.empty() || s.rfind("https://", 0) == 0 || s.rfind("http://", 0) == 0;
          if (!scheme || s.find_first_of(" \t\r\n'\"\\<>;`") != std::string::npos) return false;
          c.playgroundThree = s;
          return true;

@@ -49,8 +49,9 @@ struct Config {
   int keyMaxConcurrent = 8;              // an API key's requests in progress at once (per replica)
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
-  // three.js's ES module the playground's live view imports (it draws through clients/three/).
-  std::string playgroundThree = "https://unpkg.com/three@0.187.0/build/three.module.js";
+  // three.js's ES module the playground's live view imports (it draws through clients/three/);
+  // "" = the copy built into this binary, served at /playground/three.module.js.
+  std::string playgroundThree;
   Limits limits;
 };
 

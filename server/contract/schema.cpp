@@ -1,8 +1,8 @@
 #include "contract/schema.h"
 
+#include <charconv>
 #include <cmath>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 namespace effectd {
@@ -72,10 +72,12 @@ unsigned typeBitOf(const json& v) {
   }
 }
 
+// A schema's number as written: 16777216, 0.5, 1e-300 (the shortest text that reads back the
+// same double; iostream's default cut 16777216 to 1.67772e+07).
 std::string fmtNumber(const json& n) {
-  std::ostringstream os;
-  os << n.get<double>();
-  return os.str();
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, n.get<double>());
+  return ec == std::errc() ? std::string(buf, end) : n.dump();
 }
 
 // Counts UTF-8 code points (the JSON Schema notion of string length).

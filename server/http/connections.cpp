@@ -82,6 +82,7 @@ class DeadlineStream final : public httplib::Stream {
     timedOut_ = false;
   }
   bool timedOut() const { return timedOut_; }
+  bool buffered() const { return off_ < size_; }
 
   bool is_readable() const override { return off_ < size_ || waitReadable(); }
   bool is_writable() const override { return !timedOut_ && waitFor(sock_, POLLOUT, Clock::now() + writeTimeout_); }
@@ -186,10 +187,11 @@ bool EdgeServer::waitForRequest(socket_t sock) const {
 
 bool EdgeServer::process_and_close_socket(socket_t sock) {
   const auto writeTimeout = std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_);
-  bool refuse = false;
+  bool refuse = false, draining = false;
   {
     std::lock_guard lock(mu_);
-    refuse = draining_ || open_.size() >= maxConnections_;
+    draining = draining_;
+    refuse = draining || open_.size() >= maxConnections_;
     if (!refuse) open_.insert(sock);
   }
   if (refuse) {
@@ -198,8 +200,8 @@ bool EdgeServer::process_and_close_socket(socket_t sock) {
             rawProblem({503,
                         "overloaded",
                         "Service Unavailable",
-                        draining_ ? "the server is shutting down" : "the server holds all the connections it serves "
-                                                                    "at once (--max-connections)",
+                        draining ? "the server is shutting down" : "the server holds all the connections it serves "
+                                                                   "at once (--max-connections)",
                         {},
                         {{"Retry-After", "1"}, {"Cache-Control", "no-store"}}}),
             Clock::now() + writeTimeout);
@@ -210,7 +212,8 @@ bool EdgeServer::process_and_close_socket(socket_t sock) {
   DeadlineStream stream(sock, writeTimeout);
   const auto readTimeout = std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_);
   bool ok = false;
-  for (size_t left = keep_alive_max_count_; left > 0 && waitForRequest(sock); --left) {
+  // A request already read ahead into the stream's buffer (pipelined) needs no wait.
+  for (size_t left = keep_alive_max_count_; left > 0 && (stream.buffered() || waitForRequest(sock)); --left) {
     stream.startRequest(Clock::now() + std::chrono::duration_cast<Clock::duration>(readTimeout));
     bool closed = false;
     closeAfterAnswer_ = false;

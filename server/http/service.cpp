@@ -56,7 +56,8 @@ json parseBody(const std::string& body) {
 // listing them all.
 void throwIfInvalid(const std::vector<FieldError>& violations) {
   if (violations.empty()) return;
-  std::string detail = violations.front().pointer + ": " + violations.front().message;
+  const std::string& at = violations.front().pointer;
+  std::string detail = (at.empty() ? std::string("the request body") : at) + ": " + violations.front().message;
   if (violations.size() > 1) detail += " (and " + std::to_string(violations.size() - 1) + " more)";
   throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
 }

@@ -5,8 +5,9 @@
 //   the live view  the same request asking for what the WebGL2 view draws (timeline, table,
 //                  mesh and shader); the answer itself when it already has them
 // window.playground exposes the state and a run counter for the browser test.
+// The live view loads apart (it imports three.js): without it, everything else works and the
+// live pane says why it is empty.
 import { Schemas, SchemaForm } from './schema-form.js';
-import { LiveView } from './live-view.js';
 import { readGlb } from './glb.js';
 
 const EFFECTS = {
@@ -19,7 +20,21 @@ const EFFECTS = {
 const SIZE = 384;
 const $ = (id) => document.getElementById(id);
 const state = { effect: 'lightning', request: {}, glb: null, runs: 0, last: null };
-const view = new LiveView($('live'), { box: $('player'), play: $('play'), scrub: $('scrub'), clock: $('clock') });
+// The live view once three.js has loaded; until then, or when it cannot, a view that draws
+// nothing (and runLive asks for nothing).
+const NO_VIEW = { clear() {}, showLightning() {}, showFog() {}, showBubble() {}, showTangents() {} };
+let view = NO_VIEW;
+state.live = 'loading';
+const liveLoaded = import('./live-view.js').then(({ LiveView }) => {
+  view = new LiveView($('live'), { box: $('player'), play: $('play'), scrub: $('scrub'), clock: $('clock') });
+  state.live = 'ready';
+}, (err) => {
+  state.live = `unavailable: ${err.message || err}`;
+  $('live').hidden = true;
+  $('live-off').hidden = false;
+  $('live-off').textContent = `The live view is off: three.js did not load (${err.message || err}). It is built into ` +
+    'effectd by scripts/setup.sh (npm), or given with --playground-three URL. The preview, answer and form work without it.';
+});
 let examples = {}, schemas, form, timer = 0, inFlight = null;
 
 // ---- the small scenes the preview draws a single effect in ----
@@ -161,6 +176,8 @@ async function runPreview(signal) {
 async function runLive(answer, signal) {
   const effect = state.effect, req = state.request;
   $('live-note').textContent = '';
+  await liveLoaded;
+  if (view === NO_VIEW) return;  // nothing to draw with: no requests for it either
   if (effect === 'tangents') {
     if (!answer) return view.clear();
     if (state.glb) return view.showTangents(answer);

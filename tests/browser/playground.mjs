@@ -3,7 +3,9 @@
 // preview image, a live canvas that is not blank); changing eta re-requests and changes the
 // picture; an invalid value shows the server's problem at the field it names; a GLB upload
 // gets tangents; the shareable URL restores the request; "copy as curl" is a command that
-// works; --playground and the bind address turn the page off. A screenshot of each effect is
+// works; --playground and the bind address turn the page off; the page asks nothing of another
+// origin (three.js is built in), and with three.js unreachable everything but the live view
+// works and says why. A screenshot of each effect is
 // saved (PLAYGROUND_SCREENSHOTS, default $TMPDIR/effectd-playground); docs/playground/ holds
 // the ones README.md and docs/playground.md show.
 // Usage: node playground.mjs EFFECTD_BINARY [CHROMIUM]
@@ -12,7 +14,6 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchWebGl2Chromium } from './chromium.mjs';
-import { servePages } from './page_server.mjs';
 import { check, results, startEffectd } from '../node/effectd.mjs';
 
 const [binary, chromium = '/usr/bin/chromium'] = process.argv.slice(2);
@@ -30,16 +31,24 @@ for (const [args, expect] of [[[], 200], [['--playground', 'off'], 404], [['--ho
   p.kill();
 }
 
-// three.js for the live view from a local origin (the default is a CDN; this machine is offline).
-const three = await servePages('three.js for the playground', []);
-const { url: api, process: server } = await startEffectd(binary, ['--playground-three', `${three.origin}/nm/three/build/three.module.js`]);
+// The server as it is built: three.js from its own origin. The browser reaches nothing else
+// (every other origin's request is aborted), as on a machine behind a firewall.
+const { url: api, process: server } = await startEffectd(binary, []);
 const browser = await launchWebGl2Chromium(chromium);
-const problems = [];
+const problems = [], offOrigin = [];
 let renders = 0;
-async function open(url) {
+async function open(url, { quiet = [] } = {}) {
   const page = await browser.newPage();
   await page.setViewport({ width: 1400, height: 900 });
-  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warning') problems.push(`${m.type()}: ${m.text()}`); });
+  await page.setRequestInterception(true);
+  page.on('request', (r) => {
+    if (new URL(r.url()).origin === new URL(url).origin || r.url().startsWith('data:') || r.url().startsWith('blob:')) return r.continue();
+    offOrigin.push(r.url());
+    return r.abort('blockedbyclient');
+  });
+  page.on('console', (m) => {
+    if ((m.type() === 'error' || m.type() === 'warning') && !quiet.some((q) => q.test(m.text()))) problems.push(`${m.type()}: ${m.text()}`);
+  });
   page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   page.on('request', (r) => { if (r.url().endsWith('/v1/render')) renders++; });
   await page.goto(url);
@@ -218,10 +227,43 @@ try {
   fs.rmSync(glb);
 
   check(problems.length === 0, 'no console errors or warnings', problems);
+  check(offOrigin.length === 0, 'the page asks nothing of any other origin', offOrigin.slice(0, 5));
+  check((await page.evaluate(() => window.playground.state.live)) === 'ready', 'the live view loaded three.js from this server');
+  const csp = (await fetch(`${api}/`)).headers.get('content-security-policy');
+  check(/script-src 'self';/.test(csp), "the page's scripts come from its own origin only", csp);
 } finally {
   await browser.close();
   server.kill();
-  three.close();
+}
+
+// three.js unreachable (a URL on an origin the browser cannot reach): everything but the live
+// view works, and the live pane says why it is empty.
+{
+  const { url, process: p } = await startEffectd(binary, ['--playground-three', 'http://192.0.2.1/three.module.js']);
+  const offline = await launchWebGl2Chromium(chromium);
+  const before = problems.length;
+  try {
+    const page = await offline.newPage();
+    await page.setRequestInterception(true);
+    page.on('request', (r) => (new URL(r.url()).origin === new URL(url).origin ? r.continue() : r.abort('blockedbyclient')));
+    page.on('pageerror', (e) => problems.push(`page error without three.js: ${e.message}`));
+    await page.goto(`${url}/#fog/${Buffer.from(JSON.stringify({ fog: { fogType: 'GL_EXP2', density: 0.05 } })).toString('base64url')}`);
+    await page.waitForFunction(() => Number(document.body.dataset.runs || 0) > 0 && !document.body.dataset.busy, { timeout: 60000 });
+    const seen = await page.evaluate(() => ({
+      live: window.playground.state.live, last: window.playground.state.last,
+      note: document.getElementById('live-off').textContent, noteShown: !document.getElementById('live-off').hidden,
+      canvasHidden: document.getElementById('live').hidden, preview: document.getElementById('preview').naturalWidth,
+      examples: document.getElementById('example').options.length, fields: document.querySelectorAll('.field').length }));
+    check(seen.live.startsWith('unavailable') && seen.noteShown && seen.canvasHidden && /three\.js did not load/.test(seen.note),
+          'without three.js the live pane says why it is empty', seen);
+    check(seen.last && seen.last.status === 200 && seen.last.preview === 200 && seen.preview > 0 && seen.examples > 0 && seen.fields > 0,
+          'without three.js the answer, preview, examples and form work', seen);
+    check(problems.length === before, 'without three.js no page errors', problems.slice(before));
+    await page.screenshot({ path: path.join(shots, 'no-three.png') });
+  } finally {
+    await offline.close();
+    p.kill();
+  }
 }
 console.log(`screenshots in ${shots}`);
 process.exit(results.failures ? 1 : 0);
