@@ -333,9 +333,13 @@ function setEffect(effect, request, exampleName) {
   state.request = request;
   state.glb = null;
   for (const b of $('effects').children) b.setAttribute('aria-pressed', String(b.dataset.effect === effect));
-  const select = $('example');
-  select.replaceChildren(...(examples[effect] || []).map((e) => Object.assign(document.createElement('option'), { textContent: e.name, value: e.name })));
-  select.value = exampleName || '';
+  // The example the request is (a link's request may be one), else a first entry saying so.
+  const select = $('example'), list = examples[effect] || [];
+  const name = exampleName || (list.find((e) => JSON.stringify(e.request) === JSON.stringify(request)) || {}).name;
+  const options = list.map((e) => Object.assign(document.createElement('option'), { textContent: e.name, value: e.name }));
+  if (!name) options.unshift(Object.assign(document.createElement('option'), { textContent: '(your request)', value: '', disabled: true }));
+  select.replaceChildren(...options);
+  select.value = name || '';
   $('endpoint').textContent = `POST ${EFFECTS[effect].endpoint}`;
   $('upload').hidden = effect !== 'tangents';
   $('glb').value = '';

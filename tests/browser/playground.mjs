@@ -244,6 +244,7 @@ try {
   const before = problems.length;
   try {
     const page = await offline.newPage();
+    await page.setViewport({ width: 1400, height: 900 });
     await page.setRequestInterception(true);
     page.on('request', (r) => (new URL(r.url()).origin === new URL(url).origin ? r.continue() : r.abort('blockedbyclient')));
     page.on('pageerror', (e) => problems.push(`page error without three.js: ${e.message}`));
@@ -253,12 +254,14 @@ try {
       live: window.playground.state.live, last: window.playground.state.last,
       note: document.getElementById('live-off').textContent, noteShown: !document.getElementById('live-off').hidden,
       canvasHidden: document.getElementById('live').hidden, preview: document.getElementById('preview').naturalWidth,
-      examples: document.getElementById('example').options.length, fields: document.querySelectorAll('.field').length }));
+      examples: document.getElementById('example').options.length, fields: document.querySelectorAll('.field').length,
+      example: document.getElementById('example').selectedOptions[0]?.textContent }));
     check(seen.live.startsWith('unavailable') && seen.noteShown && seen.canvasHidden && /three\.js did not load/.test(seen.note),
           'without three.js the live pane says why it is empty', seen);
     check(seen.last && seen.last.status === 200 && seen.last.preview === 200 && seen.preview > 0 && seen.examples > 0 && seen.fields > 0,
           'without three.js the answer, preview, examples and form work', seen);
     check(problems.length === before, 'without three.js no page errors', problems.slice(before));
+    check(seen.example === '(your request)', "a link's request that is no example says so in the example list", seen.example);
     await page.screenshot({ path: path.join(shots, 'no-three.png') });
   } finally {
     await offline.close();
