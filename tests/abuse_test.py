@@ -207,6 +207,15 @@ def overload(binary):
         p.wait()
 
 
+def terminate_after(p, pause):
+    """SIGTERM to `p` after `pause` seconds: its exit status and how long it took to exit."""
+    time.sleep(pause)
+    t0 = time.monotonic()
+    p.send_signal(signal.SIGTERM)
+    code = p.wait(30)
+    return code, time.monotonic() - t0
+
+
 def drain(binary):
     p, port = effectd_process.start(binary, "--read-timeout", "60", "--shutdown-grace", "20", "--access-log", "0")
     slow = Trickler(port, b"GET /healthz HTTP/1.1\r\nHost: x\r\n" + b"X-Slow: a\r\n" * 100, 2.0)
@@ -215,11 +224,7 @@ def drain(binary):
     computing = threading.Thread(target=lambda: result.update(
         answer=request(port, "POST", "/v1/lightning", SLOW, {"Content-Type": "application/json"}, 60)))
     computing.start()
-    time.sleep(0.5)
-    t0 = time.monotonic()
-    p.send_signal(signal.SIGTERM)
-    code = p.wait(30)
-    exited = time.monotonic() - t0
+    code, exited = terminate_after(p, 0.5)
     computing.join(5)
     slow.join(5)
     print(f"      SIGTERM: exit {code} after {exited:.2f} s; the computed request "
@@ -229,19 +234,15 @@ def drain(binary):
     check(slow.closed and slow.seconds is not None and slow.seconds < 5, "... the trickler is closed, not waited for")
 
     p, port = effectd_process.start(binary, "--shutdown-grace", "1", "--access-log", "0")
+
     def late():
         try:
             request(port, "POST", "/v1/lightning", SLOW, {"Content-Type": "application/json"}, 60)
         except OSError:
             pass  # the process is gone: that is the point
 
-    computing = threading.Thread(target=late, daemon=True)
-    computing.start()
-    time.sleep(0.3)
-    t0 = time.monotonic()
-    p.send_signal(signal.SIGTERM)
-    code = p.wait(30)
-    exited = time.monotonic() - t0
+    threading.Thread(target=late, daemon=True).start()
+    code, exited = terminate_after(p, 0.3)
     print(f"      SIGTERM with --shutdown-grace 1 and a longer request: exit {code} after {exited:.2f} s")
     check(code == 1 and exited < 3, "past --shutdown-grace the process exits anyway (status 1)")
 
