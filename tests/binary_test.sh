@@ -15,7 +15,9 @@ if "$bin" --port nope 2>/dev/null; then echo "bad flag accepted"; exit 1; fi
 # --heavy-threads 8: the eight slow requests below all run at once, as this test intends
 # (by default dbm bolts queue for cores - 1 heavy slots; under ASan a queued one would wait
 # past --admission-timeout-ms and get 503 before it could be in flight at SIGTERM).
-EFFECTD_THREADS=2 "$bin" --host 127.0.0.1 --port 0 --heavy-threads 8 2>"$log" &
+# --shutdown-grace 600: the in-flight requests finish after SIGTERM also under the sanitizers
+# (past the default 20 s the process would exit without them).
+EFFECTD_THREADS=2 "$bin" --host 127.0.0.1 --port 0 --heavy-threads 8 --shutdown-grace 600 2>"$log" &
 pid=$!
 wait_for_port "$log"
 grep -q '"threads":2' "$log" || { echo "EFFECTD_THREADS ignored"; cat "$log"; exit 1; }
