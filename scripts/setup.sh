@@ -18,6 +18,7 @@ PACKAGES=(
   wrk nginx-light    # scripts/load.sh and the deploy/nginx test (two replicas behind a cache)
   redis-server       # deploy/replicas: API key quotas shared by replicas (--quota-redis)
   godot3-server      # clients/godot: the addon run headless in Godot 3 against a server (tests/godot/)
+  godot3 xvfb xauth  # clients/godot: the addon's shaders drawn by Godot 3 on llvmpipe (tests/godot/)
   mono-mcs mono-runtime  # the C API from C# through P/Invoke, as Unity calls native code (tests/capi/)
   assimp-testmodels  # test data: real models (OBJ/glTF) for the tangent oracle tests
   blender            # the second tangent oracle: Blender's own MikkTSpace (tests/mikktspace/blender_oracle.py)

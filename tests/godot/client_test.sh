@@ -1,17 +1,26 @@
 #!/usr/bin/env bash
-# The Godot addon (clients/godot/addons/effectd) in Godot 3's headless runtime against a server
-# this script starts: clients/godot/tests/run.gd asks for a bolt, fog tables and a bubble, checks
-# the ArrayMesh and ImageTexture it builds against the JSON, and that a 400 reaches the game
-# with the field's pointer. Skips (77) where godot3-server is not installed (scripts/setup.sh
-# installs it).
-#   client_test.sh EFFECTD_BINARY
+# The Godot addon (clients/godot/addons/effectd) against a server this script starts.
+#   client_test.sh EFFECTD_BINARY: in Godot 3's headless runtime (godot3-server),
+#     clients/godot/tests/run.gd asks for a bolt, fog tables and a bubble, checks the ArrayMesh
+#     and ImageTexture it builds against the JSON, that a 400 reaches the game with the field's
+#     pointer, and runs the README's snippet.
+#   client_test.sh EFFECTD_BINARY render: in Godot 3 itself (godot3, GLES3 on Mesa's llvmpipe
+#     under Xvfb), clients/godot/tests/render.gd draws the addon's shaders (the strike, the
+#     film, the fog) and checks the pictures.
+# Skips (77) where the Godot it needs is not installed (scripts/setup.sh installs both).
 set -euo pipefail
 # shellcheck source=/dev/null
 source "$(dirname "$0")/../listen.sh"
 bin=$1
 root=$(cd "$(dirname "$0")/../.." && pwd)
-godot=$(command -v godot3-server || true)
-[ -n "$godot" ] || { echo "SKIP godot3-server not installed (apt install godot3-server)"; exit 77; }
+mode=${2:-client}
+if [ "$mode" = render ]; then
+  godot=$(command -v godot3 || true)
+  [ -n "$godot" ] && command -v xvfb-run >/dev/null || { echo "SKIP godot3 or xvfb-run not installed (apt install godot3 xvfb)"; exit 77; }
+else
+  godot=$(command -v godot3-server || true)
+  [ -n "$godot" ] || { echo "SKIP godot3-server not installed (apt install godot3-server)"; exit 77; }
+fi
 work=$(mktemp -d /tmp/effectd-godot.XXXXXX)
 pid=""
 cleanup() { [ -n "$pid" ] && kill "$pid" 2>/dev/null; wait 2>/dev/null || true; rm -rf "$work"; }
@@ -24,7 +33,14 @@ wait_for_port "$work/log"
 cp -r "$root/clients/godot" "$work/project"
 awk '/^```gdscript/{on=1; next} /^```/{if (on) exit} on' "$root/clients/godot/README.md" |
   sed "s#http://127.0.0.1:8080#http://127.0.0.1:$port#" >"$work/project/tests/readme_snippet.gd"
-grep -q "bolt_mesh" "$work/project/tests/readme_snippet.gd" || { echo "FAIL no snippet in the README"; exit 1; }
-# Godot writes its user data under HOME; the locale warnings of a C locale are noise.
-HOME="$work" LANG=C.UTF-8 timeout 120 "$godot" --path "$work/project" -s res://tests/run.gd \
-  --effectd="http://127.0.0.1:$port" 2>&1 | grep -v -e "Unsupported locale" -e "core/translation.cpp"
+grep -q "EffectdClient.bolt(" "$work/project/tests/readme_snippet.gd" || { echo "FAIL no snippet in the README"; exit 1; }
+# Godot writes its user data under HOME; the locale warnings of a C locale are noise. The exit
+# status is Godot's (pipefail).
+quiet() { grep -v -e "Unsupported locale" -e "core/translation.cpp" -e "Invalid locale"; }
+if [ "$mode" = render ]; then
+  HOME="$work" LANG=C.UTF-8 timeout 150 xvfb-run -a -s "-screen 0 640x480x24" "$godot" --path "$work/project" \
+    -s res://tests/render.gd --resolution 256x256 --effectd="http://127.0.0.1:$port" 2>&1 | quiet
+else
+  HOME="$work" LANG=C.UTF-8 timeout 120 "$godot" --path "$work/project" -s res://tests/run.gd \
+    --effectd="http://127.0.0.1:$port" 2>&1 | quiet
+fi
