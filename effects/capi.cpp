@@ -657,8 +657,10 @@ effects_status effects_bubble_shader(int core330, char** vertex, char** fragment
     if (vertex) *vertex = nullptr;
     if (fragment) *fragment = nullptr;
     if (!vertex || !fragment) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "vertex or fragment is NULL");
-    const auto src = effects::bubble::shader(effects::bubble::Features{},
-                                             core330 ? effects::bubble::Glsl::kCore330 : effects::bubble::Glsl::kEs300);
+    effects::bubble::Features paper;
+    paper.shading = effects::bubble::Shading::kPaper;  // the model effects_bubble_shader_uniforms_at feeds
+    const auto src =
+        effects::bubble::shader(paper, core330 ? effects::bubble::Glsl::kCore330 : effects::bubble::Glsl::kEs300);
     char* v = copyString(src.vertex);
     try {
       *fragment = copyString(src.fragment);
@@ -667,6 +669,32 @@ effects_status effects_bubble_shader(int core330, char** vertex, char** fragment
       throw;
     }
     *vertex = v;
+    return EFFECTS_OK;
+  });
+}
+
+effects_status effects_bubble_shader_uniforms_at(const effects_bubble_params* c, double t,
+                                                 effects_bubble_shader_uniforms* out, effects_error** error) {
+  return guarded(error, [&] {
+    namespace bb = effects::bubble;
+    if (!out) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "out is NULL");
+    if (!sized(out->size, sizeof(effects_bubble_shader_uniforms)))
+      return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_bubble_shader_uniforms)");
+    bb::Params p;
+    bb::MeshOptions o;
+    if (effects_status s = toBubble(c, p, o, error)) return s;
+    if (!std::isfinite(t)) return fail(error, EFFECTS_INVALID_ARGUMENT, "/time", "must be finite");
+    const bb::Film mu = bb::film(p, t);
+    const bb::WobbleShape wobble = bb::wobbleInObject(p, o.radius);
+    out->wobble_phase = bb::reducedPhase(p.deltaSpeed, t);
+    out->wobble_amplitude = wobble.amplitude;
+    out->wobble_frequency = wobble.frequency;
+    out->film_top = mu.top;
+    out->film_bottom = mu.bottom;
+    out->eta = p.n1 / p.n2;
+    out->flow_phase = bb::reducedPhase(p.betaSpeed, t);
+    out->rim_power = p.rimPower;
+    for (int i = 0; i < 4; ++i) out->base_color[i] = bb::kBaseColor[i];
     return EFFECTS_OK;
   });
 }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "deep_field.h"
 #include "grid.h"
@@ -28,11 +29,13 @@ const char* toString(Method m) {
 const char* toString(Solver s) { return s == Solver::kCg ? "cg" : s == Solver::kCapacitance ? "capacitance" : "mgpcg"; }
 
 std::optional<Error> validate(const Params& p) {
-  if (p.width < 3 || p.height < 3) return invalid("/grid", "width and height must be >= 3");
-  if (p.width > 65536 || p.height > 65536) return overLimit("/grid", "width and height must be <= 65536");
+  // Each side named as the HTTP API names it (its schema's bounds).
+  for (const auto& [side, pointer] : {std::pair{p.width, "/grid/width"}, std::pair{p.height, "/grid/height"}}) {
+    if (side < 3) return invalid(pointer, "must be >= 3");
+    if (side > 65536) return overLimit(pointer, "must be <= 65536");
+    if (p.depth && side > 4096) return overLimit(pointer, "must be <= 4096 in a 3-D grid");
+  }
   if (p.depth != 0 && (p.depth < 3 || p.depth > 4096)) return invalid("/grid/depth", "must be 0 (2-D) or in [3, 4096]");
-  if (p.depth && (p.width > 4096 || p.height > 4096))
-    return overLimit("/grid", "a 3-D grid's width and height must be <= 4096");
   const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
   if (!p.obstacles.empty() && p.obstacles.size() != cells)
     return invalid("/obstacles", p.depth ? "must have width*height*depth cells" : "must have width*height cells");

@@ -214,7 +214,9 @@ static void test_bolt(void) {
   effects_bolt_params_defaults(&p);
   p.targets = target, p.target_count = 1;
   p.width = -5;
-  expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/grid", "a negative width");
+  expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/grid/width", "a negative width (HTTP's name)");
+  p.width = 48, p.height = 1;
+  expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/grid/height", "height 1 (HTTP's name)");
   p.width = p.height = 48;
   p.targets = NULL;
   expect_error(effects_bolt_grow(&p, &bolt, &e), &e, EFFECTS_INVALID_ARGUMENT, "/targets", "NULL targets with a count");
@@ -279,6 +281,41 @@ static void test_bubble(void) {
   CHECK(fabs(flow[0] * flow[0] + flow[1] * flow[1] - 1) < 1e-9, "flow offset (sin, cos)");
   CHECK(effects_bubble_shader(0, &vertex, &fragment, &e) == EFFECTS_OK, "shaders");
   CHECK(strstr(vertex, "#version 300 es") && strstr(fragment, "void main"), "GLSL ES text");
+  /* The shader handed out is one the C API can feed: each uniform it declares is the client's
+   * own or one effects_bubble_shader_uniforms_at gives. */
+  {
+    static const char* const fed[] = {"uModel", "uViewProjection", "uCameraPosition", "uEnvironment", "uFlowTexture",
+                                      "uWobblePhase", "uWobbleAmplitude", "uWobbleFrequency", "uFilmTop", "uFilmBottom",
+                                      "uEta", "uFlowPhase", "uRimPower", "uBaseColor"};
+    const char* stages[2] = {vertex, fragment};
+    int declared = 0, s2;
+    for (s2 = 0; s2 < 2; ++s2) {
+      const char* at = stages[s2];
+      while ((at = strstr(at, "\nuniform ")) != NULL) {
+        char type[32], name[64];
+        size_t k, known = 0;
+        CHECK(sscanf(at + 9, "%31s %63[A-Za-z0-9_]", type, name) == 2, "a uniform declaration");
+        for (k = 0; k < sizeof fed / sizeof fed[0]; ++k) known |= strcmp(name, fed[k]) == 0;
+        if (!known) fprintf(stderr, "uniform %s: nothing in the C API feeds it\n", name);
+        CHECK(known, "every uniform of effects_bubble_shader is fed");
+        ++declared, ++at;
+      }
+    }
+    CHECK(declared >= 10, "the paper model's uniforms found");
+  }
+  {
+    effects_bubble_shader_uniforms u;
+    memset(&u, 0, sizeof u);
+    u.size = sizeof u;
+    CHECK(effects_bubble_shader_uniforms_at(&p, 1e9, &u, &e) == EFFECTS_OK, "the shader's uniforms at t = 1e9");
+    CHECK(u.wobble_phase >= 0 && u.wobble_phase < 6.283185307179587 && u.flow_phase >= 0 && u.flow_phase < 6.283185307179587,
+          "phases reduced to [0, 2 pi)");
+    CHECK(fabs(u.eta - p.n1 / p.n2) < 1e-15 && u.rim_power == p.rim_power && u.base_color[3] == 1, "eta, rim, base colour");
+    u.size = 8;
+    expect_error(effects_bubble_shader_uniforms_at(&p, 0, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/size", "a wrong size");
+    u.size = sizeof u;
+    expect_error(effects_bubble_shader_uniforms_at(&p, INFINITY, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/time", "time inf");
+  }
   effects_string_free(vertex);
   effects_string_free(fragment);
   p.level = 40;

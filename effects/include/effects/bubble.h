@@ -165,6 +165,8 @@ Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 //   kPaper: seed 000's eqns 3-10 (final vector lookup, rim alpha, texture flow), straight alpha
 //     blended with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA); iridescence adds the table's colour.
 enum class Shading { kFilm, kPaper };
+// The paper model's colour and alpha without any feature (its uBaseColor).
+inline const glm::dvec4 kBaseColor{1, 1, 1, 1};
 inline constexpr int kMaxLights = 4;
 struct Features {
   // The paper model's.

@@ -281,9 +281,35 @@ const uint32_t* effects_bubble_mesh_indices(const effects_bubble_mesh* mesh);
 effects_status effects_bubble_uniforms(const effects_bubble_params* params, double t, double* film_top,
                                        double* film_bottom, double flow_offset[2], effects_error** error);
 
-/* The shaders (GLSL ES 3.00 when core330 is 0, else 3.30 core) for every feature on, the film
- * model: vertex and fragment text, each freed with effects_string_free. */
+/* The shaders of seed 000's model (the paper's: reflection, refraction, rim, texture flow and
+ * wobble; /v1/bubble's shading "paper" with its default features), GLSL ES 3.00 when core330 is
+ * 0, else 3.30 core: vertex and fragment text, each freed with effects_string_free. Attributes
+ * aPosition, aNormal, aUv at locations 0, 1, 2 (effects_bubble_mesh_*). Its uniforms are the
+ * client's own (uModel, uViewProjection, uCameraPosition, uEnvironment: the sky as a cube map,
+ * uFlowTexture: the flow texture, repeating) and those effects_bubble_shader_uniforms_at
+ * gives. Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT ("") when vertex or fragment is NULL. */
 effects_status effects_bubble_shader(int core330, char** vertex, char** fragment, effects_error** error);
+
+/* The values effects_bubble_shader's uniforms take at time t, named as the shader names them
+ * (the values /v1/bubble answers with shading "paper"); phases are reduced modulo 2 pi in
+ * extended precision, so t = 1e9 s keeps its digits. The wobble is in object units for a mesh
+ * of params->radius. */
+typedef struct effects_bubble_shader_uniforms {
+  size_t size;                 /* sizeof(effects_bubble_shader_uniforms), set by the caller */
+  double wobble_phase;         /* uWobblePhase: delta_speed t mod 2 pi (eqn 11) */
+  double wobble_amplitude;     /* uWobbleAmplitude */
+  double wobble_frequency;     /* uWobbleFrequency, radians per object unit */
+  double film_top, film_bottom; /* uFilmTop, uFilmBottom (eqn 3) */
+  double eta;                  /* uEta: n1 / n2 (eqn 5) */
+  double flow_phase;           /* uFlowPhase: beta_speed t mod 2 pi (eqn 9) */
+  double rim_power;            /* uRimPower (eqn 10) */
+  double base_color[4];        /* uBaseColor: colour and alpha without any feature */
+} effects_bubble_shader_uniforms;
+/* Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT naming the parameter (params as for
+ * effects_bubble_mesh_make, "/time" when t is not finite, "/size" when out->size is not
+ * sizeof(effects_bubble_shader_uniforms), "" when out is NULL). */
+effects_status effects_bubble_shader_uniforms_at(const effects_bubble_params* params, double t,
+                                                 effects_bubble_shader_uniforms* out, effects_error** error);
 
 #ifdef __cplusplus
 }

@@ -154,7 +154,7 @@ struct Bubble {
   std::shared_ptr<const bubble::Mesh> mesh;  // shared by the scenes that use the same sphere
   glm::dvec3 center{0, 0, 0};
   double time = 0;  // seconds (eqns 3, 9, 11)
-  glm::dvec4 baseColor{1, 1, 1, 1};
+  glm::dvec4 baseColor = bubble::kBaseColor;
   double radius = 1;  // of the mesh, object units (the wobble's unit)
   std::shared_ptr<const bubble::ThinFilmTable> thinFilm;  // film model, or iridescence (shared)
   glm::dvec2 thinFilmRangeNm{0, 1000};  // thickness at the table's first and last column
