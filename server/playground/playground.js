@@ -39,7 +39,9 @@ let examples = {}, schemas, form, timer = 0, inFlight = null;
 
 // ---- the small scenes the preview draws a single effect in ----
 
-// Example 02's corridor: quads at many distances, so the fog shows depth.
+// Example 02's corridor: quads at many distances, so the fog shows depth. Its far end is 56
+// units from FOG_CAMERA; fogStage scales it about the camera to the table's range.
+const FOG_CAMERA = { position: [0, 1.2, 6], target: [0, 1, -10], fovY: 60 };
 const FOG_STAGE = [
   { center: [0, 0, -20], normal: [0, 1, 0], up: [0, 0, -1], size: [8, 60], color: [0.35, 0.3, 0.25] },
   { center: [-4, 2, -20], normal: [1, 0, 0], size: [60, 4], up: [0, 1, 0], color: [0.6, 0.25, 0.2] },
@@ -48,6 +50,14 @@ const FOG_STAGE = [
   { center: [-1.5, 1.5, -12], size: [1.2, 1.2], color: [0.9, 0.8, 0.2] },
   { center: [1.5, 1.5, -30], size: [1.2, 1.2], color: [0.9, 0.8, 0.2] },
 ];
+// The stage scaled about the camera so that its far end lies at the request's table.range[1]
+// (the distances the table says the scene spans): the same picture, with the fog the request's
+// own distances give. Without a range, as it stands.
+function fogStage(req) {
+  const far = req.table && Array.isArray(req.table.range) ? Number(req.table.range[1]) : NaN;
+  const s = far > 0 && Number.isFinite(far) ? far / 56 : 1, eye = FOG_CAMERA.position;
+  return FOG_STAGE.map((q) => ({ ...q, center: q.center.map((c, i) => eye[i] + (c - eye[i]) * s), size: q.size.map((v) => v * s) }));
+}
 // /v1/render's camera where a scene names none (scene.json's defaults).
 const DEFAULT_CAMERA = { position: [0, 1, 6], target: [0, 0.5, 0], fovY: 45 };
 const NIGHT = { gradient: { top: [0.03, 0.03, 0.08], bottom: [0.12, 0.12, 0.2] } };
@@ -59,8 +69,8 @@ function previewScene(effect, req, animate) {
     case 'lightning':
       return { width: SIZE, height: SIZE, background: NIGHT, lightning: req, frames: frames(24) };
     case 'fog':
-      return { width: SIZE, height: SIZE, camera: { position: [0, 1.2, 6], target: [0, 1, -10], fovY: 60 },
-               background: { color: (req.fog && req.fog.color) || [0.55, 0.6, 0.68] }, quads: FOG_STAGE, fog: req };
+      return { width: SIZE, height: SIZE, camera: FOG_CAMERA,
+               background: { color: (req.fog && req.fog.color) || [0.55, 0.6, 0.68] }, quads: fogStage(req), fog: req };
     case 'bubble': {
       const { camera, format, ...bubble } = req;  // the scene's camera draws it
       return { width: SIZE, height: SIZE, camera: { position: [0, 0.3, 4], target: [0, 0, 0], fovY: 45 },

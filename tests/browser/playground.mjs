@@ -88,7 +88,7 @@ const liveAgainstPreview = (page) => page.evaluate(() => {
   for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; ++k) sum += Math.abs(a[i + k] - b[i + k]);
   return sum / (128 * 128 * 3);
 });
-// The preview image's size and a hash of its pixels.
+// The preview image's size, a hash of its pixels and the colour near its centre.
 const previewBytes = (page) => page.evaluate(() => {
   const img = document.getElementById('preview');
   if (img.hidden || !img.src || !img.naturalWidth) return null;
@@ -97,12 +97,19 @@ const previewBytes = (page) => page.evaluate(() => {
   const d = g.getImageData(0, 0, img.naturalWidth, img.naturalHeight).data;
   let h = 0;
   for (let i = 0; i < d.length; ++i) h = (h * 31 + d[i]) | 0;
-  return { hash: h, width: img.naturalWidth };
+  const c = 4 * (img.naturalWidth * Math.floor(img.naturalHeight * 0.45) + Math.floor(img.naturalWidth / 2));
+  return { hash: h, width: img.naturalWidth, centre: [d[c], d[c + 1], d[c + 2]] };  // centre: a little above the middle
 });
 
 try {
   const page = await open(`${api}/`);
   await settled(page, 0);
+  // At 1280 px the header is one row: the copy buttons sit beside the title.
+  await page.setViewport({ width: 1280, height: 800 });
+  const rows = await page.evaluate(() => ['h1', '#copy-curl', '#copy-answer-url'].map((q) => document.querySelector(q).getBoundingClientRect())
+    .map((r) => Math.round(r.top + r.height / 2)));
+  check(Math.max(...rows) - Math.min(...rows) < 8, 'at 1280 px the header is one row (title, copy buttons)', rows);
+  await page.setViewport({ width: 1400, height: 900 });
   const examples = await page.evaluate(() => fetch('/playground/examples.json').then((r) => r.json()));
   const effects = await page.$$eval('#effects button', (bs) => bs.map((b) => b.dataset.effect));
   check(effects.join() === 'lightning,fog,bubble,tangents,scene', 'every effect can be chosen', effects);
@@ -126,6 +133,13 @@ try {
       check(last.status === 200 && !last.error && (!wantPreview || (last.preview === 200 && preview && preview.width > 0)) &&
             live.lit > 20,
             `${effect} ${name}: answer, preview and live view`, { last, preview, live });
+      // A fog preview's stage lies within the request's table.range: the paper's worked example
+      // (range 0-16, fog nearly complete at 6) shows its near yellow quad at the centre, where a
+      // stage 3.5 times deeper than the range once showed almost uniform grey (saturation 14).
+      if (effect === 'fog' && name.startsWith('01-')) {
+        const [r, g, b] = preview ? preview.centre : [0, 0, 0];
+        check(Math.max(r, g, b) - Math.min(r, g, b) > 60, `${effect} ${name}: the near quad shows through the fog`, preview);
+      }
       const regions = effect === 'fog' && (await page.evaluate(() => (window.playground.state.request.regions || []).length));
       if (effect === 'fog' && !regions) {  // the live view draws the global fog's table only
         const apart = await liveAgainstPreview(page);
