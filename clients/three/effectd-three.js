@@ -26,7 +26,7 @@ const bytesOf = (base64) => Uint8Array.from(atob(base64), (c) => c.charCodeAt(0)
 const BOLT_VS = `
 attribute float _leader;
 attribute float _stroke_delay;
-attribute vec3 _across;  // from the ribbon's middle to this edge (the kit adds it)
+attribute vec3 _across;  // from the ribbon's middle to this edge, without the join's mitre (the kit adds it)
 uniform float uWiden;    // 1: the core; more: the glow around it
 uniform sampler2D uKeys;
 uniform int uKeyCount;
@@ -72,11 +72,18 @@ void main() {
 }`;
 
 // Each vertex's offset from its ribbon's middle: the ribbons' vertices come in pairs (2k, 2k + 1),
-// the two edges at one polyline vertex (server/api/bolt_ribbons.cpp).
+// the two edges at one polyline vertex (server/api/bolt_ribbons.cpp). A sharp join's offset is
+// mitred (up to twice the half width); cut back to the ribbon's median half width, the glow
+// `width` times as wide does not grow the mitre's point `width` times as long.
 function acrossAttribute(geometry) {
-  const p = geometry.attributes.position, out = new Float32Array(p.count * 3);
-  for (let i = 0; i < p.count; ++i)
+  const p = geometry.attributes.position, out = new Float32Array(p.count * 3), lengths = new Float32Array(p.count);
+  for (let i = 0; i < p.count; ++i) {
     for (let k = 0; k < 3; ++k) out[3 * i + k] = 0.5 * (p.getComponent(i, k) - p.getComponent(i ^ 1, k));
+    lengths[i] = Math.hypot(out[3 * i], out[3 * i + 1], out[3 * i + 2]);
+  }
+  const half = [...lengths].sort((a, b) => a - b)[p.count >> 1] || 0;
+  for (let i = 0; i < p.count; ++i)
+    if (lengths[i] > half) for (let k = 0; k < 3; ++k) out[3 * i + k] *= half / lengths[i];
   geometry.setAttribute('_across', new THREE.BufferAttribute(out, 3));
 }
 

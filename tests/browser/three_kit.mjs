@@ -89,10 +89,27 @@ try {
     boltScene.add(fromGltf.object);
     const a = frame(boltScene, flatCamera);
     boltScene.remove(fromGltf.object);
-    const fromJson = kit.boltFromAnswer(await (await post('/v1/lightning', { ...bolt, include: ['mesh'] })).json());
+    const boltJson = await (await post('/v1/lightning', { ...bolt, include: ['mesh'] })).json();
+    const fromJson = kit.boltFromAnswer(boltJson);
     boltScene.add(fromJson.object);
     const b = frame(boltScene, flatCamera);
     boltScene.remove(fromJson.object);
+    // The glow 6 times as wide: no lit pixel farther from the core's than the glow's half width
+    // (6 cells: the main ribbon is 2 wide), where mitred joins pushed 6 times outward once made
+    // points twice as long.
+    const glowing = kit.boltFromAnswer(boltJson, { glow: { width: 6, strength: 1 } });
+    boltScene.add(glowing.object);
+    const glowLit = litMask(frame(boltScene, flatCamera), size), coreLit = litMask(b, size);
+    boltScene.remove(glowing.object);
+    const cores = [];
+    for (let i = 0; i < size * size; ++i) if (coreLit[i]) cores.push([i % size, Math.floor(i / size)]);
+    let farthest = 0;
+    for (let i = 0; i < size * size; ++i)
+      if (glowLit[i]) {
+        const x = i % size, y = Math.floor(i / size);
+        farthest = Math.max(farthest, Math.min(...cores.map(([u, v]) => Math.hypot(u - x, v - y))));
+      }
+    out.glow = { farthestCells: farthest / (size / 64), lit: glowLit.filter(Boolean).length, core: cores.length };
     out.boltSame = compare(a, b, null);
     const p = await preview({ background: { color: [...dark, 1] }, lightning: bolt, lightningStyle: { coreWidth: size / 64, glowSigma: 0 } });
     const lit = (px) => litMask(px, size);
@@ -204,6 +221,8 @@ try {
   check(r.boltSame.mean === 0, `the bolt's GLB and its JSON mesh draw the same frame through the kit (mean difference ${r.boltSame.mean})`, r.boltSame);
   check(r.boltRecall >= 0.9 && r.boltPrecision >= 0.9, `the kit's bolt lights ${(100 * r.boltRecall).toFixed(1)} % of the preview's lit pixels ` +
         `and the preview ${(100 * r.boltPrecision).toFixed(1)} % of the kit's, within a pixel (≥ 90 %)`);
+  check(r.glow.lit > 2 * r.glow.core && r.glow.farthestCells <= 6, `a glow 6 times as wide stays within 6 cells of the core ` +
+        `(farthest lit pixel ${r.glow.farthestCells.toFixed(2)} cells; ${r.glow.lit} pixels lit, the core ${r.glow.core})`, r.glow);
   check(r.strike.before === 0 && r.strike.stroke >= 0.5 * r.strike.whole && r.strike.after === 0,
         `setTime plays the strike: lit share ${r.strike.before} before the leader, ${r.strike.stroke.toFixed(4)} at the first stroke ` +
         `(the whole bolt ${r.strike.whole.toFixed(4)}), ${r.strike.after} after the end`, r.strike);
