@@ -29,11 +29,14 @@ trap cleanup EXIT
 "$bin" --port 0 --access-log 0 2>"$work/log" &
 pid=$!
 wait_for_port "$work/log"
-# A copy of the project with clients/godot/README.md's snippet in it, pointed at this server.
+# A copy of the project with clients/godot/README.md's snippets in it (each gdscript block,
+# tests/readme_snippet_<n>.gd), pointed at this server.
 cp -r "$root/clients/godot" "$work/project"
-awk '/^```gdscript/{on=1; next} /^```/{if (on) exit} on' "$root/clients/godot/README.md" |
-  sed "s#http://127.0.0.1:8080#http://127.0.0.1:$port#" >"$work/project/tests/readme_snippet.gd"
-grep -q "EffectdClient.bolt(" "$work/project/tests/readme_snippet.gd" || { echo "FAIL no snippet in the README"; exit 1; }
+awk -v out="$work/project/tests/readme_snippet_" '/^```gdscript/{on=1; n++; next} /^```/{on=0} on {print > (out n ".gd")}' \
+  "$root/clients/godot/README.md"
+for f in "$work"/project/tests/readme_snippet_*.gd; do sed -i "s#http://127.0.0.1:8080#http://127.0.0.1:$port#" "$f"; done
+grep -q "EffectdClient.bolt(" "$work/project/tests/readme_snippet_1.gd" || { echo "FAIL no bolt snippet in the README"; exit 1; }
+grep -q "EffectdClient.bubble(" "$work/project/tests/readme_snippet_2.gd" || { echo "FAIL no bubble snippet in the README"; exit 1; }
 # Godot writes its user data under HOME; the locale warnings of a C locale are noise. The exit
 # status is Godot's (pipefail).
 quiet() { grep -v -e "Unsupported locale" -e "core/translation.cpp" -e "Invalid locale"; }

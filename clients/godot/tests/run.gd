@@ -113,22 +113,25 @@ func run():
 	r = yield(client.post("/v1/fog", {"fog": {"fogType": "LINEAR"}}), "completed")
 	check(r.error != null and r.error.status == 0, "no server: status 0")
 
-	# The README's snippet, where the test driver put it (tests/godot/client_test.sh): it must
-	# add a MeshInstance holding the bolt.
-	if ResourceLoader.exists("res://tests/readme_snippet.gd"):
+	# The README's snippets, where the test driver put them (tests/godot/client_test.sh): each
+	# must add a MeshInstance with a mesh (the bolt, the bubble).
+	var n := 1
+	while ResourceLoader.exists("res://tests/readme_snippet_%d.gd" % n):
 		var scene := Spatial.new()
-		scene.set_script(load("res://tests/readme_snippet.gd"))
+		scene.set_script(load("res://tests/readme_snippet_%d.gd" % n))
 		root.add_child(scene)
-		var bolt: MeshInstance = null
+		var drawn: MeshInstance = null
 		for frame in range(600):
 			yield(self, "idle_frame")
 			for child in scene.get_children():
 				if child is MeshInstance:
-					bolt = child
-			if bolt:
+					drawn = child
+			if drawn:
 				break
-		check(bolt != null and bolt.mesh.get_surface_count() >= 1, "the README's snippet draws a bolt")
-		print("readme snippet: %s" % ("a bolt of %d surfaces" % bolt.mesh.get_surface_count() if bolt else "nothing"))
+		check(drawn != null and drawn.mesh.get_surface_count() >= 1, "the README's snippet %d draws" % n)
+		print("readme snippet %d: %s" % [n, "a mesh of %d surfaces" % drawn.mesh.get_surface_count() if drawn else "nothing"])
+		n += 1
+	check(n > 2, "the README's two snippets ran")
 
 	print("%d checks, %d failed" % [checks, failures])
 	quit(1 if failures else 0)
