@@ -487,8 +487,9 @@ effects_status effects_bolt_lines_make(const effects_bolt* bolt, const effects_b
       lt::TimelineParams t;
       t.seed = c->timeline_seed ? c->timeline_seed : bolt->seed;
       t.timeScale = c->time_scale;
-      if (auto e = lt::validate(t)) return fail(error, *e);
-      lt::Timeline tl = lt::timeline(bolt->bolt, lines, t);
+      auto made_tl = lt::timeline(bolt->bolt, lines, t);
+      if (!made_tl.ok()) return fail(error, made_tl.error());
+      lt::Timeline& tl = made_tl.value();
       for (size_t k = 0; k < made->lines.size(); ++k) {
         made->lines[k].leader = std::move(tl.leader[k]);
         made->lines[k].strokeDelay = std::move(tl.strokeDelay[k]);

@@ -289,7 +289,9 @@ TEST(Lightning3d, PolylinesAndTimelineIn3d) {
       offPlane = offPlane || c.z != p.start.z;
     }
   EXPECT_TRUE(offPlane) << "the bolt never left its start's z plane";
-  const Timeline tl = timeline(b.value(), lines, TimelineParams{});
+  const auto made = timeline(b.value(), lines, TimelineParams{});
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  const Timeline& tl = made.value();
   for (size_t i = 0; i < lines.size(); ++i)
     for (size_t k = 1; k < tl.leader[i].size(); ++k) EXPECT_GE(tl.leader[i][k], tl.leader[i][k - 1]);
   EXPECT_GT(tl.duration, tl.connect);

@@ -21,8 +21,32 @@ Strike strike(uint64_t seed, const TimelineParams& t = {}, int n = 96) {
   EXPECT_TRUE(r.ok());
   Strike s{std::move(r.value()), {}, {}};
   s.lines = polylines(s.bolt, ShapeParams{});
-  s.tl = timeline(s.bolt, s.lines, t);
+  auto tl = timeline(s.bolt, s.lines, t);
+  EXPECT_TRUE(tl.ok()) << (tl.ok() ? "" : tl.error().field + ": " + tl.error().message);
+  if (tl.ok()) s.tl = std::move(tl.value());
   return s;
+}
+
+// The contract: bad input comes back as an Error naming it, never a crash or a wrong answer.
+TEST(Timeline, BadInputIsAnErrorNamingIt) {
+  const Strike s = strike(1);
+  const auto field = [](const Result<Timeline>& r) { return r.ok() ? std::string("(ok)") : r.error().field; };
+  EXPECT_EQ(field(timeline(Bolt{}, {}, TimelineParams{})), "/bolt");  // a default Bolt: no nodes
+  TimelineParams negative;
+  negative.timeScale = -1;
+  EXPECT_EQ(field(timeline(s.bolt, s.lines, negative)), "/timeScale");
+  TimelineParams nan;
+  nan.cellSize = std::nan("");
+  EXPECT_EQ(field(timeline(s.bolt, s.lines, nan)), "/timeline/cellSize");
+  Bolt cyclic = s.bolt;  // a node whose parent comes after it
+  cyclic.nodes[1].parent = int(cyclic.nodes.size()) - 1;
+  EXPECT_EQ(field(timeline(cyclic, s.lines, TimelineParams{})), "/bolt");
+  Bolt shortMain = s.bolt;
+  shortMain.mainChannel.push_back(int(s.bolt.nodes.size()) + 5);
+  EXPECT_EQ(field(timeline(shortMain, s.lines, TimelineParams{})), "/bolt");
+  const Strike other = strike(2, {}, 128);  // a bigger bolt's polylines over this bolt
+  const auto foreign = timeline(s.bolt, other.lines, TimelineParams{});
+  if (other.bolt.nodes.size() > s.bolt.nodes.size()) EXPECT_EQ(field(foreign), "/lines");
 }
 
 TEST(Timeline, MonotoneFiniteAndWithinTheStrike) {

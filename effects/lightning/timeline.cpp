@@ -2,6 +2,7 @@
 // Computed in physical seconds, scaled to game seconds at the end.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "effects/lightning.h"
 
@@ -150,7 +151,32 @@ std::optional<Error> validate(const TimelineParams& p) {
   return std::nullopt;
 }
 
-Timeline timeline(const Bolt& bolt, const std::vector<Polyline>& lines, const TimelineParams& p) {
+namespace {
+
+// What timeline() relies on: the bolt in growth order (every node after its parent), a main
+// channel of its nodes, polylines of its nodes.
+std::optional<Error> checkBolt(const Bolt& bolt, const std::vector<Polyline>& lines) {
+  const size_t n = bolt.nodes.size();
+  if (n == 0 || bolt.mainChannel.empty()) return invalid("/bolt", "has no nodes or no main channel: grow() makes one");
+  if (bolt.nodes[0].parent != -1) return invalid("/bolt", "node 0 must be the start (parent -1)");
+  for (size_t i = 1; i < n; ++i)
+    if (bolt.nodes[i].parent < 0 || size_t(bolt.nodes[i].parent) >= i)
+      return invalid("/bolt", "node " + std::to_string(i) + "'s parent must come before it (growth order)");
+  for (int m : bolt.mainChannel)
+    if (m < 0 || size_t(m) >= n) return invalid("/bolt", "the main channel names node " + std::to_string(m) + " of " + std::to_string(n));
+  for (const Polyline& l : lines)
+    for (const Vertex& v : l.vertices)
+      if (v.node < 0 || size_t(v.node) >= n)
+        return invalid("/lines", "a vertex names node " + std::to_string(v.node) + " of a bolt of " + std::to_string(n) +
+                                     ": polylines of another bolt");
+  return std::nullopt;
+}
+
+}  // namespace
+
+Result<Timeline> timeline(const Bolt& bolt, const std::vector<Polyline>& lines, const TimelineParams& p) {
+  if (auto e = validate(p)) return *e;
+  if (auto e = checkBolt(bolt, lines)) return *e;
   std::vector<double> leader, delay;
   nodeTimes(bolt, p, leader, delay);
   Strike s;

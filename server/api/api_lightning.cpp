@@ -310,7 +310,11 @@ JsonReply runLightning(const LightningRequest& request, const json& body, const 
   if (include.has("polylines") || include.has("timeline") || include.has("mesh") || glbFormat) {
     const std::vector<lt::Polyline> lines = lt::polylines(bolt, request.shape);
     std::optional<lt::Timeline> timeline;
-    if (include.has("timeline")) timeline = lt::timeline(bolt, lines, request.timeline);
+    if (include.has("timeline")) {
+      auto strike = lt::timeline(bolt, lines, request.timeline);
+      if (!strike.ok()) throwError(strike.error(), ctx.at);
+      timeline = std::move(strike.value());
+    }
     if (glbFormat) {  // the ribbons as one file instead of JSON; the timeline's times per vertex
       const json strike = timeline ? strikeJson(*timeline) : json(nullptr);
       const auto ribbons = boltRibbons(lines, p.depth, request.world, timeline ? &*timeline : nullptr);

@@ -175,7 +175,9 @@ rd::Lightning sceneLightning(const json& body, const Config& config, Animation* 
   }
   if (animation && animation->frames.count > 0) {
     animation->bolt = l.polylines;
-    animation->strike = effects::lightning::timeline(bolt, l.polylines, r.timeline);
+    auto strike = effects::lightning::timeline(bolt, l.polylines, r.timeline);
+    if (!strike.ok()) throwError(strike.error(), "/lightning");
+    animation->strike = std::move(strike.value());
     animation->strikeTime = body.value("lightningStyle", json::object()).value("strikeTime", animation->time);
   }
   l.gridWidth = r.params.width;

@@ -61,7 +61,7 @@ struct Params {
 // Fields: "/n1", "/n2" in [1, 10]; speeds in [0, 1e6]; rimPower in [0, 1e3]; wobble amplitude
 // >= 0 (relative: <= 1 radius), frequency in [0, kMaxWobbleFrequency], amplitude x frequency
 // <= kMaxWobbleStretch.
-std::optional<Error> validate(const Params& p);
+[[nodiscard]] std::optional<Error> validate(const Params& p);
 // The defaults of a wobble variant (what a request that names the variant alone gets).
 WobbleShape wobbleDefaults(WobbleVariant v);
 
@@ -117,7 +117,7 @@ struct ThicknessOptions {
 };
 // Fields "/bottomStartNm", "/bottomEndNm" in [0, 1e5], "/swirl" in [0, 10],
 // "/swirlSpeed" in [0, 1e6], "/width" in [4, 4096], "/height" in [2, 4096].
-std::optional<Error> validate(const ThicknessOptions& o);
+[[nodiscard]] std::optional<Error> validate(const ThicknessOptions& o);
 // The exact thickness in nm at a point of the unit sphere (normalised; zero -> +y) at time t.
 double thicknessAt(const Params& p, const ThicknessOptions& o, const glm::dvec3& unitPoint, double t);
 // Without the field, the whole film takes the drainage profile's thickness at the equator.

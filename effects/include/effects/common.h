@@ -35,9 +35,10 @@ struct Error {
   std::string message;  // the rule that was broken, for humans
 };
 
-// Either a value or an Error. Minimal on purpose: `ok()`, `value()`, `error()`.
+// Either a value or an Error. Minimal on purpose: `ok()`, `value()`, `error()`. Dropping one
+// unread is a compile warning: an ignored Result is an ignored error.
 template <class T>
-class Result {
+class [[nodiscard]] Result {
  public:
   Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor)

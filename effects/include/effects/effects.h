@@ -41,7 +41,7 @@
 extern "C" {
 #endif
 
-#define EFFECTS_C_API_VERSION 1
+#define EFFECTS_C_API_VERSION 2 /* 2: effects_bubble_shader_uniforms_at; the shader is seed 000's */
 
 /* ---- errors, versions, strings ------------------------------------------------------------ */
 
@@ -102,6 +102,10 @@ typedef struct effects_fog {
 
 /* Fills *fog with the library's defaults (and fog->size). */
 void effects_fog_defaults(effects_fog* fog);
+/* Checks *fog as /v1/fog checks its "fog" (effects::fog::validate). Statuses: EFFECTS_OK;
+ * EFFECTS_INVALID_ARGUMENT: "" for a NULL fog, "/size", "/fogType" or "/convention" for a
+ * wrong size or enum, otherwise the field fog.json names ("/density", "/color/1", ...) with
+ * its range in the message. */
 effects_status effects_fog_validate(const effects_fog* fog, effects_error** error);
 /* f (the object's weight, 1 = no fog) along a ray from height origin_y with unit direction y
  * component dir_y, at distance. Sets *f; fails only where effects_fog_validate does. */
@@ -126,6 +130,13 @@ typedef struct effects_fog_table_options {
 void effects_fog_table_options_defaults(effects_fog_table_options* options);
 
 typedef struct effects_fog_table effects_fog_table;
+/* The fog's lookup table (effects::fog::table), as /v1/fog's "table" builds it. Sets *table
+ * (free it with effects_fog_table_free) or NULL on failure. Statuses: EFFECTS_OK; every status
+ * of effects_fog_validate; EFFECTS_INVALID_ARGUMENT: "" for NULL fog, options or table,
+ * "/size" or "/layout" for a wrong size or enum, "/table/..." for an option outside its range
+ * (max_error in (0, 1), elevations, camera_height finite); EFFECTS_LIMIT_EXCEEDED: "/maxSize"
+ * above 2^24, "/size" when columns x elevations exceeds max_size or no size up to it meets
+ * max_error. */
 effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog_table_options* options,
                                        effects_fog_table** table, effects_error** error);
 void effects_fog_table_free(effects_fog_table* table);
@@ -172,6 +183,14 @@ typedef struct effects_bolt_params {
 void effects_bolt_params_defaults(effects_bolt_params* params);
 
 typedef struct effects_bolt effects_bolt;
+/* Grows a bolt (effects::lightning::grow) as /v1/lightning does. Sets *bolt (free it with
+ * effects_bolt_free) or NULL on failure. Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT: "" for
+ * NULL params or bolt, "/size", "/method" for a wrong size or enum, "/grid/width",
+ * "/grid/height" (3 to 65 536; 4 096 in 3-D), "/grid/depth", "/start", "/targets/<i>" (outside
+ * the grid, in an obstacle, NULL with a count), "/eta" ([0, 50]), "/neighbourhood" and the
+ * other fields effects::lightning::validate names; EFFECTS_LIMIT_EXCEEDED: "/grid" over the
+ * cell limits above, "/maxSteps", "/targets" (more than 64); EFFECTS_UNSATISFIABLE naming the
+ * target no path reaches. */
 effects_status effects_bolt_grow(const effects_bolt_params* params, effects_bolt** bolt, effects_error** error);
 void effects_bolt_free(effects_bolt* bolt);
 /* Cells in growth order: node i at cells[3i..3i+2], grown from parents[i] (-1 for the start) at
@@ -199,6 +218,9 @@ typedef struct effects_bolt_lines_params {
 void effects_bolt_lines_params_defaults(effects_bolt_lines_params* params);
 
 typedef struct effects_bolt_lines effects_bolt_lines;
+/* Sets *lines (free with effects_bolt_lines_free) or NULL on failure. Statuses: EFFECTS_OK;
+ * EFFECTS_INVALID_ARGUMENT: "" for NULL arguments, "/size", "/shape/jitter" ([0, 1]), "/shape"
+ * (the branch fields), and with a timeline "/timeScale" ((0, 1e6]). */
 effects_status effects_bolt_lines_make(const effects_bolt* bolt, const effects_bolt_lines_params* params,
                                        effects_bolt_lines** lines, effects_error** error);
 void effects_bolt_lines_free(effects_bolt_lines* lines);
@@ -234,7 +256,11 @@ typedef struct effects_mesh_in {
 } effects_mesh_in;
 
 typedef struct effects_tangents effects_tangents;
-/* mode: an effects_tangent_mode. Up to 2 000 000 vertices and 4 000 000 triangles. */
+/* mode: an effects_tangent_mode. Up to 2 000 000 vertices and 4 000 000 triangles. Sets
+ * *result (free with effects_tangents_free) or NULL on failure. Statuses: EFFECTS_OK;
+ * EFFECTS_INVALID_ARGUMENT: "" for NULL arguments, "/size", "/mode", "/positions" (missing, or
+ * not finite), "/uvs", "/indices/<i>" (past vertex_count, or a count not a multiple of 3);
+ * EFFECTS_LIMIT_EXCEEDED: "/positions", "/indices" over the counts above. */
 effects_status effects_tangents_generate(const effects_mesh_in* mesh, int32_t mode, effects_tangents** result,
                                          effects_error** error);
 void effects_tangents_free(effects_tangents* result);
@@ -263,6 +289,10 @@ typedef struct effects_bubble_params {
 void effects_bubble_params_defaults(effects_bubble_params* params);
 
 typedef struct effects_bubble_mesh effects_bubble_mesh;
+/* The icosphere (effects::bubble::icosphere) as /v1/bubble's "mesh". Sets *mesh (free with
+ * effects_bubble_mesh_free) or NULL on failure. Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT:
+ * "" for NULL arguments, "/size", "/time" (not finite), "/n1", "/n2", "/radius" and the other
+ * fields effects::bubble::validate names; EFFECTS_LIMIT_EXCEEDED: "/level" above its maximum. */
 effects_status effects_bubble_mesh_make(const effects_bubble_params* params, effects_bubble_mesh** mesh,
                                         effects_error** error);
 void effects_bubble_mesh_free(effects_bubble_mesh* mesh);

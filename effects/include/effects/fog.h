@@ -128,7 +128,7 @@ double glowStart(const Fog& fog);
 double observerHeight(const Fog& fog, double eyeY);
 
 // Field errors name the Fog member, e.g. "/visibilityRange".
-std::optional<Error> validate(const Fog& fog);
+[[nodiscard]] std::optional<Error> validate(const Fog& fog);
 
 // f for a point at `distance` from the viewer. For kHeight this is a horizontal ray at
 // baseHeight (use factorAlongRay for the general case). distance may be +infinity.
@@ -187,7 +187,7 @@ struct Region {
   double radius = 0.0;            // sphere, >= 0
   Fog fog;
 };
-std::optional<Error> validate(const Region& region);
+[[nodiscard]] std::optional<Error> validate(const Region& region);
 // ln of the region's volume: what "innermost" compares (in log space, so that regions of 1e-200
 // and 1e200 compare; -infinity for a flat one).
 double logVolume(const Region& region);

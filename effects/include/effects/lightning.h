@@ -128,7 +128,7 @@ struct Params {
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
 };
 
-std::optional<Error> validate(const Params& p);
+[[nodiscard]] std::optional<Error> validate(const Params& p);
 
 struct Node {
   Cell cell;
@@ -270,7 +270,7 @@ struct TimelineParams {
   double flicker = 0.25;             // relative brightness noise of the glow between strokes
 };
 
-std::optional<Error> validate(const TimelineParams& p);
+[[nodiscard]] std::optional<Error> validate(const TimelineParams& p);
 
 // Brightness of the three channel classes over time; clients interpolate linearly.
 struct Keyframe {
@@ -296,8 +296,12 @@ struct Timeline {
   std::vector<Keyframe> keyframes;
 };
 
-// `lines` must be polylines(bolt, ...) of the same bolt.
-Timeline timeline(const Bolt& bolt, const std::vector<Polyline>& lines, const TimelineParams& params);
+// The strike over `bolt` as grown by grow(), with `lines` its polylines(bolt, ...). Errors
+// (kInvalidArgument): params outside validate()'s ranges (their fields); "/bolt" for a bolt
+// grow() did not make (no nodes or main channel, a node before its parent, a main channel
+// naming no node); "/lines" for polylines naming a node the bolt does not have.
+[[nodiscard]] Result<Timeline> timeline(const Bolt& bolt, const std::vector<Polyline>& lines,
+                                        const TimelineParams& params);
 
 // The keyframe channels at time t (linear between keyframes, 0 outside).
 Keyframe channelsAt(const Timeline& tl, double t);

@@ -92,7 +92,7 @@ struct Output {
 
 // Field errors: "/positions/<i>", "/normals/<i>", "/uvs/<i>", "/indices/<i>" (element index),
 // counts and limits ("/indices", "/uvs", "/normals", "/positions").
-std::optional<Error> validate(const Mesh& mesh, const Options& options);
+[[nodiscard]] std::optional<Error> validate(const Mesh& mesh, const Options& options);
 
 Result<Output> generate(const Mesh& mesh, const Options& options);
 
