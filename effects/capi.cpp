@@ -102,12 +102,8 @@ bool sized(size_t given, size_t known) { return given >= known; }
 
 glm::dvec3 vec(const double v[3]) { return {v[0], v[1], v[2]}; }
 
-// The service's default limits (server/contract/config.h), so that untrusted parameters bound
-// the work as a request does.
-constexpr size_t kMaxGridCells = size_t(1) << 24;
-constexpr size_t kMaxSolverGridCells = 256 * 256;
-constexpr size_t kMaxSolverVolumeCells = 64 * 64 * 64;
-constexpr size_t kMaxGrowthSteps = 2'000'000;
+// The largest fog table the contract allows (lightning's bounds: effects::lightning::Limits), so
+// that untrusted parameters bound the work as a request does.
 constexpr size_t kMaxTableEntries = size_t(1) << 24;
 
 effects_status toFog(const effects_fog* c, effects::fog::Fog& f, effects_error** error) {
@@ -367,7 +363,8 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_bolt_params)");
     if (c->method < int32_t(EFFECTS_BOLT_FAST) || c->method > int32_t(EFFECTS_BOLT_CHARGES))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/method", "is not an effects_bolt_method");
-    if (c->max_steps > kMaxGrowthSteps) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSteps", "at most 2 000 000");
+    if (c->max_steps > lt::Limits{}.maxGrowthSteps)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSteps", "at most " + std::to_string(lt::Limits{}.maxGrowthSteps));
     if (c->target_count > 64) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/targets", "at most 64 targets");
     if (c->target_count && !c->targets) return fail(error, EFFECTS_INVALID_ARGUMENT, "/targets", "is NULL");
     lt::Params p;
@@ -378,7 +375,7 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
       p.targets.push_back({c->targets[3 * i], c->targets[3 * i + 1], c->depth ? c->targets[3 * i + 2] : 0});
     p.method = lt::Method(int(c->method));
     p.eta = c->eta;
-    p.neighbourhood = c->neighbourhood ? c->neighbourhood : c->depth ? 26 : 8;
+    p.neighbourhood = c->neighbourhood ? c->neighbourhood : lt::defaultNeighbourhood(c->depth);
     p.seed = c->seed;
     p.maxSteps = c->max_steps;
     // The grid's sides first: the flag arrays are read only once their size is known to be sane
@@ -386,13 +383,7 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
     lt::Params sides = p;
     if (sides.targets.empty() && c->target_region) sides.targets.push_back(sides.start);
     if (auto e = lt::validate(sides)) return fail(error, *e);
-    const size_t limit = p.method == lt::Method::kFast ? kMaxGridCells
-                         : p.depth                     ? kMaxSolverVolumeCells
-                                                       : kMaxSolverGridCells;
-    if (cellsOf(p) > limit)
-      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/grid",
-                  "grid of " + std::to_string(cellsOf(p)) + " cells exceeds the limit of " + std::to_string(limit) +
-                      " for " + lt::toString(p.method));
+    if (auto e = lt::checkLimits(p, lt::Limits{})) return fail(error, *e);
     if (c->obstacles) p.obstacles.assign(c->obstacles, c->obstacles + cellsOf(p));
     if (c->target_region) p.targetRegion.assign(c->target_region, c->target_region + cellsOf(p));
     if (c->calibrated) {

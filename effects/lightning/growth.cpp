@@ -18,16 +18,6 @@
 
 namespace effects::lightning {
 
-const char* toString(Method m) {
-  switch (m) {
-    case Method::kFast: return "fast";
-    case Method::kDbm: return "dbm";
-    case Method::kCharges: return "charges";
-  }
-  return "?";
-}
-const char* toString(Solver s) { return s == Solver::kCg ? "cg" : s == Solver::kCapacitance ? "capacitance" : "mgpcg"; }
-
 std::optional<Error> validate(const Params& p) {
   // Each side named as the HTTP API names it (its schema's bounds).
   for (const auto& [side, pointer] : {std::pair{p.width, "/grid/width"}, std::pair{p.height, "/grid/height"}}) {

@@ -182,20 +182,12 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   p.width = body["grid"]["width"];
   p.height = body["grid"]["height"];
   p.depth = body["grid"].value("depth", 0);
-  const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
-  if (cells > config.limits.maxGridCells)
-    throw fieldError(413, at + "/grid",
-                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
-                         std::to_string(config.limits.maxGridCells) + " (--max-grid-cells)");
-  const std::string method = body.value("method", "fast");
-  p.method = method == "dbm" ? lt::Method::kDbm : method == "charges" ? lt::Method::kCharges : lt::Method::kFast;
-  const size_t solverLimit = p.depth ? config.limits.maxSolverVolumeCells : config.limits.maxSolverGridCells;
-  if (p.method != lt::Method::kFast && cells > solverLimit)
-    throw fieldError(413, at + "/grid",
-                     "grid of " + std::to_string(cells) + " cells exceeds the limit of " + std::to_string(solverLimit) +
-                         " for method " + method +
-                         (p.depth ? " (--max-solver-volume-cells)" : " (--max-solver-grid-cells)") +
-                         "; the fast method takes up to " + std::to_string(config.limits.maxGridCells));
+  p.method = lt::parseMethod(body.value("method", "fast")).value_or(lt::Method::kFast);  // the schema's enum
+  lt::Limits limits;
+  limits.maxGridCells = config.limits.maxGridCells, limits.gridKnob = "--max-grid-cells";
+  limits.maxSolverGridCells = config.limits.maxSolverGridCells, limits.solverGridKnob = "--max-solver-grid-cells";
+  limits.maxSolverVolumeCells = config.limits.maxSolverVolumeCells, limits.solverVolumeKnob = "--max-solver-volume-cells";
+  if (auto e = lt::checkLimits(p, limits)) throwError(*e, at);
   if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
   r.world = parseWorld(body);
   p.start = cellOf(body["start"], p.depth, at + "/start");
@@ -204,12 +196,10 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   for (size_t i = 0; i < body.value("targets", json::array()).size(); ++i)
     p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   p.eta = body.value("eta", p.eta);
-  p.neighbourhood = body.value("neighbourhood", p.depth ? 26 : p.neighbourhood);
-  const std::string solver = body.value("solver", "capacitance");  // the schema's enum
-  p.solver = solver == "cg" ? lt::Solver::kCg : solver == "mgpcg" ? lt::Solver::kMgpcg : lt::Solver::kCapacitance;
+  p.neighbourhood = body.value("neighbourhood", lt::defaultNeighbourhood(p.depth));
+  p.solver = lt::parseSolver(body.value("solver", "capacitance")).value_or(lt::Solver::kCapacitance);  // the schema's enums
   p.tolerance = body.value("tolerance", p.tolerance);
-  const std::string guide = body.value("guide", "auto");
-  p.guide = guide == "astar" ? lt::Guide::kAstar : guide == "none" ? lt::Guide::kNone : lt::Guide::kAuto;
+  p.guide = lt::parseGuide(body.value("guide", "auto")).value_or(lt::Guide::kAuto);
   p.seed = body.value("seed", uint64_t(1));
   p.maxSteps = std::min<size_t>(body.value("maxSteps", config.limits.maxGrowthSteps), config.limits.maxGrowthSteps);
   lt::ShapeParams& shape = r.shape;

@@ -6,15 +6,18 @@
 #include <string>
 #include <vector>
 
+#include <effects/lightning.h>
+
 namespace effectd {
 
 struct Limits {
   size_t maxBodyBytes = 16u << 20;          // request body (and a GET's decoded ?r=)
   size_t maxUrlBytes = 8192;                // a GET's path and query
-  size_t maxGridCells = 4096u * 4096u;      // lightning grid width*height
-  size_t maxGrowthSteps = 2'000'000;        // lightning cells added per request
-  size_t maxSolverGridCells = 256u * 256u;  // dbm and charges: every step costs O(cells)
-  size_t maxSolverVolumeCells = 64u * 64u * 64u;  // dbm on 3-D grids
+  // Lightning's bounds, with the library's defaults (effects::lightning::Limits).
+  size_t maxGridCells = effects::lightning::Limits{}.maxGridCells;
+  size_t maxGrowthSteps = effects::lightning::Limits{}.maxGrowthSteps;
+  size_t maxSolverGridCells = effects::lightning::Limits{}.maxSolverGridCells;
+  size_t maxSolverVolumeCells = effects::lightning::Limits{}.maxSolverVolumeCells;
   size_t maxTableSize = 65536;              // fog table entries (all dimensions together)
   size_t maxMeshVertices = 2'000'000;       // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;

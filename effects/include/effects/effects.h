@@ -160,7 +160,8 @@ typedef enum effects_bolt_method { EFFECTS_BOLT_FAST = 0, EFFECTS_BOLT_DBM, EFFE
 /* effects::lightning::Params, with the server's calibration applied when `calibrated` is 1
  * (the default; 0 takes axis_growth and lifetime as given). depth 0: a 2-D grid. Cells are
  * int32 triples x, y, z (z 0 in 2-D). obstacles and target_region: NULL, or one byte per cell
- * (x fastest, then y, then z; nonzero = in the set). Limits (the service's defaults): fast
+ * (x fastest, then y, then z; nonzero = in the set). Limits (effects::lightning::Limits, the
+ * service's defaults): fast
  * grids up to 2^24 cells, dbm and charges (every step costs O(cells)) up to 256^2 cells in 2-D
  * and 64^3 in 3-D, max_steps up to 2 000 000, 64 targets. */
 typedef struct effects_bolt_params {

@@ -46,6 +46,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "effects/common.h"
@@ -87,8 +88,31 @@ int screeningRadius(const Params& p);
 // parameter itself at eta, their potential is far less screened than DBM's.
 double calibratedChargesEta(const Params& p);
 
+// The names the HTTP API spells ("fast", "dbm", "charges"; "mgpcg", "cg", "capacitance";
+// "auto", "astar", "none"), both ways: the one mapping the server and the C API use. parse*
+// give nullopt for any other name.
 const char* toString(Method m);
 const char* toString(Solver s);
+const char* toString(Guide g);
+std::optional<Method> parseMethod(std::string_view name);
+std::optional<Solver> parseSolver(std::string_view name);
+std::optional<Guide> parseGuide(std::string_view name);
+// The neighbourhood a request that names none grows in: 8 in 2-D, 26 in 3-D.
+int defaultNeighbourhood(int depth);
+
+// Bounds on one bolt's work. The defaults are the service's (its flags raise or lower them);
+// the C API holds untrusted parameters to them.
+struct Limits {
+  size_t maxGridCells = size_t(4096) * 4096;         // any method: width x height (x depth)
+  size_t maxSolverGridCells = size_t(256) * 256;     // kDbm and kCharges in 2-D: each step costs O(cells)
+  size_t maxSolverVolumeCells = size_t(64) * 64 * 64;  // kDbm and kCharges in 3-D
+  size_t maxGrowthSteps = 2'000'000;                 // cells added per bolt
+  // What raises each grid bound, named in checkLimits' message (the server's flags); empty: nothing.
+  std::string_view gridKnob, solverGridKnob, solverVolumeKnob;
+};
+// kLimitExceeded at "/grid" when the grid's cells exceed maxGridCells, or, for kDbm and
+// kCharges, the solver's bound (2-D or 3-D); the message names the cells, the bound and its knob.
+[[nodiscard]] std::optional<Error> checkLimits(const Params& p, const Limits& limits);
 // Working memory kDbm's capacitance solver may take on a grid (depth 0: 2-D) beyond the
 // iterative solver's (its Cholesky factor, rows of G, the grid's table of G), for admission
 // estimates; 0 where the grid is too large for it (3-D past about 80^3: MGPCG alone).
@@ -124,7 +148,7 @@ struct Params {
   double tolerance = 1e-6;  // kDbm, iterative solvers: the candidates' relative accuracy (each step
                             // solves to ||r|| / ||b|| <= tolerance x their largest Phi), in [1e-12, 1e-1]
   uint64_t seed = 1;
-  size_t maxSteps = 2'000'000;  // growth budget (cells added)
+  size_t maxSteps = Limits{}.maxGrowthSteps;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
 };
 
