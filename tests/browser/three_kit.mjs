@@ -94,9 +94,9 @@ try {
     boltScene.add(fromJson.object);
     const b = frame(boltScene, flatCamera);
     boltScene.remove(fromJson.object);
-    // The glow 6 times as wide: no lit pixel farther from the core's than the glow's half width
-    // (6 cells: the main ribbon is 2 wide), where mitred joins pushed 6 times outward once made
-    // points twice as long.
+    // The glow 6 times as wide: no lit pixel farther from the core's than about 5 cells (the
+    // glow's half width is 6 cells, its Gaussian dims below the lit level past ~5), where mitred
+    // joins pushed 6 times outward once made points reaching 8.5.
     const glowing = kit.boltFromAnswer(boltJson, { glow: { width: 6, strength: 1 } });
     boltScene.add(glowing.object);
     const glowLit = litMask(frame(boltScene, flatCamera), size), coreLit = litMask(b, size);
@@ -221,7 +221,7 @@ try {
   check(r.boltSame.mean === 0, `the bolt's GLB and its JSON mesh draw the same frame through the kit (mean difference ${r.boltSame.mean})`, r.boltSame);
   check(r.boltRecall >= 0.9 && r.boltPrecision >= 0.9, `the kit's bolt lights ${(100 * r.boltRecall).toFixed(1)} % of the preview's lit pixels ` +
         `and the preview ${(100 * r.boltPrecision).toFixed(1)} % of the kit's, within a pixel (≥ 90 %)`);
-  check(r.glow.lit > 2 * r.glow.core && r.glow.farthestCells <= 6, `a glow 6 times as wide stays within 6 cells of the core ` +
+  check(r.glow.lit > 2 * r.glow.core && r.glow.farthestCells <= 5.6, `a glow 6 times as wide stays within 5.6 cells of the core ` +
         `(farthest lit pixel ${r.glow.farthestCells.toFixed(2)} cells; ${r.glow.lit} pixels lit, the core ${r.glow.core})`, r.glow);
   check(r.strike.before === 0 && r.strike.stroke >= 0.5 * r.strike.whole && r.strike.after === 0,
         `setTime plays the strike: lit share ${r.strike.before} before the leader, ${r.strike.stroke.toFixed(4)} at the first stroke ` +

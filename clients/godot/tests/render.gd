@@ -270,6 +270,7 @@ func fog(client, camera: Camera):
 	root.add_child(wall)
 	camera.set_perspective(70.0, 0.1, 500.0)
 	camera.translation = Vector3(0, 3, 0)
+	camera.rotation_degrees = Vector3(-10, 15, 0)  # pitched and turned: view and world axes differ
 	# The points the chosen pixels see, worked out here from the rays and the two planes.
 	var pixels := [Vector2(128, 30), Vector2(128, 110), Vector2(128, 150), Vector2(128, 235), Vector2(20, 200), Vector2(240, 60), Vector2(10, 140)]
 	var points := []

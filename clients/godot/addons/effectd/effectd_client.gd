@@ -219,7 +219,7 @@ static func bubble(answer: Dictionary, environment: CubeMap = null) -> MeshInsta
 	var thickness: ImageTexture = null
 	if field:  # filled by bubble_update below
 		thickness = ImageTexture.new()
-		thickness.create(int(answer.thickness.width), int(answer.thickness.height), Image.FORMAT_RF,
+		thickness.create(int(answer.thickness.width), int(answer.thickness.height), Image.FORMAT_RH,
 				Texture.FLAG_FILTER | Texture.FLAG_REPEAT)  # u wraps around the sphere
 	# The far side (cull_front) then the near side, each what passes (blend_mul) then what it
 	# reflects (blend_add), as the answer's shader.draw says; without features.backFace only the near.
@@ -228,11 +228,8 @@ static func bubble(answer: Dictionary, environment: CubeMap = null) -> MeshInsta
 	var last: ShaderMaterial = null
 	for side in sides:
 		for step in [0, 1]:
-			var shader := Shader.new()
-			shader.code = BubbleShader.code.replace("blend_add, cull_back",
-					"%s, %s" % ["blend_mul" if step == 0 else "blend_add", side])
 			var material := ShaderMaterial.new()
-			material.shader = shader
+			material.shader = _bubble_variant("blend_mul" if step == 0 else "blend_add", side)
 			material.set_shader_param("film_pass", step)
 			material.set_shader_param("thin_film", thin_film)
 			material.set_shader_param("use_thickness_field", field)
@@ -250,6 +247,15 @@ static func bubble(answer: Dictionary, environment: CubeMap = null) -> MeshInsta
 	node.material_override = first
 	bubble_update(node, answer)
 	return node
+
+# The four film shaders made once (kept on the shared resource): a new bubble compiles nothing.
+static func _bubble_variant(blend: String, side: String) -> Shader:
+	var key := "effectd_%s_%s" % [blend, side]
+	if not BubbleShader.has_meta(key):
+		var shader := Shader.new()
+		shader.code = BubbleShader.code.replace("blend_add, cull_back", "%s, %s" % [blend, side])
+		BubbleShader.set_meta(key, shader)
+	return BubbleShader.get_meta(key)
 
 # A later answer's uniforms (a new time: wobble phase, thickness, lights) into bubble()'s materials.
 static func bubble_update(node: MeshInstance, answer: Dictionary) -> void:
@@ -274,11 +280,14 @@ static func bubble_update(node: MeshInstance, answer: Dictionary) -> void:
 		var image := Image.new()  # row 0 at v = 0, as Godot reads an image's first row
 		image.create_from_data(int(answer.thickness.width), int(answer.thickness.height), false, Image.FORMAT_RF,
 				Marshalls.base64_to_raw(answer.thickness.data))
+		image.convert(Image.FORMAT_RH)  # half floats filter everywhere (mobile GLES3 may not filter floats)
 		node.material_override.get_shader_param("thickness_field").set_data(image)
 
 # Fog over the whole view (effectd_fog.shader): a full-screen quad that fogs what is drawn by
-# its depth, from a fog answer's table (any encoding; HEIGHT tables linear or warped). Add it
-# under the camera's viewport; it draws after the opaque scene.
+# its depth, from a fog answer's `table` (any encoding; HEIGHT tables linear or warped; the
+# global fog only: regionTables, ATMOSPHERIC's per-channel transmittance and the directional
+# glow are not drawn). It draws first among see-through objects (lowest render_priority) and
+# fogs the opaque scene; see-through objects drawn after it (bolts, bubbles) are not fogged.
 static func fog_overlay(table: Dictionary) -> MeshInstance:
 	var quad := QuadMesh.new()
 	quad.size = Vector2(2, 2)
@@ -295,6 +304,7 @@ static func fog_overlay(table: Dictionary) -> MeshInstance:
 		material.set_shader_param("fog_warp_range", Vector2(a.factorStart, a.end))
 	var node := MeshInstance.new()
 	node.mesh = quad
+	material.render_priority = Material.RENDER_PRIORITY_MIN
+	quad.custom_aabb = AABB(Vector3.ONE * -1e7, Vector3.ONE * 2e7)  # placed by its shader: never culled
 	node.material_override = material
-	node.extra_cull_margin = 16384.0  # placed by its shader, never culled
 	return node
