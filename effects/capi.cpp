@@ -675,6 +675,8 @@ effects_status effects_bubble_shader_uniforms_at(const effects_bubble_params* c,
     bb::Params p;
     bb::MeshOptions o;
     if (effects_status s = toBubble(c, p, o, error)) return s;
+    o.wobble = true;  // the shader wobbles the rest shape: the radius must keep its shape in float32
+    if (auto e = bb::validate(p, o)) return fail(error, *e);
     if (!std::isfinite(t)) return fail(error, EFFECTS_INVALID_ARGUMENT, "/time", "must be finite");
     const bb::Film mu = bb::film(p, t);
     const bb::WobbleShape wobble = bb::wobbleInObject(p, o.radius);

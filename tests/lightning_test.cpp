@@ -1,6 +1,7 @@
 // effects/lightning: growth methods, guide, stiff and extreme cases, shape, quality metrics.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -362,6 +363,20 @@ TEST(Lightning, TinyGridsAndAdjacentTarget) {
   auto b = grow(p);
   ASSERT_TRUE(b.ok());
   EXPECT_EQ(b.value().nodes.size(), 2u);
+}
+
+// checkLimits on sides as large as int allows: the cell count saturates, it does not wrap to a
+// small number that passes (2^31 cubed wraps a size_t).
+TEST(Lightning, LimitsSaturateOnHugeSides) {
+  Params p;
+  p.width = p.height = p.depth = std::numeric_limits<int>::max();
+  const auto e = checkLimits(p, Limits{});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->field, "/grid");
+  p.width = p.height = 64, p.depth = 0;
+  EXPECT_FALSE(checkLimits(p, Limits{}).has_value());
+  p.method = Method::kDbm, p.width = p.height = 257;
+  EXPECT_NE(checkLimits(p, Limits{}).value_or(Error{}).message.find("for method dbm"), std::string::npos);
 }
 
 TEST(Lightning, ClearErrors) {

@@ -226,14 +226,19 @@ void shade(const Params& p, const MeshOptions& o, Mesh& out) {
 
 }  // namespace
 
-Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
-  if (auto e = validate(p)) return *e;
+std::optional<Error> validate(const Params& p, const MeshOptions& o) {
+  if (auto e = validate(p)) return e;
   if (o.level < 0 || o.level > o.maxLevel)
     return overLimit("/level", "must be in [0, " + std::to_string(o.maxLevel) + "]");
   if (!(o.radius >= 1e-6) || !std::isfinite(o.radius) || o.radius > 1e6) return invalid("/radius", "must be in [1e-6, 1e6]");
   if (o.wobble)
-    if (auto e = wobbleFits(p, o.radius)) return *e;
+    if (auto e = wobbleFits(p, o.radius)) return e;
   if (!std::isfinite(o.t)) return invalid("/t", "must be finite");
+  return std::nullopt;
+}
+
+Result<Mesh> icosphere(const Params& p, const MeshOptions& o) {
+  if (auto e = validate(p, o)) return *e;
   Stopwatch watch;
   // Unit icosahedron, then subdivision with shared midpoints.
   const Sphere sphere = subdivide(o.level);

@@ -1,5 +1,6 @@
 // Bounds on one bolt's work (Limits) and the defaults a request that names nothing gets.
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include "effects/lightning.h"
@@ -10,7 +11,11 @@ int defaultNeighbourhood(int depth) { return depth ? 26 : 8; }
 
 std::optional<Error> checkLimits(const Params& p, const Limits& limits) {
   const auto knob = [](std::string_view k) { return k.empty() ? std::string() : " (" + std::string(k) + ")"; };
-  const size_t cells = size_t(std::max(p.width, 0)) * size_t(std::max(p.height, 0)) * size_t(std::max(p.depth, 1));
+  // Sides as large as int allows: saturate rather than wrap (callers may not have validated).
+  size_t cells = 0;
+  if (__builtin_mul_overflow(size_t(std::max(p.width, 0)), size_t(std::max(p.height, 0)), &cells) ||
+      __builtin_mul_overflow(cells, size_t(std::max(p.depth, 1)), &cells))
+    cells = std::numeric_limits<size_t>::max();
   if (cells > limits.maxGridCells)
     return overLimit("/grid", "grid of " + std::to_string(cells) + " cells exceeds the limit of " +
                                   std::to_string(limits.maxGridCells) + knob(limits.gridKnob));

@@ -315,6 +315,11 @@ static void test_bubble(void) {
     expect_error(effects_bubble_shader_uniforms_at(&p, 0, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/size", "a wrong size");
     u.size = sizeof u;
     expect_error(effects_bubble_shader_uniforms_at(&p, INFINITY, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/time", "time inf");
+    p.radius = 0;
+    expect_error(effects_bubble_shader_uniforms_at(&p, 0, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/radius", "uniforms for radius 0");
+    p.radius = NAN;
+    expect_error(effects_bubble_shader_uniforms_at(&p, 0, &u, &e), &e, EFFECTS_INVALID_ARGUMENT, "/radius", "uniforms for radius NaN");
+    effects_bubble_params_defaults(&p);
   }
   effects_string_free(vertex);
   effects_string_free(fragment);

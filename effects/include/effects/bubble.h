@@ -150,6 +150,9 @@ struct Mesh {
   std::vector<float> rim;
   Stats stats;
 };
+// What icosphere() checks before any work: p, then level (kLimitExceeded past maxLevel),
+// radius in [1e-6, 1e6], wobbleFits when o.wobble, t finite.
+[[nodiscard]] std::optional<Error> validate(const Params& p, const MeshOptions& o);
 Result<Mesh> icosphere(const Params& p, const MeshOptions& o);
 
 // ---- shaders ----------------------------------------------------------------------------------

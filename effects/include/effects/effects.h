@@ -133,8 +133,8 @@ typedef struct effects_fog_table effects_fog_table;
 /* The fog's lookup table (effects::fog::table), as /v1/fog's "table" builds it. Sets *table
  * (free it with effects_fog_table_free) or NULL on failure. Statuses: EFFECTS_OK; every status
  * of effects_fog_validate; EFFECTS_INVALID_ARGUMENT: "" for NULL fog, options or table,
- * "/size" or "/layout" for a wrong size or enum, "/table/..." for an option outside its range
- * (max_error in (0, 1), elevations, camera_height finite); EFFECTS_LIMIT_EXCEEDED: "/maxSize"
+ * "/size" or "/layout" for a wrong size or enum, "/table" for an option outside its range
+ * (max_error in [0, 1], elevations, camera_height finite); EFFECTS_LIMIT_EXCEEDED: "/maxSize"
  * above 2^24, "/size" when columns x elevations exceeds max_size or no size up to it meets
  * max_error. */
 effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog_table_options* options,
@@ -186,12 +186,13 @@ void effects_bolt_params_defaults(effects_bolt_params* params);
 typedef struct effects_bolt effects_bolt;
 /* Grows a bolt (effects::lightning::grow) as /v1/lightning does. Sets *bolt (free it with
  * effects_bolt_free) or NULL on failure. Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT: "" for
- * NULL params or bolt, "/size", "/method" for a wrong size or enum, "/grid/width",
- * "/grid/height" (3 to 65 536; 4 096 in 3-D), "/grid/depth", "/start", "/targets/<i>" (outside
- * the grid, in an obstacle, NULL with a count), "/eta" ([0, 50]), "/neighbourhood" and the
- * other fields effects::lightning::validate names; EFFECTS_LIMIT_EXCEEDED: "/grid" over the
- * cell limits above, "/maxSteps", "/targets" (more than 64); EFFECTS_UNSATISFIABLE naming the
- * target no path reaches. */
+ * NULL params or bolt, "/size", "/method" for a wrong size or enum, "/grid/width" or
+ * "/grid/height" below 3, "/grid/depth", "/start", "/targets" (NULL with a count),
+ * "/targets/<i>" (outside the grid), "/eta" ([0, 50]), "/neighbourhood" and the other fields
+ * effects::lightning::validate names; EFFECTS_LIMIT_EXCEEDED: "/grid/width" or "/grid/height"
+ * over 65 536 (4 096 in 3-D), "/grid" over the cell limits above, "/maxSteps", "/targets"
+ * (more than 64); EFFECTS_UNSATISFIABLE naming a target in an obstacle, on the start, or that
+ * no path reaches. */
 effects_status effects_bolt_grow(const effects_bolt_params* params, effects_bolt** bolt, effects_error** error);
 void effects_bolt_free(effects_bolt* bolt);
 /* Cells in growth order: node i at cells[3i..3i+2], grown from parents[i] (-1 for the start) at
@@ -293,7 +294,9 @@ typedef struct effects_bubble_mesh effects_bubble_mesh;
 /* The icosphere (effects::bubble::icosphere) as /v1/bubble's "mesh". Sets *mesh (free with
  * effects_bubble_mesh_free) or NULL on failure. Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT:
  * "" for NULL arguments, "/size", "/time" (not finite), "/n1", "/n2", "/radius" and the other
- * fields effects::bubble::validate names; EFFECTS_LIMIT_EXCEEDED: "/level" above its maximum. */
+ * fields effects::bubble::validate names, "/radius" outside [1e-6, 1e6]; EFFECTS_LIMIT_EXCEEDED:
+ * "/level" outside [0, its maximum]; EFFECTS_UNSATISFIABLE: "/radius" too small for the paper's
+ * wobble in float32 (wobble on). */
 effects_status effects_bubble_mesh_make(const effects_bubble_params* params, effects_bubble_mesh** mesh,
                                         effects_error** error);
 void effects_bubble_mesh_free(effects_bubble_mesh* mesh);
@@ -336,9 +339,9 @@ typedef struct effects_bubble_shader_uniforms {
   double rim_power;            /* uRimPower (eqn 10) */
   double base_color[4];        /* uBaseColor: colour and alpha without any feature */
 } effects_bubble_shader_uniforms;
-/* Statuses: EFFECTS_OK; EFFECTS_INVALID_ARGUMENT naming the parameter (params as for
- * effects_bubble_mesh_make, "/time" when t is not finite, "/size" when out->size is not
- * sizeof(effects_bubble_shader_uniforms), "" when out is NULL). */
+/* Statuses: EFFECTS_OK; those of effects_bubble_mesh_make for params (the radius checked as for
+ * a wobbled mesh: the shader wobbles); EFFECTS_INVALID_ARGUMENT: "/time" when t is not finite,
+ * "/size" when out->size is not sizeof(effects_bubble_shader_uniforms), "" when out is NULL. */
 effects_status effects_bubble_shader_uniforms_at(const effects_bubble_params* params, double t,
                                                  effects_bubble_shader_uniforms* out, effects_error** error);
 
