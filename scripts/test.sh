@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-scripts/build.sh -DEFFECTD_TESTS=ON -DEFFECTD_BENCH=ON
+scripts/build.sh -DEFFECTD_TESTS=ON -DEFFECTD_BENCH=ON -DEFFECTD_LAB=ON
 ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j "$(nproc)" "$@"
 scripts/test-image.sh  # the container image, served from (skips, saying why, where podman cannot run)
 

@@ -2,7 +2,7 @@
 // Markdown, for scripts/calibration-table.py to place in docs/lightning-calibration.md.
 #include <cstdio>
 
-#include "calibration.h"
+#include "lightning/calibration.h"
 
 int main() {
   std::fputs(effects::lightning::calibrationMarkdown().c_str(), stdout);

@@ -10,6 +10,8 @@
 
 #include <effects/lightning.h>
 
+#include "lightning/hooks.h"
+
 #include "fixtures.h"
 
 namespace effects::lightning {

@@ -8,6 +8,8 @@
 
 #include <effects/lightning.h>
 
+#include "lightning/hooks.h"
+
 #include "fixtures.h"
 
 namespace effects::lightning {

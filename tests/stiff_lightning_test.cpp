@@ -11,7 +11,7 @@
 
 #include <effects/lightning.h>
 
-#include "deep_field.h"
+#include "lightning/deep_field.h"
 
 namespace {
 

@@ -10,7 +10,9 @@
 
 #include <effects/lightning.h>
 
-#include "nearest.h"
+#include "lightning/hooks.h"
+
+#include "lightning/nearest.h"
 
 namespace effects::lightning {
 namespace {

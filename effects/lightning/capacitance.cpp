@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "laplace3.h"
+#include "map_cache.h"
 
 namespace effects::lightning::detail {
 

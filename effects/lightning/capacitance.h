@@ -41,7 +41,7 @@ class BoxGreen {
   std::vector<double> k_;
 };
 
-// The table of a grid size, kept beside the boundary maps (grid.h: cachedMap).
+// The table of a grid size, kept beside the boundary maps (map_cache.h).
 std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth = 0);
 
 class Capacitance final : public Potential {

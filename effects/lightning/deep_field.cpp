@@ -4,7 +4,7 @@
 #include <cfloat>
 #include <cmath>
 
-#include "potential.h"
+#include "solver_choice.h"
 
 namespace effects::lightning::detail {
 
@@ -36,7 +36,7 @@ void DeepField::fix(Cell c, double value) {
 }
 
 std::unique_ptr<Potential> DeepField::build(int stage) const {
-  // A rebuilt stage is solved iteratively (potential.h's rule for any solver but capacitance).
+  // A rebuilt stage is solved iteratively (solver_choice.h's rule for any solver but capacitance).
   std::unique_ptr<Potential> lap = potentialFor(w_, h_, d_, Solver::kMgpcg, 0, 0);
   for (size_t i = 0; i < cells_; ++i) {
     if (zero_[i]) {

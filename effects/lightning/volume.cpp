@@ -1,9 +1,10 @@
 // Seed 002 eqn 4 in 3-D: the boundary potential of the shell around a voxel grid and of its
-// obstacle voxels, by a Barnes-Hut octree (grid.h: VolumeBoundary).
+// obstacle voxels, by a Barnes-Hut octree (boundary_map.h: VolumeBoundary).
 #include <algorithm>
 #include <cmath>
 
-#include "grid.h"
+#include "boundary_map.h"
+#include "hooks.h"
 
 namespace effects::lightning {
 namespace detail {

@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """The layers of docs/architecture.md, checked on the sources: includes point one way,
 server -> render -> effects, and inside server/ from app/ down to api/, http/, contract/.
+The library's private headers (effects/lightning/deep_field.h and the like) stay inside it: the
+product above it (render/, server/, bench/) includes its public headers only. Nothing in the
+product includes the lab's (lab/).
 
   tests/docs/layers_test.py ROOT     exit 1 naming each include that points up
 """
@@ -21,7 +24,10 @@ def layer_of(path):
 
 def violations(root):
     bad = []
-    for top in ("effects", "render", "server"):
+    private = {d for d in os.listdir(os.path.join(root, "effects"))
+               if os.path.isdir(os.path.join(root, "effects", d)) and d != "include"}
+    lab = {f for _, _, fs in os.walk(os.path.join(root, "lab")) for f in fs if f.endswith(".h")}
+    for top in ("effects", "render", "server", "bench"):
         for d, _, files in os.walk(os.path.join(root, top)):
             for f in files:
                 if not f.endswith((".h", ".cpp")):
@@ -30,6 +36,10 @@ def violations(root):
                 owner, part = layer_of(rel)
                 for inc in INCLUDE.findall(open(os.path.join(d, f), encoding="utf-8").read()):
                     first = inc.split("/")[0]
+                    if owner != "effects" and first in private:
+                        bad.append(f"{rel} includes {inc}: the library's private headers are its own")
+                    if os.path.basename(inc) in lab and not os.path.exists(os.path.join(d, inc)):
+                        bad.append(f"{rel} includes {inc}: the product does not use the lab")
                     if owner == "effects" and (first in ("render", "server") or inc.startswith("effects/render")):
                         bad.append(f"{rel} includes {inc}: effects/ is the bottom layer")
                     if owner == "render" and first in SERVER + ["server"]:

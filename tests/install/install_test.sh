@@ -22,7 +22,15 @@ cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work
 lib=$(ls "$prefix"/lib*/libeffects.so.* | head -1)
 soname=$(objdump -p "$lib" | awk '/SONAME/ {print $2}')
 [[ "$soname" =~ ^libeffects\.so\.[0-9]+$ ]] || fail "SONAME is '$soname'"
-for f in include/effects/lightning.h include/effects/version.h; do [ -f "$prefix/$f" ] || fail "$f not installed"; done
+# Hidden visibility (effects/export.h): the public headers' functions are exported, nothing
+# private (a detail:: namespace, the test hooks of effects/lightning/hooks.h).
+exported=$(nm -D --defined-only -C "$lib")
+private=$(grep -E 'effects::[a-z:]*detail::|effects::lightning::(solveLaplace|astar|boundaryPotential)' <<<"$exported" || true)
+[ -z "$private" ] || fail "libeffects.so exports private symbols: $(head -3 <<<"$private")"
+grep -q 'effects::lightning::grow(' <<<"$exported" || fail "libeffects.so does not export effects::lightning::grow"
+grep -q ' effects_bolt_grow$' <<<"$exported" || fail "libeffects.so does not export effects_bolt_grow"
+echo "ok   exports: $(grep -cE ' (effects::|effects_)' <<<"$exported") effects symbols, none private"
+for f in include/effects/lightning.h include/effects/version.h include/effects/export.h; do [ -f "$prefix/$f" ] || fail "$f not installed"; done
 ls "$prefix"/lib*/cmake/effectd/effectdConfig.cmake "$prefix"/lib*/cmake/effectd/effectdConfigVersion.cmake \
   "$prefix"/lib*/pkgconfig/effectd.pc >/dev/null || fail "package files"
 echo "ok   installed: $(cd "$prefix" && find . -type f | wc -l) files, $soname"

@@ -28,6 +28,9 @@
 #include "effects/common.h"
 #include "effects/parallel.h"
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects::bubble {
 
 // Eqn 11 moves x by a sin(phase + k x): its Jacobian is diagonal, 1 + a k cos(...), and the
@@ -262,3 +265,4 @@ struct ThinFilmTable {
 Result<ThinFilmTable> thinFilmTable(const ThinFilmOptions& o);
 
 }  // namespace effects::bubble
+EFFECTS_API_END

@@ -21,6 +21,9 @@
 #include <variant>
 #include <vector>
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects {
 
 enum class ErrorKind {
@@ -113,3 +116,4 @@ class Rng {
 };
 
 }  // namespace effects
+EFFECTS_API_END

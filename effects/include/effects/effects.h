@@ -37,9 +37,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "effects/export.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
+EFFECTS_API_BEGIN
 
 #define EFFECTS_C_API_VERSION 2 /* 2: effects_bubble_shader_uniforms_at; the shader is seed 000's */
 
@@ -345,6 +348,7 @@ typedef struct effects_bubble_shader_uniforms {
 effects_status effects_bubble_shader_uniforms_at(const effects_bubble_params* params, double t,
                                                  effects_bubble_shader_uniforms* out, effects_error** error);
 
+EFFECTS_API_END
 #ifdef __cplusplus
 }
 #endif

@@ -22,6 +22,9 @@
 
 #include "effects/common.h"
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects::fog {
 
 enum class FogType {
@@ -277,3 +280,4 @@ double measureTableError(const Fog& fog, const Table& table, double cameraHeight
                          double* where = nullptr);
 
 }  // namespace effects::fog
+EFFECTS_API_END

@@ -51,8 +51,12 @@
 
 #include "effects/common.h"
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects::lightning {
 
+// ---- The request -------------------------------------------------------------------
 struct Cell {
   int x = 0, y = 0, z = 0;  // z: 3-D grids only (0 in 2-D)
   bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
@@ -70,53 +74,8 @@ inline constexpr int kPaperLifetime = 4;
 // within and the candidates' lifetime that make the fast method's bolts meet DBM's fractal
 // dimension, cell count and branch tips. Below 256^2 in the 8-neighbourhood (2-D) the base is:
 inline constexpr double kCalibratedAxisGrowth8 = 1.2;
-struct Params;
-double calibratedAxisGrowth(const Params& p);
-// eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
-// the paper); the calibration's radius for 2-D fast, else 1.
-int calibratedScreeningRadius(const Params& p);
-// Steps a fast candidate lives (0 = forever): the calibration's lifetime.
-int calibratedLifetime(const Params& p);
-// Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth and
-// lifetime (the radius follows from screeningRadius 0 when the bolt grows).
-void calibrate(Params& p);
-// The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
-// one; 1 for every method but 2-D fast.
-int screeningRadius(const Params& p);
-// kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
-// gives DBM's dimension at the grid's eta (the calibration's charges law). Used with the
-// parameter itself at eta, their potential is far less screened than DBM's.
-double calibratedChargesEta(const Params& p);
-
-// The names the HTTP API spells ("fast", "dbm", "charges"; "mgpcg", "cg", "capacitance";
-// "auto", "astar", "none"), both ways: the one mapping the server and the C API use. parse*
-// give nullopt for any other name.
-const char* toString(Method m);
-const char* toString(Solver s);
-const char* toString(Guide g);
-std::optional<Method> parseMethod(std::string_view name);
-std::optional<Solver> parseSolver(std::string_view name);
-std::optional<Guide> parseGuide(std::string_view name);
-// The neighbourhood a request that names none grows in: 8 in 2-D, 26 in 3-D.
-int defaultNeighbourhood(int depth);
-
-// Bounds on one bolt's work. The defaults are the service's (its flags raise or lower them);
-// the C API holds untrusted parameters to them.
-struct Limits {
-  size_t maxGridCells = size_t(4096) * 4096;         // any method: width x height (x depth)
-  size_t maxSolverGridCells = size_t(256) * 256;     // kDbm and kCharges in 2-D: each step costs O(cells)
-  size_t maxSolverVolumeCells = size_t(64) * 64 * 64;  // kDbm and kCharges in 3-D
-  size_t maxGrowthSteps = 2'000'000;                 // cells added per bolt
-  // What raises each grid bound, named in checkLimits' message (the server's flags); empty: nothing.
-  std::string_view gridKnob, solverGridKnob, solverVolumeKnob;
-};
-// kLimitExceeded at "/grid" when the grid's cells exceed maxGridCells, or, for kDbm and
-// kCharges, the solver's bound (2-D or 3-D); the message names the cells, the bound and its knob.
-[[nodiscard]] std::optional<Error> checkLimits(const Params& p, const Limits& limits);
-// Working memory kDbm's capacitance solver may take on a grid (depth 0: 2-D) beyond the
-// iterative solver's (its Cholesky factor, rows of G, the grid's table of G), for admission
-// estimates; 0 where the grid is too large for it (3-D past about 80^3: MGPCG alone).
-size_t capacitanceBytes(int width, int height, int depth = 0);
+// Cells one bolt may add (Params::maxSteps, Limits::maxGrowthSteps).
+inline constexpr size_t kDefaultMaxGrowthSteps = 2'000'000;
 
 struct Params {
   int width = 128, height = 128;
@@ -148,12 +107,13 @@ struct Params {
   double tolerance = 1e-6;  // kDbm, iterative solvers: the candidates' relative accuracy (each step
                             // solves to ||r|| / ||b|| <= tolerance x their largest Phi), in [1e-12, 1e-1]
   uint64_t seed = 1;
-  size_t maxSteps = Limits{}.maxGrowthSteps;  // growth budget (cells added)
+  size_t maxSteps = kDefaultMaxGrowthSteps;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
 };
 
 [[nodiscard]] std::optional<Error> validate(const Params& p);
 
+// ---- The bolt ----------------------------------------------------------------------
 struct Node {
   Cell cell;
   int parent = -1;  // index into Bolt::nodes; -1 for the start
@@ -171,6 +131,56 @@ struct Bolt {
 
 Result<Bolt> grow(const Params& params);
 
+// ---- The calibration: the fast method's defaults -----------------------------------
+double calibratedAxisGrowth(const Params& p);
+// eqn 6's N counts the bolt cells within this Chebyshev radius (1: the adjacent cells, as in
+// the paper); the calibration's radius for 2-D fast, else 1.
+int calibratedScreeningRadius(const Params& p);
+// Steps a fast candidate lives (0 = forever): the calibration's lifetime.
+int calibratedLifetime(const Params& p);
+// Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth and
+// lifetime (the radius follows from screeningRadius 0 when the bolt grows).
+void calibrate(Params& p);
+// The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
+// one; 1 for every method but 2-D fast.
+int screeningRadius(const Params& p);
+// kCharges: the power of Kim et al.'s normalised potential (their dimension parameter) that
+// gives DBM's dimension at the grid's eta (the calibration's charges law). Used with the
+// parameter itself at eta, their potential is far less screened than DBM's.
+double calibratedChargesEta(const Params& p);
+
+// ---- Names and limits --------------------------------------------------------------
+// The names the HTTP API spells ("fast", "dbm", "charges"; "mgpcg", "cg", "capacitance";
+// "auto", "astar", "none"), both ways: the one mapping the server and the C API use. parse*
+// give nullopt for any other name.
+const char* toString(Method m);
+const char* toString(Solver s);
+const char* toString(Guide g);
+std::optional<Method> parseMethod(std::string_view name);
+std::optional<Solver> parseSolver(std::string_view name);
+std::optional<Guide> parseGuide(std::string_view name);
+// The neighbourhood a request that names none grows in: 8 in 2-D, 26 in 3-D.
+int defaultNeighbourhood(int depth);
+
+// Bounds on one bolt's work. The defaults are the service's (its flags raise or lower them);
+// the C API holds untrusted parameters to them.
+struct Limits {
+  size_t maxGridCells = size_t(4096) * 4096;         // any method: width x height (x depth)
+  size_t maxSolverGridCells = size_t(256) * 256;     // kDbm and kCharges in 2-D: each step costs O(cells)
+  size_t maxSolverVolumeCells = size_t(64) * 64 * 64;  // kDbm and kCharges in 3-D
+  size_t maxGrowthSteps = kDefaultMaxGrowthSteps;     // cells added per bolt
+  // What raises each grid bound, named in checkLimits' message (the server's flags); empty: nothing.
+  std::string_view gridKnob, solverGridKnob, solverVolumeKnob;
+};
+// kLimitExceeded at "/grid" when the grid's cells exceed maxGridCells, or, for kDbm and
+// kCharges, the solver's bound (2-D or 3-D); the message names the cells, the bound and its knob.
+[[nodiscard]] std::optional<Error> checkLimits(const Params& p, const Limits& limits);
+// Working memory kDbm's capacitance solver may take on a grid (depth 0: 2-D) beyond the
+// iterative solver's (its Cholesky factor, rows of G, the grid's table of G), for admission
+// estimates; 0 where the grid is too large for it (3-D past about 80^3: MGPCG alone).
+size_t capacitanceBytes(int width, int height, int depth = 0);
+
+// ---- Measures ----------------------------------------------------------------------
 // Box-counting dimension of a set of cells (seed 002's quality figure): for box sizes
 // 1, 2, 4, ... up to a quarter of the grid, the minimum box count over four grid offsets;
 // D is the slope of log N against log(1/s) fitted over the straightest run of >= 4 scales.
@@ -195,26 +205,6 @@ struct ShapeDistance {
 };
 ShapeDistance shapeDistance(const std::vector<BoltShape>& method, const std::vector<BoltShape>& reference);
 
-// ---- for tests and the error report --------------------------------------------------
-// Converged potential of the DBM problem for a given bolt (Phi = 0 on bolt, obstacles and
-// outside; 1 on target) by the given solver (kCapacitance: direct while its limit allows).
-// Returns the full grid, row-major.
-std::vector<double> solveLaplace(int width, int height, const std::vector<uint8_t>& obstacles,
-                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
-                                 int* iterations = nullptr, double* residual = nullptr);
-// The same on a 3-D grid (depth > 0; depth 0: the 2-D one above); cells (z * height + y) *
-// width + x.
-std::vector<double> solveLaplace(int width, int height, int depth, const std::vector<uint8_t>& obstacles,
-                                 const std::vector<Cell>& bolt, Cell target, Solver solver, double tolerance,
-                                 int* iterations = nullptr, double* residual = nullptr);
-
-// Seed 002 eqn 4: the boundary map's point-charge sum at a cell, sum over border ring and
-// obstacle cells of 1/r (Barnes-Hut, opening angle 0.5; exact for r < 2 block sizes).
-// Normalisation (division by a constant) cancels in p_i and is not applied.
-double boundaryPotential(int width, int height, const std::vector<uint8_t>& obstacles, Cell c);
-// In 3-D: the shell of voxels around the grid and the obstacle voxels (an octree, same angle).
-double boundaryPotential(int width, int height, int depth, const std::vector<uint8_t>& obstacles, Cell c);
-
 // Conservative voxelisation (3-D obstacles from meshes): sets obstacles[(z*height + y)*width
 // + x] for every voxel [x, x+1] x [y, y+1] x [z, z+1] that a triangle touches (separating-axis
 // test). positions: x, y, z per vertex in voxel units; indices: three per triangle, each
@@ -225,19 +215,6 @@ size_t voxelizeTriangles(int width, int height, int depth, const std::vector<dou
 // a mesh before the work.
 size_t voxelizationWork(int width, int height, int depth, const std::vector<double>& positions,
                         const std::vector<uint32_t>& indices);
-
-// A* over the 8-neighbourhood (octile heuristic) or the 4-neighbourhood (Manhattan); empty if
-// unreachable. With depth > 0, over the 26-neighbourhood (3-D octile) or the 6 (Manhattan).
-std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obstacles, Cell from, Cell to,
-                        int neighbourhood = 8, int depth = 0);
-// The same to the nearest reachable cell of a set (goals: flags like obstacles), guided by the
-// distance to the set's bounding box; empty if no cell of it is reachable.
-std::vector<Cell> astarToRegion(int width, int height, const std::vector<uint8_t>& obstacles, Cell from,
-                                const std::vector<uint8_t>& goals, int neighbourhood = 8, int depth = 0);
-
-}  // namespace effects::lightning
-
-namespace effects::lightning {
 
 // ---- Shape for renderers (seed 002 section 3.3) -------------------------------------
 struct ShapeParams {
@@ -264,10 +241,6 @@ struct Polyline {
 
 // Main channel first, then branches, each following its longest continuation.
 std::vector<Polyline> polylines(const Bolt& bolt, const ShapeParams& shape);
-
-}  // namespace effects::lightning
-
-namespace effects::lightning {
 
 // ---- Strike timeline: when each vertex lights and how bright the channels are -------------
 // A cloud-to-ground flash in physical units (Uman, "The Lightning Discharge"; Rakov & Uman,
@@ -340,3 +313,4 @@ double vertexBrightness(const Timeline& tl, const std::vector<Polyline>& lines, 
 std::vector<Polyline> exposure(const Timeline& tl, const std::vector<Polyline>& lines, double t0, double t1);
 
 }  // namespace effects::lightning
+EFFECTS_API_END

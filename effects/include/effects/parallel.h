@@ -14,6 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects {
 
 class Parallel {
@@ -53,3 +56,4 @@ class ThreadPool final : public Parallel {
 };
 
 }  // namespace effects
+EFFECTS_API_END

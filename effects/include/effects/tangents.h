@@ -50,6 +50,9 @@
 #include "effects/common.h"
 #include "effects/parallel.h"
 
+#include "effects/export.h"
+
+EFFECTS_API_BEGIN
 namespace effects::tangents {
 
 enum class Mode { kMikkTSpace, kPerTriangle, kPerVertex };
@@ -103,3 +106,4 @@ Frame triangleFrame(const glm::dvec3 p[3], const glm::dvec2 uv[3], const glm::dv
 double angleDeg(const glm::vec4& a, const glm::vec4& b);
 
 }  // namespace effects::tangents
+EFFECTS_API_END

@@ -1,4 +1,5 @@
-#include "potential.h"
+#include "solver_choice.h"
+#include "hooks.h"
 
 #include <algorithm>
 

@@ -1,5 +1,5 @@
 // A bolt's shape as distributions, for comparing the fast method with DBM by measures the
-// calibration was not tuned to (issue 49; bench/lightning_shape.cpp). Independent of
+// calibration was not tuned to (issue 49; lab/lightning_shape.cpp). Independent of
 // effects/lightning/shape.cpp's estimators: the box counts here are grid-aligned (no minimum
 // over offsets) and every curve is kept, not just its slope.
 //

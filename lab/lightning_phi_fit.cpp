@@ -48,6 +48,8 @@
 
 #include <effects/lightning.h>
 
+#include "lightning/hooks.h"
+
 #include "half_field.h"
 #include "layouts.h"
 

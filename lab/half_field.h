@@ -5,7 +5,7 @@
 // N1: bolt cells among the 8 neighbours, N4: among the 4 edge neighbours, N3: within 3 cells
 // (Chebyshev: screening()); E: the candidate's exposure() (bench/exposure_law.h, where the law
 // without a field is). bench/lightning_phi_fit.cpp fits the constants to DBM's step
-// distribution (the field solved from scratch: CoarseField); bench/lightning_shape.cpp
+// distribution (the field solved from scratch: CoarseField); lab/lightning_shape.cpp
 // (--method half-field) grows bolts by it (the field kept by DBM's incremental solver:
 // GrowingCoarseField) and compares their shapes.
 // 2-D, 8-neighbourhood, one point target.
@@ -20,9 +20,11 @@
 
 #include <effects/lightning.h>
 
-#include "deep_field.h"  // effects/lightning, private
+#include "lightning/hooks.h"
+
+#include "lightning/deep_field.h"
 #include "exposure_law.h"
-#include "potential.h"
+#include "lightning/solver_choice.h"
 
 namespace bench::shape {
 
