@@ -32,6 +32,7 @@
 #include <effects/tangents.h>
 #include <render/render.h>
 
+#include "api/api_render.h"
 #include "api/scene.h"
 #include "contract/config.h"
 
@@ -951,7 +952,7 @@ FogProbe fogProbe(bool quick, const json& fogDef) {
 rd::Scene sceneOf(const json& scene) {
   static const effectd::Config config;
   const effectd::RequestContext ctx{"report", config};
-  return effectd::buildScene(scene, ctx);
+  return effectd::buildScene(effectd::parseRenderRequest(scene, ctx), scene, ctx);
 }
 
 void fogPreviewTimes(bool quick, Section& out) {

@@ -14,6 +14,7 @@
 #include <render/render.h>
 
 #include "contract/config.h"
+#include "api/api_render.h"
 #include "api/scene.h"
 
 namespace {
@@ -54,7 +55,7 @@ bool measure(rd::Renderer& renderer, const effectd::RequestContext& ctx, const c
   std::string passes;
   for (int i = 0; i <= iterations; ++i) {
     effects::Stopwatch watch;
-    rd::Scene s = effectd::buildScene(body, ctx);
+    rd::Scene s = effectd::buildScene(effectd::parseRenderRequest(body, ctx), body, ctx);
     const double built = watch.ms();
     auto f = renderer.render(s);
     if (!f.ok()) {

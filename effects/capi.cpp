@@ -102,10 +102,6 @@ bool sized(size_t given, size_t known) { return given >= known; }
 
 glm::dvec3 vec(const double v[3]) { return {v[0], v[1], v[2]}; }
 
-// The largest fog table the contract allows (lightning's bounds: effects::lightning::Limits), so
-// that untrusted parameters bound the work as a request does.
-constexpr size_t kMaxTableEntries = size_t(1) << 24;
-
 effects_status toFog(const effects_fog* c, effects::fog::Fog& f, effects_error** error) {
   namespace fg = effects::fog;
   if (!c) return fail(error, EFFECTS_INVALID_ARGUMENT, "", "fog is NULL");
@@ -276,7 +272,7 @@ effects_status effects_fog_table_build(const effects_fog* fog, const effects_fog
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/size", "must be sizeof(effects_fog_table_options)");
     if (c->layout != int32_t(EFFECTS_FOG_LAYOUT_LINEAR) && c->layout != int32_t(EFFECTS_FOG_LAYOUT_WARPED))
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/layout", "is not an effects_fog_layout");
-    if (c->max_size > kMaxTableEntries)
+    if (c->max_size > effects::fog::kMaxTableEntries)
       return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSize", "at most 2^24 entries (the contract's largest table)");
     if (c->columns > c->max_size || c->elevations > c->max_size)
       return fail(error, EFFECTS_LIMIT_EXCEEDED, "/size", "columns and elevations are each at most max_size");
@@ -365,7 +361,8 @@ effects_status effects_bolt_grow(const effects_bolt_params* c, effects_bolt** bo
       return fail(error, EFFECTS_INVALID_ARGUMENT, "/method", "is not an effects_bolt_method");
     if (c->max_steps > lt::Limits{}.maxGrowthSteps)
       return fail(error, EFFECTS_LIMIT_EXCEEDED, "/maxSteps", "at most " + std::to_string(lt::Limits{}.maxGrowthSteps));
-    if (c->target_count > 64) return fail(error, EFFECTS_LIMIT_EXCEEDED, "/targets", "at most 64 targets");
+    if (c->target_count > lt::Limits{}.maxTargets)
+      return fail(error, EFFECTS_LIMIT_EXCEEDED, "/targets", "at most " + std::to_string(lt::Limits{}.maxTargets) + " targets");
     if (c->target_count && !c->targets) return fail(error, EFFECTS_INVALID_ARGUMENT, "/targets", "is NULL");
     lt::Params p;
     p.width = c->width, p.height = c->height, p.depth = c->depth;

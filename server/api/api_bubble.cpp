@@ -117,20 +117,14 @@ bb::ThinFilmOptions readThinFilm(const json& body, const bb::Params& params, con
   return o;
 }
 
+
+}  // namespace
+
 void checkThinFilmSize(const bb::ThinFilmOptions& o, const Config& config, const std::string& pointer) {
   if (size_t(o.width) * size_t(o.height) > config.limits.maxThinFilmTexels)
     throw fieldError(413, pointer + "/thinFilm/width",
                      "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " table exceeds the limit of " +
                          std::to_string(config.limits.maxThinFilmTexels) + " texels (--max-thin-film-texels)");
-}
-
-}  // namespace
-
-bb::ThinFilmOptions thinFilmOptions(const json& body, const bb::Params& params, const json& range, const Config& config,
-                                    const std::string& pointer) {
-  bb::ThinFilmOptions o = readThinFilm(body, params, range);
-  checkThinFilmSize(o, config, pointer);
-  return o;
 }
 
 namespace {
@@ -184,7 +178,7 @@ namespace {
 
 bb::Mesh buildMesh(const BubbleRequest& request, bool wobbled, const RequestContext& ctx) {
   bb::MeshOptions o = request.mesh;
-  o.t = request.time;
+  o.t = request.time.value_or(0.0);
   o.wobble = request.features.wobble && wobbled;
   o.parallel = ctx.parallel;
   // The rest shape comes with a shader that wobbles it: the same float32 limit holds.
@@ -382,10 +376,11 @@ BubbleRequest parseBubbleRequest(const json& body, const RequestContext& ctx) {
   r.features = parseBubbleFeatures(body);
   r.film = parseFilm(body, ctx.config, ctx.at);
   r.lights = parseLights(body, ctx.at);
-  r.time = body.value("time", r.time);
+  if (body.contains("time")) r.time = body["time"].get<double>();
   r.thicknessRange = thicknessRange(body, r.features, r.film);
   r.thinFilm = readThinFilm(body, r.params, r.thicknessRange);
   const json m = body.value("mesh", json::object());
+  r.meshLevelGiven = m.contains("level");
   r.mesh.level = m.value("level", r.mesh.level);
   r.mesh.maxLevel = kMaxIcosphereLevel;
   r.mesh.radius = m.value("radius", r.mesh.radius);
@@ -402,7 +397,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
   const bool film = features.shading == bb::Shading::kFilm;
   const bb::ThicknessOptions& filmOptions = request.film;
   const std::vector<bb::Light>& lights = request.lights;
-  const double t = request.time;
+  const double t = request.time.value_or(0.0);
   const json tf = body.value("thinFilm", json::object());
   const json& range = request.thicknessRange;
   // glTF: the film model's own thickness (the field's texture over [0, its thickest], or one

@@ -32,10 +32,8 @@ std::vector<effects::bubble::Light> parseLights(const nlohmann::json& body, cons
 // or up to the film's thickest for the film model.
 nlohmann::json thicknessRange(const nlohmann::json& body, const effects::bubble::Features& f,
                               const effects::bubble::ThicknessOptions& film);
-// Throws 413 over --max-thin-film-texels.
-effects::bubble::ThinFilmOptions thinFilmOptions(const nlohmann::json& body, const effects::bubble::Params& params,
-                                                 const nlohmann::json& range, const Config& config,
-                                                 const std::string& pointer);
+// A thin-film table's size: 413 over --max-thin-film-texels, naming pointer/thinFilm/width.
+void checkThinFilmSize(const effects::bubble::ThinFilmOptions& o, const Config& config, const std::string& pointer);
 // Where the icosphere's own parameters (level, radius) sit: under `at`/mesh.
 FieldTable meshFields(const std::string& at);
 // Icosphere subdivisions: the most a request may ask for (327 680 triangles), and the default

@@ -112,7 +112,8 @@ std::string encodeTexels(const fog::Table& t, const fog::Fog& f, const std::stri
   return base64Encode(bytes);
 }
 
-json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, const json& objectColors) {
+json tableJson(const fog::Table& t, const fog::Fog& f, const std::string& encoding,
+               const std::optional<std::vector<glm::dvec3>>& objectColors) {
   json out = {{"fogType", fog::toString(f.type)},
               {"size", t.width},
               {"range", {t.rangeStart, t.rangeEnd}},
@@ -132,7 +133,6 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
       out["elevationAxis"] = "ray direction y from -1 (row 0) to 1";
     }
   }
-  const std::string encoding = options.value("encoding", "json");
   out["encoding"] = encoding;
   if (encoding == "json") {
     json factor = json::array(), contribution = json::array();
@@ -145,10 +145,9 @@ json tableJson(const fog::Table& t, const fog::Fog& f, const json& options, cons
     out["factor"] = std::move(factor);
     out["fogContribution"] = std::move(contribution);
     if (!t.inscatter.empty()) out["inscatter"] = json(t.inscatter);
-    if (!objectColors.is_null()) {
+    if (objectColors) {
       json finals = json::array();
-      for (const auto& oc : objectColors) {
-        glm::dvec3 o = toVec3(oc);
+      for (const glm::dvec3& o : *objectColors) {
         json row = json::array();
         for (size_t i = 0; i < t.factor.size(); ++i) {
           const glm::dvec3 s = scatteredAt(t, f, i);
@@ -203,16 +202,15 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
 
 // The fog function an engine pastes into its own fragment shader (render::fogShader, the
 // renderer's own), in the asked language, with its uniforms' values for the asked camera.
-json fogShaderJson(const fog::Fog& global, const std::vector<fog::Region>& regions, const json& body,
-                   const RequestContext& ctx, JsonReply& reply) {
+json fogShaderJson(const FogRequest& request, const RequestContext& ctx, JsonReply& reply) {
+  const fog::Fog& global = request.fog;
+  const std::vector<fog::Region>& regions = request.regions;
   if (regions.size() > effects::render::kMaxFogRegions)
     throw fieldError(422, ctx.at + "/regions",
                      "the fog shader takes at most " + std::to_string(effects::render::kMaxFogRegions) + " regions");
-  const json opts = body.value("shader", json::object());
-  const std::string language = opts.value("language", "glsl-es-300");
-  const glm::dvec3 camera = opts.contains("camera") ? toVec3(opts["camera"]) : glm::dvec3(0);
+  const std::string& language = request.shaderLanguage;
   effects::Stopwatch watch;
-  const effects::render::FogShader fs = effects::render::fogShader({global, regions}, camera);
+  const effects::render::FogShader fs = effects::render::fogShader({global, regions}, request.shaderCamera);
   json uniforms = json::object();
   for (const auto& u : fs.uniforms) uniforms[u.name] = {{"type", u.type}, {"values", u.values}};
   json out = {{"language", language},
@@ -246,17 +244,26 @@ FogRequest parseFogRequest(const json& body, const RequestContext& ctx) {
     for (size_t i = 0; i < body["regions"].size(); ++i)
       r.regions.push_back(parseRegion(body["regions"][i], ctx.at + "/regions/" + std::to_string(i)));
   r.table = tableOptions(body.value("table", json::object()), ctx.config);
-  r.objectColors = body.contains("objectColors") ? body["objectColors"].size() : 0;
-  r.samplePoints = body.contains("samples") ? body["samples"].value("points", json::array()).size() : 0;
+  r.encoding = body.value("table", json::object()).value("encoding", r.encoding);
+  if (body.contains("objectColors")) {
+    r.objectColors.emplace();
+    for (const json& c : body["objectColors"]) r.objectColors->push_back(toVec3(c));
+  }
+  if (body.contains("samples")) {
+    const json& s = body["samples"];
+    r.samples = FogRequest::Samples{toVec3(s["camera"]), {}};
+    for (const json& p : s["points"]) r.samples->points.push_back(toVec3(p));
+  }
+  const json shader = body.value("shader", json::object());
+  r.shaderLanguage = shader.value("language", r.shaderLanguage);
+  if (shader.contains("camera")) r.shaderCamera = toVec3(shader["camera"]);
   return r;
 }
 
-JsonReply runFog(const FogRequest& request, const json& body, const RequestContext& ctx) {
+JsonReply runFog(const FogRequest& request, const json& /*body*/, const RequestContext& ctx) {
   const Includes& include = request.include;
   const fog::Fog& global = request.fog;
   const std::vector<fog::Region>& regions = request.regions;
-  const json tableOpts = body.value("table", json::object());
-  const json objectColors = body.contains("objectColors") ? body["objectColors"] : json();
 
   JsonReply reply;
   reply.method = std::string("table-") + fog::toString(global.type);
@@ -275,7 +282,7 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
     reply.computeMs += t.value().stats.elapsedMs;
     reply.errorMs += t.value().stats.errorMs;
     stats.push_back(statsJson(t.value().stats));
-    return tableJson(t.value(), f, tableOpts, objectColors);
+    return tableJson(t.value(), f, request.encoding, request.objectColors);
   };
   if (include.has("table")) {
     out["table"] = build(global, ctx.at + "/fog");
@@ -297,13 +304,12 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
     out["regionTables"] = std::move(list);
   }
   if (include.has("samples")) {
-    if (!body.contains("samples"))
+    if (!request.samples)
       throw fieldError(400, ctx.at + "/samples", "is required when include has \"samples\"");
     effects::Stopwatch watch;
-    glm::dvec3 camera = toVec3(body["samples"]["camera"]);
     json list = json::array();
-    for (const auto& pj : body["samples"]["points"]) {
-      const fog::Sample at = fog::sampleAt(global, regions, camera, toVec3(pj));
+    for (const glm::dvec3& point : request.samples->points) {
+      const fog::Sample at = fog::sampleAt(global, regions, request.samples->camera, point);
       const fog::Fog& f = at.region < 0 ? global : regions[size_t(at.region)].fog;
       json sample = {{"region", at.region}, {"factor", wire(at.factor)}};
       if (f.type == fog::FogType::kAtmospheric || f.directional) {  // colour = object * T + fogColor
@@ -315,7 +321,7 @@ JsonReply runFog(const FogRequest& request, const json& body, const RequestConte
     reply.computeMs += watch.ms();
     out["samples"] = std::move(list);
   }
-  if (include.has("shader")) out["shader"] = fogShaderJson(global, regions, body, ctx, reply);
+  if (include.has("shader")) out["shader"] = fogShaderJson(request, ctx, reply);
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);
   return reply;

@@ -18,49 +18,6 @@ namespace {
 using nlohmann::json;
 namespace lt = effects::lightning;
 
-std::vector<uint8_t> parseObstacles(const json& o, int w, int h, const std::string& at) {
-  for (const char* threeD : {"boxes", "spheres", "mesh", "glb"})
-    if (o.contains(threeD)) throw fieldError(400, at + "/" + threeD, "is for 3-D grids (grid.depth)");
-  std::vector<uint8_t> grid(size_t(w) * size_t(h), 0);
-  bool any = false;
-  if (o.contains("rects")) {
-    for (const auto& r : o["rects"]) {
-      int x0 = r[0], y0 = r[1], rw = r[2], rh = r[3];
-      for (int y = y0; y < std::min(h, y0 + rh); ++y)
-        for (int x = x0; x < std::min(w, x0 + rw); ++x) grid[size_t(y) * w + x] = 1;
-      any = true;
-    }
-  }
-  if (o.contains("rows")) {
-    const json& rows = o["rows"];
-    for (size_t i = 0; i < rows.size(); ++i) {
-      int y = rows[i]["y"];
-      if (y >= h) throw fieldError(400, at + "/rows/" + std::to_string(i) + "/y", "is outside the grid");
-      if (rows[i].contains("z"))
-        throw fieldError(400, at + "/rows/" + std::to_string(i) + "/z", "is for 3-D grids (grid.depth)");
-      for (const auto& run : rows[i]["runs"]) {
-        int x0 = run[0], len = run[1];
-        for (int x = x0; x < std::min(w, x0 + len); ++x) grid[size_t(y) * w + x] = 1;
-      }
-      any = true;
-    }
-  }
-  if (o.contains("bitmap")) {
-    auto bytes = base64Decode(o["bitmap"].get<std::string>());
-    if (!bytes) throw fieldError(400, at + "/bitmap", "is not valid base64 (standard alphabet, padded)");
-    size_t need = (grid.size() + 7) / 8;
-    if (bytes->size() != need)
-      throw fieldError(400, at + "/bitmap",
-                       "must decode to " + std::to_string(need) + " bytes (width*height bits), got " +
-                           std::to_string(bytes->size()));
-    for (size_t i = 0; i < grid.size(); ++i)
-      if ((uint8_t((*bytes)[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
-    any = true;
-  }
-  if (!any) grid.clear();
-  return grid;
-}
-
 // A cell of the request: [x, y] on a 2-D grid, [x, y, z] on a 3-D one.
 lt::Cell cellOf(const json& j, int depth, const std::string& at) {
   if (j.size() != (depth ? 3u : 2u))
@@ -192,7 +149,6 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   r.world = parseWorld(body);
   p.start = cellOf(body["start"], p.depth, at + "/start");
   p.targets.clear();
-  r.targetRegion = body.contains("targetRegion");
   for (size_t i = 0; i < body.value("targets", json::array()).size(); ++i)
     p.targets.push_back(cellOf(body["targets"][i], p.depth, at + "/targets/" + std::to_string(i)));
   p.eta = body.value("eta", p.eta);
@@ -213,20 +169,23 @@ LightningRequest parseLightning(const json& body, const Config& config, const st
   r.include = Includes(body, kLightningIncludes);
   r.glb = body.value("format", "json") == "glb";
   r.variant = body.value("variant", r.variant);
+  if (body.contains("lifetime")) r.lifetime = body["lifetime"].get<int>();
+  if (body.contains("axisGrowth")) r.axisGrowth = body["axisGrowth"].get<double>();
+  if (body.contains("obstacles"))
+    r.obstacles = parseCellShapes(body["obstacles"], p.width, p.height, p.depth, r.world, config, at + "/obstacles");
+  if (body.contains("targetRegion")) {
+    r.targetRegion =
+        parseCellShapes(body["targetRegion"], p.width, p.height, p.depth, r.world, config, at + "/targetRegion");
+    if (!r.targetRegion.given) throw fieldError(400, at + "/targetRegion", "holds no cell of the grid");
+  }
   return r;
 }
 
-lt::Params boltParams(const LightningRequest& r, const json& body, const Config& config, const std::string& at) {
+lt::Params boltParams(const LightningRequest& r, const std::string& at) {
   lt::Params p = r.params;
-  if (body.contains("obstacles"))  // a mesh is voxelised here
-    p.obstacles = p.depth ? parseVolumeObstacles(body["obstacles"], p.width, p.height, p.depth, r.world, config,
-                                                 at + "/obstacles")
-                          : parseObstacles(body["obstacles"], p.width, p.height, at + "/obstacles");
-  if (r.targetRegion) {
-    const json& region = body["targetRegion"];
-    p.targetRegion =
-        p.depth ? parseVolumeObstacles(region, p.width, p.height, p.depth, r.world, config, at + "/targetRegion")
-                : parseObstacles(region, p.width, p.height, at + "/targetRegion");
+  p.obstacles = drawCellShapes(r.obstacles, p.width, p.height, p.depth);  // a mesh is voxelised here
+  if (r.targetRegion.given) {
+    p.targetRegion = drawCellShapes(r.targetRegion, p.width, p.height, p.depth);
     if (std::find(p.targetRegion.begin(), p.targetRegion.end(), uint8_t(1)) == p.targetRegion.end())
       throw fieldError(400, at + "/targetRegion", "holds no cell of the grid");
   }
@@ -237,8 +196,8 @@ lt::Params boltParams(const LightningRequest& r, const json& body, const Config&
     p.chargesEta = p.eta;
     p.screeningRadius = 1;  // eqn 6's N: the adjacent cells
   }
-  p.lifetime = body.value("lifetime", p.lifetime);
-  p.axisGrowth = body.value("axisGrowth", p.axisGrowth);
+  p.lifetime = r.lifetime.value_or(p.lifetime);
+  p.axisGrowth = r.axisGrowth.value_or(p.axisGrowth);
   return p;
 }
 
@@ -274,10 +233,10 @@ std::string errorHeader(const lt::Params& p, const lt::Bolt& bolt) {
 
 }  // namespace
 
-JsonReply runLightning(const LightningRequest& request, const json& body, const RequestContext& ctx) {
+JsonReply runLightning(const LightningRequest& request, const json& /*body*/, const RequestContext& ctx) {
   const Includes& include = request.include;
   const bool glbFormat = request.glb;  // include: only timeline applies
-  lt::Params p = boltParams(request, body, ctx.config, ctx.at);
+  lt::Params p = boltParams(request, ctx.at);
   p.measureError = include.has("error") && !glbFormat;
   const lt::Bolt bolt = growBolt(p, ctx.at);
   JsonReply reply;

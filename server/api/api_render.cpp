@@ -39,21 +39,6 @@ std::vector<std::pair<const json*, std::string>> sceneBubbles(const json& body) 
   return out;
 }
 
-// Each part read by its endpoint's parser at its pointer; a bubble's lights are the scene's
-// when it has them, as the render lights it.
-SceneRequest parseSceneRequest(const json& body, const RequestContext& ctx) {
-  SceneRequest r;
-  if (body.contains("lightning"))
-    r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
-  if (body.contains("fog")) r.fog = parseFogRequest(body["fog"], partContext(ctx, "/fog"));
-  for (const auto& [bubble, at] : sceneBubbles(body)) {
-    json lit = *bubble;
-    if (body.contains("lights")) lit["lights"] = body["lights"];
-    r.bubbles.push_back(parseBubbleRequest(lit, partContext(ctx, at)));
-  }
-  return r;
-}
-
 JsonReply runScene(const SceneRequest& request, const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = "scene";
@@ -90,18 +75,6 @@ JsonReply runScene(const SceneRequest& request, const json& body, const RequestC
   return reply;
 }
 
-RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
-  RenderRequest r;
-  r.scene = parseSceneRequest(body, ctx);
-  r.reference = body.value("reference", r.reference);
-  r.measureError = body.value("measureError", r.measureError);
-  const rd::Scene defaults;
-  r.width = body.value("width", defaults.width);
-  r.height = body.value("height", defaults.height);
-  if (body.contains("frames")) r.frames = body["frames"]["count"].get<int>();
-  r.backgroundImage = body.contains("background") && body["background"].contains("image");
-  return r;
-}
 
 // The bubble ray traced on the CPU (render::referenceRender), a still of at most
 // kMaxReferencePixels: the answer of `reference: true` and what `measureError` compares with.
@@ -160,7 +133,7 @@ std::vector<std::string> passEstimates(const rd::Scene& scene, bool bubbleMeasur
 JsonReply referenceReply(const RenderRequest& request, const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = "reference";
-  rd::Scene scene = buildScene(body, ctx, &reply.computeMs);
+  rd::Scene scene = buildScene(request, body, ctx, &reply.computeMs);
   auto r = traceReference(request, scene, body, ctx);
   auto png = rd::encodePng(r.image, scene.bitDepth, ctx.parallel);
   if (!png.ok()) throwError(png.error());
@@ -173,6 +146,35 @@ JsonReply referenceReply(const RenderRequest& request, const json& body, const R
 }
 
 }  // namespace
+
+// Each part read by its endpoint's parser at its pointer; a bubble's lights are the scene's
+// when it has them, as the render lights it.
+SceneRequest parseSceneRequest(const json& body, const RequestContext& ctx) {
+  SceneRequest r;
+  if (body.contains("lightning"))
+    r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
+  if (body.contains("fog")) r.fog = parseFogRequest(body["fog"], partContext(ctx, "/fog"));
+  for (const auto& [bubble, at] : sceneBubbles(body)) {
+    json lit = *bubble;
+    if (body.contains("lights")) lit["lights"] = body["lights"];
+    r.bubbles.push_back(parseBubbleRequest(lit, partContext(ctx, at)));
+  }
+  return r;
+}
+
+RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
+  RenderRequest r;
+  r.scene = parseSceneRequest(body, ctx);
+  r.reference = body.value("reference", r.reference);
+  r.measureError = body.value("measureError", r.measureError);
+  const rd::Scene defaults;
+  r.width = body.value("width", defaults.width);
+  r.height = body.value("height", defaults.height);
+  if (body.contains("frames")) r.frames = body["frames"]["count"].get<int>();
+  r.backgroundImage = body.contains("background") && body["background"].contains("image");
+  return r;
+}
+
 
 void addRenderEndpoints(Service& service) {
   const Config& config = service.config();
@@ -187,7 +189,7 @@ void addRenderEndpoints(Service& service) {
     JsonReply reply;
     reply.method = "render";
     Animation animation;
-    rd::Scene scene = buildScene(body, ctx, &reply.computeMs, &animation);
+    rd::Scene scene = buildScene(request, body, ctx, &reply.computeMs, &animation);
     std::vector<std::string> estimates = passEstimates(scene, request.measureError);
     std::optional<rd::Reference> reference;  // measureError: traced first, so that a scene it cannot
     effects::Stopwatch measuring;            // trace is refused before the GPU works

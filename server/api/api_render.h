@@ -4,11 +4,18 @@
 
 #include <cstddef>
 
+#include <nlohmann/json.hpp>
+
+#include "api/requests.h"
 #include "http/service.h"
 
 namespace effectd {
 
 void addRenderEndpoints(Service& service);
+// The scene's parts, each read by its endpoint's parser at its pointer (a bubble lit by the
+// scene's lights when it has them), and a render's frame.
+SceneRequest parseSceneRequest(const nlohmann::json& body, const RequestContext& ctx);
+RenderRequest parseRenderRequest(const nlohmann::json& body, const RequestContext& ctx);
 // The most pixels a `reference: true` render traces (400 wavelengths each).
 inline constexpr size_t kMaxReferencePixels = 512 * 512;
 

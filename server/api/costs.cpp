@@ -28,7 +28,8 @@ Cost fogCost(const FogRequest& r, const Config& config) {
   const bool height = r.fog.type == effects::fog::FogType::kHeight;
   size_t entries = height ? size * effects::fog::tableRows(r.table, size) : size;
   entries = std::min(entries, config.limits.maxTableSize);
-  return {kBase + entries * (64 + kAnswerNumber * (4 + 3 * r.objectColors)) + r.samplePoints * 8 * kAnswerNumber,
+  return {kBase + entries * (64 + kAnswerNumber * (4 + 3 * (r.objectColors ? r.objectColors->size() : 0))) +
+             (r.samples ? r.samples->points.size() : 0) * 8 * kAnswerNumber,
           false};
 }
 
@@ -54,7 +55,7 @@ Cost lightningCost(const LightningRequest& r, const Config& config) {
   // cell; at most 6 of 7 cells lie on a region's surface (a 3-D packing that leaves every
   // region cell a free neighbour), so 3 + 13 * 6/7 < 15 bytes per cell.
   const size_t perCell =
-      (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion ? 15 : 0);
+      (solver ? (depth ? 200 : 160) : (depth ? 12 : 24)) + (dbm ? 11 : 0) + (r.targetRegion.given ? 15 : 0);
   // dbm's default capacitance solver adds its Cholesky factor, rows and table.
   const bool capacitance = dbm && p.solver == lt::Solver::kCapacitance;
   const bool clamped = size_t(p.width) * size_t(p.height) > cells;  // refused by the parser

@@ -1,5 +1,6 @@
 #include "api/lightning_volume.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -115,21 +116,21 @@ void glbTriangles(const std::string& bytes, const std::string& at, std::vector<d
   for (size_t r : roots) visit(r, glm::dmat4(1));
 }
 
-// Blocks every voxel the triangles touch; positions in world units (with "world") or voxels.
-void voxelize(std::vector<double> positions, const std::vector<uint32_t>& indices, int w, int h, int d,
-              const World& world, const Config& config, const std::string& field, std::vector<uint8_t>& grid) {
+// The triangles in voxel units (positions given in world units with "world"), their work
+// bounded: every triangle tests the voxels of its bounding box.
+CellShapes::Triangles voxelTriangles(std::vector<double> positions, std::vector<uint32_t> indices, int w, int h, int d,
+                                     const World& world, const Config& config, const std::string& field) {
   for (size_t i = 0; i + 2 < positions.size(); i += 3) {
     const auto v = world.toVoxels({positions[i], positions[i + 1], positions[i + 2]});
     positions[i] = v[0], positions[i + 1] = v[1], positions[i + 2] = v[2];
   }
-  // Bounded work: every triangle tests the voxels of its bounding box.
   const size_t work = effects::lightning::voxelizationWork(w, h, d, positions, indices);
   const size_t limit = 8 * config.limits.maxGridCells;
   if (work > limit)
     throw fieldError(413, field,
                      "voxelising the triangles would test " + std::to_string(work) + " voxels; the limit is " +
                          std::to_string(limit) + " (8 x --max-grid-cells)");
-  effects::lightning::voxelizeTriangles(w, h, d, positions, indices, grid);
+  return {std::move(positions), std::move(indices)};
 }
 
 }  // namespace
@@ -144,70 +145,59 @@ World parseWorld(const json& body) {
   return w;
 }
 
-// Long because it is the list of obstacle forms a 3-D grid takes (boxes, spheres, rows, bitmap,
-// mesh, glb), each a few lines into the same voxel grid, in the schema's order.
-std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, const World& world, const Config& config,
-                                          const std::string& at) {
-  if (o.contains("rects"))
+// Long because it is the list of the forms a grid's cells take (rects; boxes, spheres; rows,
+// bitmap; mesh, glb), each read and checked in the schema's order.
+CellShapes parseCellShapes(const json& o, int w, int h, int d, const World& world, const Config& config,
+                           const std::string& at) {
+  CellShapes s;
+  if (!d) {
+    for (const char* threeD : {"boxes", "spheres", "mesh", "glb"})
+      if (o.contains(threeD)) throw fieldError(400, at + "/" + threeD, "is for 3-D grids (grid.depth)");
+  } else if (o.contains("rects")) {
     throw fieldError(400, at + "/rects", "is for 2-D grids; a 3-D grid takes boxes, spheres, rows, bitmap, mesh or glb");
-  std::vector<uint8_t> grid(size_t(w) * size_t(h) * size_t(d), 0);
-  auto index = [&](int x, int y, int z) { return (size_t(z) * size_t(h) + size_t(y)) * size_t(w) + size_t(x); };
-  bool any = false;
+  }
+  const size_t cells = size_t(w) * size_t(h) * size_t(std::max(d, 1));
+  if (o.contains("rects")) {
+    for (const auto& r : o["rects"]) s.rects.push_back({r[0].get<int>(), r[1].get<int>(), r[2].get<int>(), r[3].get<int>()});
+    s.given = true;
+  }
   if (o.contains("boxes")) {
-    for (const auto& b : o["boxes"]) {
-      const int x0 = b[0], y0 = b[1], z0 = b[2], bw = b[3], bh = b[4], bd = b[5];
-      for (int z = z0; z < std::min(d, z0 + bd); ++z)
-        for (int y = y0; y < std::min(h, y0 + bh); ++y)
-          for (int x = x0; x < std::min(w, x0 + bw); ++x) grid[index(x, y, z)] = 1;
-    }
-    any = true;
+    for (const auto& b : o["boxes"])
+      s.boxes.push_back({b[0].get<int>(), b[1].get<int>(), b[2].get<int>(), b[3].get<int>(), b[4].get<int>(),
+                         b[5].get<int>()});
+    s.given = true;
   }
   if (o.contains("spheres")) {
-    for (const auto& s : o["spheres"]) {
-      const auto c = world.toVoxels(vec3(s["center"]));
-      const double r = s["radius"].get<double>() / (world.given ? world.cellSize : 1.0);
-      auto range = [&](double centre, int n, int& lo, int& hi) {  // lo > hi: none of the grid
-        const double l = std::max(0.0, std::floor(centre - r)), u = std::min(double(n - 1), std::ceil(centre + r));
-        lo = u >= l ? int(l) : 1;  // compared first: a centre 1e33 voxels away fits no int
-        hi = u >= l ? int(u) : 0;
-      };
-      int x0, x1, y0, y1, z0, z1;
-      range(c[0], w, x0, x1), range(c[1], h, y0, y1), range(c[2], d, z0, z1);
-      for (int z = z0; z <= z1; ++z)
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) {
-            const double dx = x + 0.5 - c[0], dy = y + 0.5 - c[1], dz = z + 0.5 - c[2];
-            if (dx * dx + dy * dy + dz * dz <= r * r) grid[index(x, y, z)] = 1;
-          }
-    }
-    any = true;
+    for (const auto& sp : o["spheres"])
+      s.spheres.push_back({world.toVoxels(vec3(sp["center"])),
+                           sp["radius"].get<double>() / (world.given ? world.cellSize : 1.0)});
+    s.given = true;
   }
   if (o.contains("rows")) {
     const json& rows = o["rows"];
     for (size_t i = 0; i < rows.size(); ++i) {
       const std::string row = at + "/rows/" + std::to_string(i);
-      if (!rows[i].contains("z")) throw fieldError(400, row + "/z", "is required on a 3-D grid");
-      const int y = rows[i]["y"], z = rows[i]["z"];
-      if (y >= h) throw fieldError(400, row + "/y", "is outside the grid");
-      if (z >= d) throw fieldError(400, row + "/z", "is outside the grid");
-      for (const auto& run : rows[i]["runs"]) {
-        const int x0 = run[0], len = run[1];
-        for (int x = x0; x < std::min(w, x0 + len); ++x) grid[index(x, y, z)] = 1;
-      }
+      if (d && !rows[i].contains("z")) throw fieldError(400, row + "/z", "is required on a 3-D grid");
+      CellShapes::Row r{rows[i]["y"].get<int>(), d ? rows[i]["z"].get<int>() : 0, {}};
+      if (r.y >= h) throw fieldError(400, row + "/y", "is outside the grid");
+      if (!d && rows[i].contains("z")) throw fieldError(400, row + "/z", "is for 3-D grids (grid.depth)");
+      if (d && r.z >= d) throw fieldError(400, row + "/z", "is outside the grid");
+      for (const auto& run : rows[i]["runs"]) r.runs.push_back({run[0].get<int>(), run[1].get<int>()});
+      s.rows.push_back(std::move(r));
     }
-    any = true;
+    s.given = true;
   }
   if (o.contains("bitmap")) {
     auto bytes = base64Decode(o["bitmap"].get<std::string>());
     if (!bytes) throw fieldError(400, at + "/bitmap", "is not valid base64 (standard alphabet, padded)");
-    const size_t need = (grid.size() + 7) / 8;
+    const size_t need = (cells + 7) / 8;
     if (bytes->size() != need)
       throw fieldError(400, at + "/bitmap",
-                       "must decode to " + std::to_string(need) + " bytes (width*height*depth bits), got " +
+                       "must decode to " + std::to_string(need) + (d ? " bytes (width*height*depth bits), got "
+                                                                     : " bytes (width*height bits), got ") +
                            std::to_string(bytes->size()));
-    for (size_t i = 0; i < grid.size(); ++i)
-      if ((uint8_t((*bytes)[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
-    any = true;
+    s.bitmap = std::move(*bytes);
+    s.given = true;
   }
   if (o.contains("mesh")) {
     const json& m = o["mesh"];
@@ -221,8 +211,8 @@ std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, co
         throw fieldError(400, at + "/mesh/indices/" + std::to_string(i), "is past the last vertex");
       indices.push_back(uint32_t(v));
     }
-    voxelize(std::move(positions), indices, w, h, d, world, config, at + "/mesh", grid);
-    any = true;
+    s.meshes.push_back(voxelTriangles(std::move(positions), std::move(indices), w, h, d, world, config, at + "/mesh"));
+    s.given = true;
   }
   if (o.contains("glb")) {
     auto bytes = base64Decode(o["glb"].get<std::string>());
@@ -230,10 +220,49 @@ std::vector<uint8_t> parseVolumeObstacles(const json& o, int w, int h, int d, co
     std::vector<double> positions;
     std::vector<uint32_t> indices;
     glbTriangles(*bytes, at + "/glb", positions, indices);
-    voxelize(std::move(positions), indices, w, h, d, world, config, at + "/glb", grid);
-    any = true;
+    s.meshes.push_back(voxelTriangles(std::move(positions), std::move(indices), w, h, d, world, config, at + "/glb"));
+    s.given = true;
   }
-  if (!any) grid.clear();
+  return s;
+}
+
+std::vector<uint8_t> drawCellShapes(const CellShapes& s, int w, int h, int d) {
+  if (!s.given) return {};
+  const int depth = std::max(d, 1);
+  std::vector<uint8_t> grid(size_t(w) * size_t(h) * size_t(depth), 0);
+  auto index = [&](int x, int y, int z) { return (size_t(z) * size_t(h) + size_t(y)) * size_t(w) + size_t(x); };
+  for (const auto& [x0, y0, rw, rh] : s.rects)
+    for (int y = y0; y < std::min(h, y0 + rh); ++y)
+      for (int x = x0; x < std::min(w, x0 + rw); ++x) grid[index(x, y, 0)] = 1;
+  for (const auto& [x0, y0, z0, bw, bh, bd] : s.boxes)
+    for (int z = z0; z < std::min(depth, z0 + bd); ++z)
+      for (int y = y0; y < std::min(h, y0 + bh); ++y)
+        for (int x = x0; x < std::min(w, x0 + bw); ++x) grid[index(x, y, z)] = 1;
+  for (const CellShapes::Sphere& sp : s.spheres) {
+    const auto& c = sp.center;
+    const double r = sp.radius;
+    auto range = [&](double centre, int n, int& lo, int& hi) {  // lo > hi: none of the grid
+      const double l = std::max(0.0, std::floor(centre - r)), u = std::min(double(n - 1), std::ceil(centre + r));
+      lo = u >= l ? int(l) : 1;  // compared first: a centre 1e33 voxels away fits no int
+      hi = u >= l ? int(u) : 0;
+    };
+    int x0, x1, y0, y1, z0, z1;
+    range(c[0], w, x0, x1), range(c[1], h, y0, y1), range(c[2], depth, z0, z1);
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const double dx = x + 0.5 - c[0], dy = y + 0.5 - c[1], dz = z + 0.5 - c[2];
+          if (dx * dx + dy * dy + dz * dz <= r * r) grid[index(x, y, z)] = 1;
+        }
+  }
+  for (const CellShapes::Row& row : s.rows)
+    for (const auto& [x0, len] : row.runs)
+      for (int x = x0; x < std::min(w, x0 + len); ++x) grid[index(x, row.y, row.z)] = 1;
+  if (!s.bitmap.empty())
+    for (size_t i = 0; i < grid.size(); ++i)
+      if ((uint8_t(s.bitmap[i / 8]) >> (7 - i % 8)) & 1u) grid[i] = 1;
+  for (const CellShapes::Triangles& t : s.meshes)
+    effects::lightning::voxelizeTriangles(w, h, depth, t.positions, t.indices, grid);
   return grid;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
 #include <effects/bubble.h>
@@ -40,19 +41,28 @@ struct FogRequest {
   effects::fog::Fog fog;
   std::vector<effects::fog::Region> regions;
   effects::fog::TableOptions table;  // maxSize: the configured limit
-  size_t objectColors = 0;           // how many colours the table is also given for
-  size_t samplePoints = 0;
+  std::string encoding = "json";     // table.encoding: json, rgba8 or rgba16f
+  std::optional<std::vector<glm::dvec3>> objectColors;  // the table's final colours are also given for these
+  struct Samples {
+    glm::dvec3 camera{0};
+    std::vector<glm::dvec3> points;
+  };
+  std::optional<Samples> samples;  // exact fog at points seen from a camera
+  std::string shaderLanguage = "glsl-es-300";  // include "shader": shader.language
+  glm::dvec3 shaderCamera{0};                  // ... and the camera its uniforms are for
 };
 
 struct LightningRequest {
   Includes include{nlohmann::json::object(), kLightningIncludes};
   bool glb = false;                    // "format": "glb"
   std::string variant = "calibrated";  // or "paper"
-  effects::lightning::Params params;   // obstacles, calibration: added by the run step
+  effects::lightning::Params params;   // obstacles, region, calibration: added by the run step
+  CellShapes obstacles, targetRegion;  // as given; the run step draws them into params
+  std::optional<int> lifetime;         // the body's own, over the calibration's or the variant's
+  std::optional<double> axisGrowth;
   effects::lightning::ShapeParams shape;
   effects::lightning::TimelineParams timeline;  // animationSeed, timeScale, "timeline"
   World world;                                  // 3-D: where the grid lies ("world")
-  bool targetRegion = false;                    // "targetRegion" given (parsed by the run step)
 };
 
 struct TangentsRequest {
@@ -69,7 +79,8 @@ struct BubbleRequest {
   effects::bubble::ThicknessOptions film;
   std::vector<effects::bubble::Light> lights;
   effects::bubble::MeshOptions mesh;  // level, radius, camera; the rest is set when it is built
-  double time = 0;
+  bool meshLevelGiven = false;        // else a rendered bubble's own default level
+  std::optional<double> time;         // seconds; absent: 0, or a scene's time
   nlohmann::json thicknessRange;  // the thin-film table's axis, nm
   effects::bubble::ThinFilmOptions thinFilm;
 };
@@ -78,7 +89,8 @@ struct BubbleRequest {
 struct SceneRequest {
   std::optional<LightningRequest> lightning;
   std::optional<FogRequest> fog;
-  std::vector<BubbleRequest> bubbles;  // "bubble", then each of "bubbles"
+  std::vector<BubbleRequest> bubbles;  // "bubble", then each of "bubbles"; lit by the scene's
+                                       // lights when it has them
 };
 
 // /v1/render: the scene's parts, and the frame.

@@ -142,25 +142,18 @@ void parseQuads(const json& quads, rd::Scene& s) {
   }
 }
 
-// The scene's "/fog": a /v1/fog body, parsed by that endpoint's parsers.
-rd::Fog parseSceneFog(const json& f) {
-  rd::Fog fog;
-  fog.global = parseFog(f["fog"], "/fog/fog");
-  if (f.contains("regions")) {
-    if (f["regions"].size() > rd::kMaxFogRegions)
-      throw fieldError(422, "/fog/regions",
-                       "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
-    for (size_t i = 0; i < f["regions"].size(); ++i)
-      fog.regions.push_back(parseRegion(f["regions"][i], "/fog/regions/" + std::to_string(i)));
-  }
-  return fog;
+// The scene's "/fog", as /v1/fog's parser read it.
+rd::Fog sceneFog(const FogRequest& f) {
+  if (f.regions.size() > rd::kMaxFogRegions)
+    throw fieldError(422, "/fog/regions",
+                     "a rendered scene takes at most " + std::to_string(rd::kMaxFogRegions) + " fog regions");
+  return {f.fog, f.regions};
 }
 
-// The bolt grown by the lightning endpoint's own parser and method, in the scene's style;
-// for an animated render, its strike timeline.
-rd::Lightning sceneLightning(const json& body, const Config& config, Animation* animation) {
-  const LightningRequest r = parseLightning(body["lightning"], config, "/lightning");
-  const effects::lightning::Bolt bolt = growBolt(boltParams(r, body["lightning"], config, "/lightning"), "/lightning");
+// The bolt grown as /v1/lightning grows it (r: its parser's), in the scene's style; for an
+// animated render, its strike timeline.
+rd::Lightning sceneLightning(const LightningRequest& r, const json& body, Animation* animation) {
+  const effects::lightning::Bolt bolt = growBolt(boltParams(r, "/lightning"), "/lightning");
   rd::Lightning l;
   l.polylines = effects::lightning::polylines(bolt, r.shape);
   if (r.params.depth) {  // a 3-D bolt lies in the scene: its vertices in world units
@@ -194,21 +187,21 @@ rd::Lightning sceneLightning(const json& body, const Config& config, Animation* 
   return l;
 }
 
-// A bubble (its request `bj` at pointer `at`, its style at `styleAt`): mesh and thin-film
-// table computed once here, wobbled by the shader.
-rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at, const std::string& styleAt,
-                       const json& scene, const RequestContext& ctx, double sceneTime) {
+// A bubble (r: /v1/bubble's parser's, lit by the scene's lights when it has them; its body
+// `bj` at pointer `at`, its style at `styleAt`): mesh and thin-film table computed once here,
+// wobbled by the shader.
+rd::Bubble sceneBubble(const BubbleRequest& r, const json& bj, const json& style, const std::string& at,
+                       const std::string& styleAt, const RequestContext& ctx, double sceneTime) {
   const Config& config = ctx.config;
   rd::Bubble b;
-  const double t = bj.value("time", sceneTime);
-  b.params = parseBubbleParams(bj.value("params", json::object()), at + "/params");
-  b.features = parseBubbleFeatures(bj);
+  const double t = r.time.value_or(sceneTime);
+  b.params = r.params;
+  b.features = r.features;
   const bool film = b.features.shading == bb::Shading::kFilm;
   bb::MeshOptions o;
-  const json m = bj.value("mesh", json::object());
-  o.level = m.value("level", kRenderedIcosphereLevel);
+  o.level = r.meshLevelGiven ? r.mesh.level : kRenderedIcosphereLevel;
   o.maxLevel = kMaxIcosphereLevel;
-  o.radius = m.value("radius", 1.0);
+  o.radius = r.mesh.radius;
   o.wobble = false;  // the vertex shader wobbles (eqn 11)
   o.parallel = ctx.parallel;
   if (auto e = bb::validate(b.params)) throwError(*e, at);  // the cached sphere's were other params
@@ -217,12 +210,12 @@ rd::Bubble sceneBubble(const json& bj, const json& style, const std::string& at,
     if (auto e = bb::wobbleFits(b.params, o.radius)) throwError(*e, at + "/mesh");
   b.radius = o.radius;
   if (film) {
-    b.film = parseFilm(bj, config, at);
-    // The scene's lights light every effect; a bubble's own serve when the scene has none.
-    b.lights = scene.contains("lights") ? parseLights(scene, "") : parseLights(bj, at);
+    b.film = r.film;
+    b.lights = r.lights;
   }
   if (film || b.features.iridescence) {
-    bb::ThinFilmOptions tf = thinFilmOptions(bj, b.params, thicknessRange(bj, b.features, b.film), config, at);
+    bb::ThinFilmOptions tf = r.thinFilm;
+    checkThinFilmSize(tf, config, at);
     tf.measureError = false;
     b.thinFilm = cachedThinFilm(tf, at);
     b.thinFilmRangeNm = {tf.thicknessMinNm, tf.thicknessMaxNm};
@@ -261,7 +254,9 @@ Frames parseFrames(const json& f, const rd::Scene& s, const Config& config) {
 
 }  // namespace
 
-rd::Scene buildScene(const json& body, const RequestContext& ctx, double* computeMs, Animation* animation) {
+rd::Scene buildScene(const RenderRequest& request, const json& body, const RequestContext& ctx, double* computeMs,
+                     Animation* animation) {
+  const SceneRequest& parts = request.scene;
   const Config& config = ctx.config;
   effects::Stopwatch watch;
   rd::Scene s;
@@ -291,16 +286,17 @@ rd::Scene buildScene(const json& body, const RequestContext& ctx, double* comput
     s.blend = rd::CameraBlend{toVec3(body["cameraBlend"]["color"]), body["cameraBlend"]["amount"].get<double>()};
   if (body.contains("quads")) parseQuads(body["quads"], s);
   if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"], s.quads.size());
-  if (body.contains("fog")) s.fog = parseSceneFog(body["fog"]);
-  if (body.contains("lightning")) s.lightning = sceneLightning(body, config, animation);
+  if (parts.fog) s.fog = sceneFog(*parts.fog);
+  if (parts.lightning) s.lightning = sceneLightning(*parts.lightning, body, animation);
+  size_t k = 0;  // parts.bubbles: "bubble", then each of "bubbles"
   if (body.contains("bubble"))
-    s.bubbles.push_back(sceneBubble(body["bubble"], body.value("bubbleStyle", json::object()), "/bubble",
-                                    "/bubbleStyle", body, ctx, s.time));
+    s.bubbles.push_back(sceneBubble(parts.bubbles.at(k++), body["bubble"], body.value("bubbleStyle", json::object()),
+                                    "/bubble", "/bubbleStyle", ctx, s.time));
   if (body.contains("bubbles"))
     for (size_t i = 0; i < body["bubbles"].size(); ++i) {
       const json& item = body["bubbles"][i];
       const std::string at = "/bubbles/" + std::to_string(i);
-      s.bubbles.push_back(sceneBubble(item["bubble"], item, at + "/bubble", at, body, ctx, s.time));
+      s.bubbles.push_back(sceneBubble(parts.bubbles.at(k++), item["bubble"], item, at + "/bubble", at, ctx, s.time));
     }
   if (animation)
     for (const rd::Bubble& b : s.bubbles) animation->bubbleTimes.push_back(b.time);

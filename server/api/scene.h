@@ -5,6 +5,7 @@
 #include <render/render.h>
 #include <nlohmann/json.hpp>
 
+#include "api/requests.h"
 #include "contract/config.h"
 #include "http/service.h"
 
@@ -28,10 +29,12 @@ struct Animation {
   std::optional<effects::lightning::Timeline> strike;
 };
 
-// Computes every effect the scene contains (bolt, bubble mesh, thin-film table) and decodes
-// images. Throws ApiError naming the field, with pointers from the scene's root. With
-// `animation`, also what an animated render ("frames") needs.
-effects::render::Scene buildScene(const nlohmann::json& body, const RequestContext& ctx, double* computeMs = nullptr,
-                                  Animation* animation = nullptr);
+// Computes every effect the scene contains (bolt, bubble mesh, thin-film table) from its parts
+// as their endpoints' parsers read them (request: api_render.h's parseRenderRequest), reads
+// the scene's own fields (camera, quads, styles, frames) from its body, and decodes images.
+// Throws ApiError naming the field, with pointers from the scene's root. With `animation`,
+// also what an animated render ("frames") needs.
+effects::render::Scene buildScene(const RenderRequest& request, const nlohmann::json& body, const RequestContext& ctx,
+                                  double* computeMs = nullptr, Animation* animation = nullptr);
 
 }  // namespace effectd

@@ -23,7 +23,9 @@
 #include "http/access_log.h"
 #include "http/idle_trim.h"
 #include "contract/json_reader.h"
+#include "api/api_render.h"
 #include "api/movie.h"
+#include "api/scene.h"
 #include "app/playground.h"
 #include "http/service.h"
 
@@ -67,8 +69,9 @@ int renderToFile(const nlohmann::json& body, const effectd::Config& config, cons
   try {
     effectd::Animation animation;
     effects::ThreadPool pool(effects::ThreadPool::besideCaller());  // as the server's
+    const effectd::RequestContext ctx{"render", config, &pool};
     effects::render::Scene scene =
-        effectd::buildScene(body, effectd::RequestContext{"render", config, &pool}, nullptr, &animation);
+        effectd::buildScene(effectd::parseRenderRequest(body, ctx), body, ctx, nullptr, &animation);
     // The file's name says what it holds: a .gif only for an animated GIF, a .png for the rest.
     const bool gif = animation.frames.count > 0 && !animation.frames.flipbook;
     auto ends = [&](const char* ext) {

@@ -1,5 +1,7 @@
 #include "contract/config.h"
 
+#include <effects/fog.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <functional>
@@ -124,7 +126,7 @@ const std::vector<Option>& options() {
        "largest 3-D grid (width*height*depth) for method dbm (default 262144 = 64^3)",
        limitField(&Limits::maxSolverVolumeCells, 27, 1LL << 28)},
       {"max-table-size", "EFFECTD_MAX_TABLE_SIZE", "fog table entries (default 65536)",
-       limitField(&Limits::maxTableSize, 2, 1LL << 24)},
+       limitField(&Limits::maxTableSize, 2, effects::fog::kMaxTableEntries)},
       {"max-mesh-vertices", "EFFECTD_MAX_MESH_VERTICES", "vertices per mesh (default 2000000)",
        limitField(&Limits::maxMeshVertices, 3, 1LL << 28)},
       {"max-mesh-triangles", "EFFECTD_MAX_MESH_TRIANGLES", "triangles per mesh (default 4000000)",

@@ -11,6 +11,7 @@
 #include "api/api_lightning.h"
 #include "api/api_tangents.h"
 #include "contract/json_reader.h"
+#include "api/api_render.h"
 #include "api/scene.h"
 #include "http/service.h"
 
@@ -38,7 +39,7 @@ struct Endpoint {
 };
 
 JsonReply buildOnly(const json& body, const RequestContext& ctx) {  // no GL in a fuzzer
-  (void)effectd::buildScene(body, ctx);
+  (void)effectd::buildScene(effectd::parseRenderRequest(body, ctx), body, ctx);
   return {};
 }
 

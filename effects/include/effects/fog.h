@@ -210,6 +210,10 @@ Sample sampleAt(const Fog& global, const std::vector<Region>& regions, const glm
                 const glm::dvec3& point);
 
 // ---- Colour tables ---------------------------------------------------------------------
+// The largest table (entries: size * elevations) the service's contract allows: the top of
+// --max-table-size, and the C API's bound on untrusted options.
+inline constexpr size_t kMaxTableEntries = size_t(1) << 24;
+
 struct TableOptions {
   size_t size = 0;                             // distance samples N >= 2; 0 = pick the smallest N meeting maxError
   double maxError = 0.0;                       // used when size == 0: largest acceptable interpolation error

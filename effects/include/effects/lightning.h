@@ -169,6 +169,7 @@ struct Limits {
   size_t maxSolverGridCells = size_t(256) * 256;     // kDbm and kCharges in 2-D: each step costs O(cells)
   size_t maxSolverVolumeCells = size_t(64) * 64 * 64;  // kDbm and kCharges in 3-D
   size_t maxGrowthSteps = kDefaultMaxGrowthSteps;     // cells added per bolt
+  size_t maxTargets = 64;                            // chain lightning's targets (the contract's)
   // What raises each grid bound, named in checkLimits' message (the server's flags); empty: nothing.
   std::string_view gridKnob, solverGridKnob, solverVolumeKnob;
 };
