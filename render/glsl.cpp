@@ -78,7 +78,7 @@ std::string waveVertex(bool world) {
                 : "  gl_Position = vec4(aPosition, 1.0, 1.0);\n}\n");
 }
 
-std::string waveFragment(bool world, const FogVariant* fog) {
+std::string waveFragment(bool world, const fog::ShaderVariant* fog) {
   std::string s = std::string(kFragmentHeader) +
                   "in vec2 vUv;\nin vec3 vNormal;\nin vec4 vTangent;\nout vec4 fragColor;\n" +
                   (world ? "in vec3 vWorld;\n" : "") +
@@ -86,7 +86,7 @@ std::string waveFragment(bool world, const FogVariant* fog) {
                   "uniform vec2 uOffsetA;  // scroll offsets, reduced modulo 1 on the CPU\n"
                   "uniform vec2 uOffsetB;\n"
                   "uniform float uScale;\nuniform float uStrength;\nuniform vec3 uLightColor;\nuniform vec3 uLight;\n";
-  if (world && fog) s += fogGlsl(*fog);
+  if (world && fog) s += fog::shaderGlsl(*fog);
   s += "void main() {\n"
        "  vec3 a = texture(uNormalA, vUv * uScale + uOffsetA).xyz * 2.0 - 1.0;\n"
        "  vec3 b = texture(uNormalB, vUv * uScale * 0.73 + uOffsetB).xyz * 2.0 - 1.0;\n"
@@ -111,9 +111,9 @@ std::string quadVertex() {
          "  gl_Position = uViewProjection * vec4(aPosition, 1.0);\n}\n";
 }
 
-std::string quadFragment(const FogVariant* fog) {
+std::string quadFragment(const fog::ShaderVariant* fog) {
   std::string s = std::string(kFragmentHeader) + "in vec3 vWorld;\nin vec3 vColor;\nout vec4 fragColor;\n";
-  if (fog) s += fogGlsl(*fog);
+  if (fog) s += fog::shaderGlsl(*fog);
   s += "void main() {\n  vec3 c = vColor;\n";
   if (fog) s += "  c = applyFog(c, vWorld);\n";
   return s + "  fragColor = vec4(c, 1.0);\n}\n";

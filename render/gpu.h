@@ -96,7 +96,7 @@ struct FrameState {
   const Scene& scene;
   View view;
   Target& main;                   // premultiplied RGBA float with depth (Gpu::main)
-  std::optional<FogVariant> fog;  // the fog shader variant when the scene has fog
+  std::optional<fog::ShaderVariant> fog;  // the fog shader variant when the scene has fog
   std::string fogKey;             // ":" + its key, part of the program keys that include fog
   Texture backgroundImage;        // the backdrop image, when it is one
   Frame frame;

@@ -31,9 +31,9 @@ std::string environmentFragment(Background::Kind kind, bool sky);
 // The surface wave over the frame (NDC positions), or on a quad in the world (`world`: world
 // positions through uViewProjection, fogged as the quad when `fog`).
 std::string waveVertex(bool world);
-std::string waveFragment(bool world, const FogVariant* fog);
+std::string waveFragment(bool world, const fog::ShaderVariant* fog);
 std::string quadVertex();
-std::string quadFragment(const FogVariant* fog);
+std::string quadFragment(const fog::ShaderVariant* fog);
 std::string boltVertex(bool world);
 std::string boltFragment();
 std::string blurFragment();

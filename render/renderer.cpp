@@ -151,7 +151,7 @@ Result<Frame> Renderer::Impl::render(const Scene& scene) {
   glDisable(GL_BLEND);
   glBindVertexArray(gpu.emptyVao);
   if (scene.fog) {
-    f.fog = fogVariant(*scene.fog);
+    f.fog = fog::shaderVariant(scene.fog->global, scene.fog->regions);
     f.fogKey = ":" + f.fog->key();
   }
   const Background& bg = scene.background;

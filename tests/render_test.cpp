@@ -389,7 +389,7 @@ TEST(Render, OnlyThePassesAndCodeTheSceneNeeds) {
   EXPECT_EQ(rd::detail::quadFragment(nullptr).find("Fog"), std::string::npos);
   rd::Fog fog;
   fog.global.type = effects::fog::FogType::kGlExp;
-  auto v = rd::detail::fogVariant(fog);
+  auto v = effects::fog::shaderVariant(fog.global, fog.regions);
   const std::string withFog = rd::detail::quadFragment(&v);
   EXPECT_NE(withFog.find("applyFog"), std::string::npos);
   EXPECT_NE(withFog.find("GL_EXP"), std::string::npos);

@@ -144,7 +144,7 @@ std::optional<Error> drawBubble(Gpu& gpu, FrameState& f, const Bubble& b) {
   const bubble::Features& features = b.features;
   const bool film = features.shading == bubble::Shading::kFilm;
   auto program = gpu.program("bubble:" + bubble::variantKey(features) + f.fogKey, [&] {
-    bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fogGlsl(*f.fog) : "",
+    bubble::ShaderSource src = bubble::shader(features, bubble::Glsl::kEs300, f.fog ? fog::shaderGlsl(*f.fog) : "",
                                               f.fog ? fogFinish(features) : "");
     return std::pair{src.vertex, src.fragment};
   });

@@ -200,7 +200,7 @@ fog::TableOptions tableOptions(const json& o, const Config& config) {
   return opt;
 }
 
-// The fog function an engine pastes into its own fragment shader (render::fogShader, the
+// The fog function an engine pastes into its own fragment shader (fog::shader, the
 // renderer's own), in the asked language, with its uniforms' values for the asked camera.
 json fogShaderJson(const FogRequest& request, const RequestContext& ctx, JsonReply& reply) {
   const fog::Fog& global = request.fog;
@@ -210,7 +210,7 @@ json fogShaderJson(const FogRequest& request, const RequestContext& ctx, JsonRep
                      "the fog shader takes at most " + std::to_string(effects::render::kMaxFogRegions) + " regions");
   const std::string& language = request.shaderLanguage;
   effects::Stopwatch watch;
-  const effects::render::FogShader fs = effects::render::fogShader({global, regions}, request.shaderCamera);
+  const fog::FogShader fs = fog::shader(global, regions, request.shaderCamera);
   json uniforms = json::object();
   for (const auto& u : fs.uniforms) uniforms[u.name] = {{"type", u.type}, {"values", u.values}};
   json out = {{"language", language},

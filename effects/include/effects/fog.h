@@ -283,5 +283,36 @@ Result<Table> buildTable(const Fog& fog, const TableOptions& options);
 double measureTableError(const Fog& fog, const Table& table, double cameraHeight, int subdivisions,
                          double* where = nullptr);
 
+// ---- The fog in a shader -----------------------------------------------------------
+// GLSL without a #version line (valid in GLSL ES 3.00 and 330 core) defining
+// vec3 applyFog(vec3 rgb, vec3 world): the colour rgb seen at world position `world`, fogged
+// by `global` and `regions` (factor()'s formulas per fragment, in float), with exactly the fog
+// types and engine terms they use. effectd's renderer compiles the same text.
+struct ShaderVariant {  // what of the GLSL a fog needs; equal variants share a program
+  std::vector<FogType> types;  // distinct, sorted
+  size_t regions = 0;
+  // The engine terms some slot uses: only those are compiled in.
+  bool start = false, cutoff = false, opacity = false, secondLayer = false, directional = false;
+  bool filament = false, unreal = false;  // some slot follows that engine's convention
+  bool engine() const { return start || cutoff || opacity || directional || filament || unreal; }
+  std::string key() const;  // e.g. "fog:GL_EXP:r0"
+};
+ShaderVariant shaderVariant(const Fog& global, const std::vector<Region>& regions);
+std::string shaderGlsl(const ShaderVariant& variant);
+// The uniforms' values for a camera at `eye`: arrays flattened, slot 0 the global fog, then the
+// regions smallest first (as regionAt() picks them).
+struct ShaderUniform {
+  std::string name, type;  // e.g. "uFogParams", "vec4[3]"
+  std::vector<double> values;
+};
+std::vector<ShaderUniform> shaderUniforms(const Fog& global, const std::vector<Region>& regions,
+                                          const glm::dvec3& eye);
+struct FogShader {
+  std::string glsl;
+  std::vector<ShaderUniform> uniforms;
+};
+FogShader shader(const Fog& global, const std::vector<Region>& regions, const glm::dvec3& eye);
+
+
 }  // namespace effects::fog
 EFFECTS_API_END

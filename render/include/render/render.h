@@ -131,19 +131,6 @@ struct Fog {
 };
 inline constexpr size_t kMaxFogRegions = 16;
 
-// The fog as the renderer shades it, for an engine's own fragment shader: GLSL without a
-// #version line (valid in GLSL ES 3.00 and 330 core) defining vec3 applyFog(vec3 rgb, vec3
-// world) with exactly the formulas of the fog types `fog` uses, and its uniforms' values for a
-// camera at `eye` (arrays flattened, slot 0 the global fog, then regions smallest first).
-struct FogShader {
-  struct Uniform {
-    std::string name, type;  // e.g. "uFogParams", "vec4[3]"
-    std::vector<double> values;
-  };
-  std::string glsl;
-  std::vector<Uniform> uniforms;
-};
-FogShader fogShader(const Fog& fog, const glm::dvec3& eye);
 
 // The bubble with effectd's shader (bubble::shader) for `features` (the soap film, or seed
 // 000's model); wobble runs in the vertex shader, so the mesh is the undisturbed icosphere of
