@@ -1,5 +1,5 @@
 // The fast method's calibration against DBM (calibration.h): the one place its numbers are written.
-// Section numbers are docs/lightning-calibration.md's "how we got here" appendix.
+// Sections in quotes are docs/lightning-calibration-history.md's, where each number was measured.
 #include "calibration.h"
 
 #include <algorithm>
@@ -21,18 +21,18 @@ struct BaseLaw {
     return std::exp((c + slope * std::min(eta, etaCap)) * std::pow(ref / longest, power));
   }
 };
-constexpr BaseLaw kLaw4{0.155, 0.06, 3.0, 128.0, 0.35};  // 2-D, 4-neighbourhood (section 5)
-constexpr BaseLaw kLaw3d26{0.25, 0.0, 0.0, 32.0, 0.6};   // 3-D, 26-neighbourhood (section 10)
-constexpr BaseLaw kLaw3d6{0.32, 0.0, 0.0, 32.0, 0.55};   // 3-D, 6-neighbourhood (section 10)
-// 2-D, 8-neighbourhood below the table: kCalibratedAxisGrowth8 (lightning.h; section 3).
+constexpr BaseLaw kLaw4{0.155, 0.06, 3.0, 128.0, 0.35};  // 2-D, 4-neighbourhood ("The 4-neighbourhood")
+constexpr BaseLaw kLaw3d26{0.25, 0.0, 0.0, 32.0, 0.6};   // 3-D, 26-neighbourhood ("3-D grids: a base per voxel")
+constexpr BaseLaw kLaw3d6{0.32, 0.0, 0.0, 32.0, 0.55};   // 3-D, 6-neighbourhood ("3-D grids: a base per voxel")
+// 2-D, 8-neighbourhood below the table: kCalibratedAxisGrowth8 (lightning.h; "Candidates that never expire").
 
-// kCharges: Kim et al.'s power = coef eta^etaPower (L / ref)^sidePower (section 6).
+// kCharges: Kim et al.'s power = coef eta^etaPower (L / ref)^sidePower ("The charges method").
 struct ChargesLaw {
   double coef, etaPower, ref, sidePower;
 };
 constexpr ChargesLaw kChargesLaw{5.2, 0.7, 128.0, 0.2};
 
-// The grid side from which N is counted within a radius and the table below holds (section 11):
+// The grid side from which N is counted within a radius and the table below holds ("Screening counted within a radius"):
 // 256 in the 8-neighbourhood, 512 in the 4-neighbourhood (whose adjacent-cell law still meets
 // DBM at 256^2).
 constexpr int kTableFrom8 = 256, kTableFrom4 = 512;
@@ -53,13 +53,13 @@ using Table = std::array<std::array<Setting, kTableColumns>, Rows>;
 // Section 12 (N within radius 3, candidates that never expire). Grids with obstacles keep it
 // whole: a finite lifetime there makes the guide's legs revive their frontier again and again
 // (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta 1 with 1.035, 7, 100).
-// At eta 3, N within radius 2 up to 512^2 (section 15: radius 3 left D 0.04 low at 362^2).
+// At eta 3, N within radius 2 up to 512^2 ("Feet": radius 3 left D 0.04 low at 362^2).
 constexpr Table<3> kTable8Obstructed = {{
     {{{1.13, 3, 0}, {1.13, 3, 0}, {1.13, 3, 0}, {1.13, 2, 0}, {1.13, 3, 0}}},      // 256^2
     {{{1.085, 3, 0}, {1.095, 3, 0}, {1.095, 3, 0}, {1.115, 2, 0}, {1.11, 3, 0}}},  // 512^2
     {{{1.08, 3, 0}, {1.08, 3, 0}, {1.08, 3, 0}, {1.09, 3, 0}, {1.09, 3, 0}}},      // 1024^2
 }};
-// Open grids: the same but for 1024^2 at eta 1 (section 13) and 0.5 (section 14), where
+// Open grids: the same but for 1024^2 at eta 1 ("Low η on the largest grids") and 0.5 ("1024², η 0.5, and the grids between"), where
 // candidates that expire (with N counted over a wider square at eta 1) meet DBM.
 constexpr Table<3> kTable8 = [] {
   Table<3> t = kTable8Obstructed;
@@ -74,7 +74,7 @@ constexpr Table<3> kTable8 = [] {
 // the row below in radius or lifetime and has no foot, the step is half-way.
 constexpr Table<3> kFeet8Obstructed = [] {
   Table<3> t{};
-  t[2][3] = {1.11, 3, 0};  // eta 3: radius 3 from 513^2, from section 12's 512^2 base
+  t[2][3] = {1.11, 3, 0};  // eta 3: radius 3 from 513^2, from "A base per grid and η from 512² up"'s 512^2 base
   return t;
 }();
 constexpr Table<3> kFeet8 = [] {
@@ -94,7 +94,7 @@ constexpr bool feetFit(const Table<Rows>& table, const Table<Rows>& feet) {
     }
   return true;
 }
-// The 4-neighbourhood (sections 12, 13, 16); at 1024^2 eta 4 (and, with obstacles, 0.5 and 1)
+// The 4-neighbourhood ("A base per grid and η from 512² up", "Low η on the largest grids", "The 4-neighbourhood beyond 512²"); at 1024^2 eta 4 (and, with obstacles, 0.5 and 1)
 // is 512^2's, held.
 constexpr Table<2> kTable4Obstructed = {{
     {{{1.08, 5, 0}, {1.08, 5, 0}, {1.095, 3, 0}, {1.125, 3, 0}, {1.125, 3, 0}}},  // 512^2
@@ -107,7 +107,7 @@ constexpr Table<2> kFeet4Obstructed = [] {
   return t;
 }();
 // Open grids: candidates that expire at 1024^2, eta 1 (one DBM bolt), and at eta 0.5 from 512^2
-// (section 16: 512^2's 1.08 grew 14 % too few cells there; held beyond, eta 1's entry grew 63 %
+// ("The 4-neighbourhood beyond 512²": 512^2's 1.08 grew 14 % too few cells there; held beyond, eta 1's entry grew 63 %
 // too few at 724^2).
 constexpr Table<2> kTable4 = [] {
   Table<2> t = kTable4Obstructed;

@@ -1,8 +1,8 @@
 // The fast method's calibration against DBM, as data: the laws below the table, the table of
 // settings per grid side and eta with its feet, and the rule that blends between them. This file
 // (calibration.cpp) is the one place they are written; docs/lightning-calibration.md's
-// "Current table" is calibrationMarkdown()'s output (scripts/calibration-table.py), and the
-// sections below it say how each number was measured.
+// "Current table" is calibrationMarkdown()'s output (scripts/calibration-table.py), and
+// docs/lightning-calibration-history.md says how each number was measured.
 #pragma once
 
 #include <string>
