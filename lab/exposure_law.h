@@ -5,7 +5,7 @@
 // G = geodesic() at the start less at the candidate (its progress towards the target, as the A*
 // guide measures it), P = geodesic() at the candidate (at least 0.5); N1, N4, N3: the bolt cells
 // among the 8 neighbours, the 4 edge neighbours and within 3 cells (half_field.h, screening());
-// E: exposure(). bench/lightning_phi_fit.cpp fits the constants to DBM's single steps;
+// E: exposure(). lab/lightning_phi_fit.cpp fits the constants to DBM's single steps;
 // lab/lightning_shape.cpp (--method exposure) grows bolts by growExposureLaw and compares
 // their shapes. Results: docs/lightning-shape.md, "What a law would have to do", item 4.
 // 2-D, 8-neighbourhood, one point target.

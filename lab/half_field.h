@@ -3,8 +3,8 @@
 // around the candidate:
 //   log Phi_i = phi * ln PhiC(i) + n1 * ln N1 + n4 * ln(1 + N4) + n3 * ln N3 [+ free * ln E]
 // N1: bolt cells among the 8 neighbours, N4: among the 4 edge neighbours, N3: within 3 cells
-// (Chebyshev: screening()); E: the candidate's exposure() (bench/exposure_law.h, where the law
-// without a field is). bench/lightning_phi_fit.cpp fits the constants to DBM's step
+// (Chebyshev: screening()); E: the candidate's exposure() (lab/exposure_law.h, where the law
+// without a field is). lab/lightning_phi_fit.cpp fits the constants to DBM's step
 // distribution (the field solved from scratch: CoarseField); lab/lightning_shape.cpp
 // (--method half-field) grows bolts by it (the field kept by DBM's incremental solver:
 // GrowingCoarseField) and compares their shapes.
@@ -161,7 +161,7 @@ class GrowingCoarseField {
 };
 
 // The constants (docs/lightning-shape.md, "What a law would have to do"): phi is fitted to DBM's
-// single steps (bench/lightning_phi_fit.cpp, open 128^2, eta 2); the screening n1, n4, n3 were
+// single steps (lab/lightning_phi_fit.cpp, open 128^2, eta 2); the screening n1, n4, n3 were
 // then set by the shapes of grown bolts at that one layout and eta (single steps gave -0.32,
 // -0.25, -0.34, and bolts too bushy). Every other geometry, size and eta is judged held out.
 struct HalfFieldLaw {

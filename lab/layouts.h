@@ -1,5 +1,5 @@
 // The geometries games use, as lightning layouts for the shape comparisons (issue 49):
-// lab/lightning_shape.cpp and bench/lightning_phi_fit.cpp. At size s:
+// lab/lightning_shape.cpp and lab/lightning_phi_fit.cpp. At size s:
 //   open      the calibration's own: start top-centre, target bottom-centre, s x s
 //   off-axis  start at s/4 on the top row, target at 3s/4 on the bottom row
 //   ground    start top-centre, every bottom cell a target (a target region)

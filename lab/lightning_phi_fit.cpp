@@ -5,7 +5,7 @@
 // candidates, p_i = Phi_i^eta / sum_j Phi_j^eta. A law q_i ∝ exp(eta * sum_k beta_k f_k(i)) over
 // local features of the candidate is fitted to p by cross-entropy (Newton) on training bolts
 // and judged by the mean total-variation distance sum_i |p_i - q_i| / 2 per step on held-out
-// bolts and on other geometries (bench/layouts.h). Features:
+// bolts and on other geometries (lab/layouts.h). Features:
 //   G      eqn 8's steps along start -> target (folded past the target, as grow() does)
 //   lnB    log of eqn 4's border/obstacle potential
 //   lnP    log of eqn 5's distance to the target (at least 0.5)
@@ -16,10 +16,10 @@
 //          method's lifetime cuts at
 //   lnLead log(1 + how far the bolt's leading cell is ahead of the candidate along the axis)
 //   lnPhiC log of the Laplace field solved on a grid F times coarser (--coarse F, default 2),
-//          read around the candidate (bench/half_field.h, CoarseField): the field's screening at
+//          read around the candidate (lab/half_field.h, CoarseField): the field's screening at
 //          1/F^2 of the cells
 //   lnNcal log of the bolt cells within the calibrated screening radius (the calibrated law's N)
-//   lnFree log of the candidate's exposure (bench/exposure_law.h, exposure()): the mean length 16
+//   lnFree log of the candidate's exposure (lab/exposure_law.h, exposure()): the mean length 16
 //          rays travel before they meet the bolt, an obstacle or the border, capped at --reach
 //          (default 16). The field's short-range screening without a solve
 //   lnPgeo log of the distance to the target around the obstacles (exposure_law.h, geodesic())
@@ -28,7 +28,7 @@
 // The laws compared: every candidate alike (the scale of the distances); the paper's eqn 8
 // (a = 2, N adjacent, lifetime 4); the calibrated fast method (calibrate(): its base, radius and
 // lifetime; candidates past the lifetime have q = 0); eqn 8's terms with fitted constants, then
-// with lnAge and lnLead; the coarse field with the neighbour counts (bench/half_field.h's law);
+// with lnAge and lnLead; the coarse field with the neighbour counts (lab/half_field.h's law);
 // exposure with eqn 8's terms, with no field at all (Ggeo, lnPgeo, the counts) and with the
 // coarse field; all of them. A law is a law if its constants fitted on one geometry and eta
 // hold at the others.

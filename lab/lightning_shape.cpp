@@ -1,6 +1,6 @@
 // The fast method's (or the charges method's) bolts against DBM's by shape, over seeds: the
 // box-count curve N(s) at every scale, the mass-radius curve, branch segment lengths, branching
-// angles and tips counted two ways (bench/bolt_shape.h). Each comparison's noise level comes
+// angles and tips counted two ways (lab/bolt_shape.h). Each comparison's noise level comes
 // from DBM against DBM: random half-splits of the DBM seeds, the 95th percentile of the same
 // statistic, scaled to the sample sizes compared. "meets" = the method's distance from DBM is
 // within that noise: indistinguishable at these seeds.
@@ -9,11 +9,11 @@
 //                   [--method fast|charges|half-field|exposure] [--law ...] [--splits 40]
 //                   [--geometry open]
 //
-// half-field and exposure: the candidate laws of bench/half_field.h and bench/exposure_law.h
+// half-field and exposure: the candidate laws of lab/half_field.h and lab/exposure_law.h
 // (2-D layouts with one point target), with their constants or, after --method, --law's:
 // half-field phi,n1,n4,n3[,coarse factor[,free,reach]]; exposure g,p,n1,n4,n3,e[,reach].
 //
-// Geometries (--size s): bench/layouts.h.
+// Geometries (--size s): lab/layouts.h.
 // Where the strike ends on a region, the struck cell's distance from below the start is
 // compared too (KS). Times are per bolt, growing only (not calibrate(), not the measures).
 #include <algorithm>

@@ -160,6 +160,29 @@ TEST(LightningApi, FourNeighbourhoodGrowsFourConnectedTrees) {
   EXPECT_TRUE(hasPointer(p, "/neighbourhood")) << p.dump();
 }
 
+// An empty list of rects or rows blocks no cell on a 2-D grid: the grid stays open (no A*
+// guide under guide "auto"), the same bolt as without "obstacles"; one rect is a grid with
+// obstacles, guided.
+TEST(LightningApi, EmptyObstacleListsLeaveTheGridOpen) {
+  TestServer s;
+  json open = request(48);
+  open["include"] = {"cells", "guide"};
+  const std::string plain = s.postJson("/v1/lightning", open)->body;
+  for (const char* form : {"rects", "rows"}) {
+    json empty = open;
+    empty["obstacles"] = {{form, json::array()}};
+    auto r = s.postJson("/v1/lightning", empty);
+    ASSERT_EQ(r->status, 200) << r->body;
+    EXPECT_EQ(json::parse(r->body)["cells"], json::parse(plain)["cells"]) << form;
+    EXPECT_TRUE(json::parse(r->body)["guide"].empty()) << form;
+  }
+  json walled = open;
+  walled["obstacles"] = {{"rects", {{0, 20, 10, 2}}}};
+  auto r = s.postJson("/v1/lightning", walled);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_FALSE(json::parse(r->body)["guide"].empty());
+}
+
 TEST(LightningApi, LargeGridWithBitmapObstacles) {
   TestServer s;
   const int n = 1024;

@@ -89,7 +89,7 @@ TEST(Fast, LargeGridsCountScreeningWithinRadius3) {
 }
 
 // What calibrate() sets (base, radius, lifetime; the charges power) over grids, etas,
-// neighbourhoods and obstacles, against tests/golden/lightning-calibration.txt: the table of
+// neighbourhoods and obstacles (to 15 digits), against tests/golden/lightning-calibration.txt: the table of
 // effects/lightning/calibration.cpp, its rules between entries and beyond them, in one file a
 // reviewer reads as a diff. EFFECTD_UPDATE_GOLDEN=1 rewrites it after a deliberate change
 // (then regenerate docs/lightning-calibration.md's table: scripts/calibration-table.py).
@@ -98,7 +98,7 @@ std::string calibrationDump() {
   char line[200];
   const int sides[] = {3, 16, 64, 128, 200, 255, 256, 300, 362, 400, 511, 512, 513, 600, 609, 700,
                        724, 725, 800, 900, 1023, 1024, 1500, 2048, 4096};
-  const double etas[] = {0.1, 0.3, 0.5, 0.6, 0.75, 0.8, 1, 1.25, 1.4, 1.5, 1.6, 2, 2.4, 2.5, 3, 3.4, 3.5, 4, 5, 9};
+  const double etas[] = {0.1, 0.3, 0.5, 0.6, 0.7, 0.75, 0.8, 1, 1.25, 1.4, 1.5, 1.6, 2, 2.4, 2.5, 3, 3.4, 3.5, 4, 5, 9};
   for (int neighbourhood : {8, 4})
     for (bool walled : {false, true})
       for (int side : sides)
@@ -114,7 +114,7 @@ std::string calibrationDump() {
           calibrate(p);
           Params c = p;
           c.method = Method::kCharges;
-          std::snprintf(line, sizeof line, "2-D %d %s %4d eta %-4g: base %.10g radius %d lifetime %d charges %.10g\n",
+          std::snprintf(line, sizeof line, "2-D %d %s %4d eta %-4g: base %.15g radius %d lifetime %d charges %.15g\n",
                         neighbourhood, walled ? "walled" : "open  ", side, eta, p.axisGrowth,
                         calibratedScreeningRadius(p), p.lifetime, calibratedChargesEta(c));
           out += line;
@@ -127,7 +127,7 @@ std::string calibrationDump() {
         p.eta = eta;
         p.neighbourhood = neighbourhood;
         calibrate(p);
-        std::snprintf(line, sizeof line, "3-D %d %4d eta %-4g: base %.10g radius %d lifetime %d\n", neighbourhood,
+        std::snprintf(line, sizeof line, "3-D %d %4d eta %-4g: base %.15g radius %d lifetime %d\n", neighbourhood,
                       side, eta, p.axisGrowth, calibratedScreeningRadius(p), p.lifetime);
         out += line;
       }

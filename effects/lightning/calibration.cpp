@@ -38,9 +38,10 @@ constexpr ChargesLaw kChargesLaw{5.2, 0.7, 128.0, 0.2};
 constexpr int kTableFrom8 = 256, kTableFrom4 = 512;
 int radiusFrom(const Params& p) { return p.neighbourhood == 4 ? kTableFrom4 : kTableFrom8; }
 
-// Sections 12-16: what meets DBM per grid side (a row: 256, 512, 1024) and eta (a column:
-// kTableEtas), measured against DBM's bolts: eqn 8's base per cell, the radius N is counted
-// within, and the candidates' lifetime (0 = forever).
+// "A base per grid and η from 512² up" to "The 4-neighbourhood beyond 512²": what meets DBM per
+// grid side (a row: 256, 512, 1024) and eta (a column: kTableEtas), measured against DBM's
+// bolts: eqn 8's base per cell, the radius N is counted within, and the candidates' lifetime
+// (0 = forever).
 struct Setting {
   double base;
   int radius;
@@ -50,7 +51,7 @@ constexpr double kTableEtas[] = {0.5, 1, 2, 3, 4};
 constexpr int kTableColumns = 5;
 template <size_t Rows>
 using Table = std::array<std::array<Setting, kTableColumns>, Rows>;
-// Section 12 (N within radius 3, candidates that never expire). Grids with obstacles keep it
+// "A base per grid and η from 512² up" (N within radius 3, candidates that never expire). Grids with obstacles keep it
 // whole: a finite lifetime there makes the guide's legs revive their frontier again and again
 // (a 1024^2 maze of five walls grew 634 000 cells in 12 s at eta 1 with 1.035, 7, 100).
 // At eta 3, N within radius 2 up to 512^2 ("Feet": radius 3 left D 0.04 low at 362^2).
@@ -67,7 +68,7 @@ constexpr Table<3> kTable8 = [] {
   t[2][1] = {1.035, 7, 100};
   return t;
 }();
-// Section 15: feet. An entry with a foot reaches down to the row below: just above that row it
+// "Feet": An entry with a foot reaches down to the row below: just above that row it
 // runs with its foot, the setting measured there, and towards its own row the base goes linearly
 // and the lifetime geometrically in log2 of the side (a lifetime of 0 stays 0); the radius is the
 // foot's up to half-way, then the entry's. A foot of base 0 is none. Where an entry differs from

@@ -1,4 +1,4 @@
-// bench/bolt_shape.h, the shape statistics that compare bolts with DBM (lab/lightning_shape),
+// lab/bolt_shape.h, the shape statistics that compare bolts with DBM (lab/lightning_shape),
 // on shapes whose answers are known: a straight line, a filled square, a comb.
 #include <cmath>
 

@@ -1,4 +1,4 @@
-// bench/exposure_law.h, the law without a field of docs/lightning-shape.md ("What a law would
+// lab/exposure_law.h, the law without a field of docs/lightning-shape.md ("What a law would
 // have to do", item 4): exposure and the geodesic distance on configurations with known
 // answers, the exposure the grower keeps step by step against exposure() from scratch, and
 // bolts grown by it (a tree from the start to the target, the same for a seed).

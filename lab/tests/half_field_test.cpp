@@ -1,4 +1,4 @@
-// bench/half_field.h, the candidate law of docs/lightning-shape.md ("What a law would have to
+// lab/half_field.h, the candidate law of docs/lightning-shape.md ("What a law would have to
 // do"): its neighbour counts on a known configuration, its coarse field's boundary values and
 // screening, and bolts grown by it, with exposure and without (a tree from the start to the
 // target, the same for a seed).

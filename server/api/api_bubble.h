@@ -19,15 +19,6 @@ void addBubbleEndpoints(Service& service);
 BubbleRequest parseBubbleRequest(const nlohmann::json& body, const RequestContext& ctx);
 JsonReply runBubble(const BubbleRequest& request, const nlohmann::json& body, const RequestContext& ctx);
 JsonReply handleBubble(const nlohmann::json& body, const RequestContext& ctx);
-// The parts of a bubble body; `pointer` is where that part sits in the request (problems name
-// fields under it): params at "/params", the body itself at "" (or "/bubble" in a scene).
-effects::bubble::Params parseBubbleParams(const nlohmann::json& j, const std::string& pointer);
-// Features from the body's "features" and its "shading" model.
-effects::bubble::Features parseBubbleFeatures(const nlohmann::json& body);
-// The thickness field of the body's "film" (413 over --max-thin-film-texels, naming pointer/film/width).
-effects::bubble::ThicknessOptions parseFilm(const nlohmann::json& body, const Config& config, const std::string& pointer);
-// The body's "lights" (the default sun when absent).
-std::vector<effects::bubble::Light> parseLights(const nlohmann::json& body, const std::string& pointer);
 // The thin-film table's thickness axis, nm: the body's thinFilm.thicknessRange, else [0, 1000],
 // or up to the film's thickest for the film model.
 nlohmann::json thicknessRange(const nlohmann::json& body, const effects::bubble::Features& f,

@@ -18,8 +18,5 @@ void addFogEndpoints(Service& service);
 FogRequest parseFogRequest(const nlohmann::json& body, const RequestContext& ctx);
 JsonReply runFog(const FogRequest& request, const nlohmann::json& body, const RequestContext& ctx);
 JsonReply handleFog(const nlohmann::json& body, const RequestContext& ctx);
-// A fog object / a region from the request; problems name fields under `pointer`.
-effects::fog::Fog parseFog(const nlohmann::json& j, const std::string& pointer);
-effects::fog::Region parseRegion(const nlohmann::json& j, const std::string& pointer);
 
 }  // namespace effectd

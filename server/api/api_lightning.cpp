@@ -133,7 +133,9 @@ lt::TimelineParams parseTimeline(const json& body, uint64_t seed, const std::str
 
 }  // namespace
 
-LightningRequest parseLightning(const json& body, const Config& config, const std::string& at) {
+LightningRequest parseLightningRequest(const json& body, const RequestContext& ctx) {
+  const Config& config = ctx.config;
+  const std::string& at = ctx.at;
   LightningRequest r;
   lt::Params& p = r.params;
   p.width = body["grid"]["width"];
@@ -208,9 +210,6 @@ lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
   return std::move(grown.value());
 }
 
-LightningRequest parseLightningRequest(const json& body, const RequestContext& ctx) {
-  return parseLightning(body, ctx.config, ctx.at);
-}
 
 namespace {
 

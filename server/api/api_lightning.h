@@ -19,8 +19,6 @@ void addLightningEndpoints(Service& service);
 LightningRequest parseLightningRequest(const nlohmann::json& body, const RequestContext& ctx);
 JsonReply runLightning(const LightningRequest& request, const nlohmann::json& body, const RequestContext& ctx);
 JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx);
-// The request at JSON pointer `at` ("" for the endpoint's body); problems name fields under it.
-LightningRequest parseLightning(const nlohmann::json& body, const Config& config, const std::string& at);
 // The bolt's parameters, completed by the heavy step: the obstacles and the region drawn (a
 // mesh voxelised), the calibration for them, and the variant's and the request's overrides.
 effects::lightning::Params boltParams(const LightningRequest& request, const std::string& at);

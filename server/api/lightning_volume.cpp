@@ -157,9 +157,11 @@ CellShapes parseCellShapes(const json& o, int w, int h, int d, const World& worl
     throw fieldError(400, at + "/rects", "is for 2-D grids; a 3-D grid takes boxes, spheres, rows, bitmap, mesh or glb");
   }
   const size_t cells = size_t(w) * size_t(h) * size_t(std::max(d, 1));
+  // On a 2-D grid an empty list of rects or rows gives no cells (the grid stays open: no guide
+  // under guide "auto"); on a 3-D grid, as a bitmap, a mesh or a glb, any form given does.
   if (o.contains("rects")) {
     for (const auto& r : o["rects"]) s.rects.push_back({r[0].get<int>(), r[1].get<int>(), r[2].get<int>(), r[3].get<int>()});
-    s.given = true;
+    s.given |= !s.rects.empty();
   }
   if (o.contains("boxes")) {
     for (const auto& b : o["boxes"])
@@ -185,7 +187,7 @@ CellShapes parseCellShapes(const json& o, int w, int h, int d, const World& worl
       for (const auto& run : rows[i]["runs"]) r.runs.push_back({run[0].get<int>(), run[1].get<int>()});
       s.rows.push_back(std::move(r));
     }
-    s.given = true;
+    s.given |= d || !rows.empty();
   }
   if (o.contains("bitmap")) {
     auto bytes = base64Decode(o["bitmap"].get<std::string>());

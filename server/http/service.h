@@ -83,7 +83,9 @@ struct RequestContext {
 };
 
 // A JSON endpoint works in two steps. The first reads and checks the body's fields into the
-// endpoint's typed request (cheap: nothing is voxelised, decoded or computed) and says what
+// endpoint's typed request (work linear in the body: base64 decoded, a glTF's triangles read, a
+// mesh's voxelisation work bounded; nothing voxelised, drawn or computed; what it holds is
+// covered by the body's reservation, kJsonBodyFactor times its text) and says what
 // running it will cost, from that request; the service admits the cost (admission.h), then
 // calls `run`, which does the heavy work and answers.
 struct PreparedRequest {
