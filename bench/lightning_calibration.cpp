@@ -52,6 +52,7 @@ Sample measure(const lt::Params& p) {
 }
 
 double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
@@ -60,6 +61,7 @@ double median(std::vector<double> v) {
 // median cells.
 double row(const std::string& grid, double eta, const char* method, const std::string& setting, const lt::Params& base, int seeds,
            int firstSeed = 1) {
+  if (seeds <= 0) return std::nan("");  // --seeds 0: DBM's rows alone
   std::vector<double> d, cells, tips;
   double ms = 0;
   for (int s = firstSeed; s < firstSeed + seeds; ++s) {
@@ -183,6 +185,7 @@ int main(int argc, char** argv) {
         const double dbmCells = row(grid, eta, "dbm", std::string(lt::toString(p.solver)) + " (default)", p, dbmSeeds, dbmFirstSeed);
         if (fit) {
           for (double sc : screenings) {
+            if (seeds <= 0) break;
             lt::Params f = base;
             f.lifetime = lifetimes.front();
             f.screening = sc;
