@@ -1,6 +1,9 @@
 # Multi-stage: build with the same setup script as developers and CI; run as a non-root user
 # from an image that holds effectd, the libraries it loads and Mesa's software renderer only.
 #   podman build --isolation=chroot -t effectd .       (or docker build -t effectd .)
+# The default target, edge, puts nginx in front of effectd in the one container (publish 8080;
+# the admin port 9090 is for probes and Prometheus). --target runtime is effectd alone, for a
+# deployment that brings its own proxy: deploy/k8s runs it beside an nginx sidecar.
 # scripts/test-image.sh builds it with a binary built on the host instead (--build-arg
 # PREBUILT=1: the binary staged at build/image/effectd; nothing is installed or compiled).
 FROM debian:bookworm AS build
@@ -38,3 +41,21 @@ ENV EFFECTD_HOST=0.0.0.0 EFFECTD_PORT=8080 LP_NUM_THREADS=2 XDG_CACHE_HOME=/tmp/
 HEALTHCHECK --interval=10s --timeout=3s --retries=3 CMD ["/usr/bin/curl", "-fsS", "http://127.0.0.1:8080/healthz"]
 ENTRYPOINT ["/usr/local/bin/effectd"]
 CMD ["serve"]
+
+# The edge: the runtime with nginx and bash added, effectd on loopback behind nginx
+# (deploy/image/edge.sh, deploy/nginx/pod.conf and edge.conf; docs/serving.md, "The edge").
+FROM full AS edge-closure
+RUN apt-get update -qq && apt-get install -y -qq --no-install-recommends nginx-light && rm -rf /var/lib/apt/lists/*
+COPY deploy/image/closure.sh /usr/local/bin/closure.sh
+RUN closure.sh /runtime /usr/local/bin/effectd /usr/bin/curl /usr/sbin/nginx /usr/bin/bash
+COPY deploy/image/edge.sh /runtime/usr/local/bin/effectd-edge
+COPY deploy/nginx/pod.conf /runtime/etc/effectd-edge/nginx.conf
+COPY deploy/nginx/edge.conf /runtime/etc/effectd-edge/edge.conf
+
+FROM scratch AS edge
+COPY --from=edge-closure /runtime /
+USER 10001
+EXPOSE 8080 9090
+ENV LP_NUM_THREADS=2 XDG_CACHE_HOME=/tmp/cache
+HEALTHCHECK --interval=10s --timeout=3s --retries=3 CMD ["/usr/bin/curl", "-fsS", "http://127.0.0.1:8080/healthz"]
+ENTRYPOINT ["/usr/local/bin/effectd-edge"]

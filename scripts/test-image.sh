@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Builds the container image (Dockerfile) with podman and serves from it as a cluster would:
-# the runtime image's entrypoint, as its non-root user, on a read-only root filesystem with a
-# tmpfs /tmp (deploy/k8s: readOnlyRootFilesystem, an emptyDir on /tmp). Checks /healthz,
-# /readyz, one request per endpoint, a render, and the image's HEALTHCHECK command; prints the
-# image sizes (the runtime image and the full stage it is collected from).
+# the default (edge) image's entrypoint, as its non-root user, on a read-only root filesystem
+# with a tmpfs /tmp (deploy/k8s: readOnlyRootFilesystem, an emptyDir on /tmp). Checks, through
+# nginx on the public port, /healthz, one request per endpoint and a render; that /readyz,
+# /metrics and / are not public but answered on the admin port; that effectd listens on
+# loopback only; the image's HEALTHCHECK command; that SIGTERM stops the container with status
+# 0, and that effectd dying stops it non-zero. The runtime target (effectd alone) must start
+# too. Prints the image sizes (edge, runtime, and the full stage they are collected from).
 #
 # `podman run` cannot start containers in every sandbox (crun needs rlimits and cgroups), so
 # the image's filesystem is mounted (`podman image mount`) and entered with chroot inside new
@@ -37,6 +40,7 @@ fi
 podman rmi -f "$probe" >/dev/null 2>&1 || true
 
 image=localhost/effectd:test
+runtime=localhost/effectd:test-runtime
 full=localhost/effectd:test-full
 
 # 1. The base image, made once from Debian's archive (the mirror apt uses here).
@@ -67,11 +71,17 @@ fi
 start=$(date +%s)
 blog=$(mktemp)
 podman build "${args[@]}" --target full -t "$full" . >"$blog" 2>&1 &&
+  podman build "${args[@]}" --target runtime -t "$runtime" . >>"$blog" 2>&1 &&
   podman build "${args[@]}" -t "$image" . >>"$blog" 2>&1 || { tail -30 "$blog"; say "FAIL: podman build"; exit 1; }
 say "built in $(($(date +%s) - start)) s"
 size() { podman image inspect --format '{{.Size}}' "$1"; }
-say "image size: runtime $(($(size "$image") / 1000000)) MB, full stage $(($(size "$full") / 1000000)) MB"
-[ "$(size "$image")" -lt "$(size "$full")" ] || { say "FAIL: the runtime image is not smaller than the full stage"; exit 1; }
+say "image size: edge $(($(size "$image") / 1000000)) MB, runtime $(($(size "$runtime") / 1000000)) MB, full stage $(($(size "$full") / 1000000)) MB"
+[ "$(size "$image")" -lt "$(size "$full")" ] || { say "FAIL: the edge image is not smaller than the full stage"; exit 1; }
+# The runtime target: effectd alone from its closure, as deploy/k8s runs it.
+rmnt=$(podman image mount "$runtime")
+chroot --userspec=10001:10001 "$rmnt" /usr/local/bin/effectd --help >/dev/null ||
+  { podman image unmount "$runtime" >/dev/null; say "FAIL: the runtime image's effectd does not start"; exit 1; }
+podman image unmount "$runtime" >/dev/null
 
 inspect() { podman image inspect --format "$1" "$image"; }
 user=$(inspect '{{.Config.User}}')
@@ -101,21 +111,32 @@ mount --rbind /sys "$mnt/sys"
 mount --rbind /dev "$mnt/dev"
 as_user() { env -i "${env[@]}" /usr/sbin/chroot --userspec="$user:$user" "$mnt" "$@"; }
 log=$(mktemp)
-env -i "${env[@]}" /usr/sbin/chroot --userspec="$user:$user" "$mnt" "${entry[@]}" >"$log" 2>&1 &  # env, chroot exec: $! is effectd
-pid=$!
+start() {  # the image's entrypoint; env, chroot exec: $! is the entrypoint itself
+  env -i "${env[@]}" /usr/sbin/chroot --userspec="$user:$user" "$mnt" "${entry[@]}" >"$log" 2>&1 &
+  pid=$!
+  for _ in $(seq 100); do curl -fsS "$base/healthz" >/dev/null 2>&1 && break; sleep 0.1; done
+}
 cleanup() { kill "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; }
 trap cleanup EXIT
 fail() { say "FAIL: $*"; tail -20 "$log"; exit 1; }
-port=$(printf '%s\n' "${env[@]}" | sed -n 's/^EFFECTD_PORT=//p')
-base="http://127.0.0.1:$port"
-for _ in $(seq 100); do curl -fsS "$base/healthz" >/dev/null 2>&1 && break; sleep 0.1; done
-curl -fsS "$base/healthz" >/dev/null || fail "/healthz"
-ready=$(curl -fsS "$base/readyz") || fail "/readyz: $ready"
+base=http://127.0.0.1:8080 admin=http://127.0.0.1:9090  # deploy/image/edge.sh's ports
+start
+curl -fsS "$base/healthz" >/dev/null || fail "/healthz through nginx"
+ready=$(curl -fsS "$admin/readyz") || fail "/readyz on the admin port: $ready"
 say "/readyz: $ready"
 root_opts=$(awk '$5 == "/" { print $6 }' "/proc/$pid/mountinfo")  # as the server sees its root
 case "$root_opts" in ro,* | ro) ;; *) fail "the server's root is mounted '$root_opts', not read-only" ;; esac
 if as_user /usr/bin/curl -fsS -o /tmp/../probe "$base/healthz" 2>/dev/null; then fail "the server's user could write to /"; fi
-for path in /metrics /v1/openapi.yaml /v1/schemas/fog.json; do
+for path in /metrics /readyz /; do
+  code=$(curl -sS -o /dev/null -w '%{http_code}' "$base$path")
+  [ "$code" = 404 ] || fail "GET $path on the public port answered $code, not 404"
+  [ "$path" = / ] || curl -fsS -o /dev/null "$admin$path" || fail "GET $path on the admin port"
+done
+# effectd itself listens on loopback only (8081), its admin port on every address.
+listen=$(ss -Hltn | awk '{ print $4 }' | sort | tr '\n' ' ')
+case " $listen " in *" 127.0.0.1:8081 "*) ;; *) fail "effectd is not on 127.0.0.1:8081 alone: $listen" ;; esac
+case " $listen " in *":8081 "*"0.0.0.0:8081"* | *"*:8081"*) fail "effectd listens beyond loopback: $listen" ;; esac
+for path in /v1/openapi.yaml /v1/schemas/fog.json; do
   curl -fsS -o /dev/null "$base$path" || fail "GET $path"
 done
 for effect in fog lightning tangents bubble scene; do
@@ -130,5 +151,20 @@ code=$(curl -sS -o "$png" -w '%{http_code}' -H 'Content-Type: application/json' 
 say "render: $(stat -c %s "$png") bytes of PNG"
 as_user "${health[@]}" >/dev/null || fail "the HEALTHCHECK command (${health[*]}) failed"
 [ -d "$mnt/tmp/cache" ] && say "Mesa's shader cache went to /tmp/cache"
-say "ok: served as user $user from a read-only root: /healthz /readyz /metrics, 5 effect endpoints, a render, HEALTHCHECK"
+# SIGTERM to the container (its entrypoint): nginx and effectd stop, the status is 0.
+kill -TERM "$pid"
+status=0
+timeout 30 tail --pid="$pid" -f /dev/null || fail "the container did not stop within 30 s of SIGTERM"
+wait "$pid" || status=$?
+[ "$status" = 0 ] || fail "SIGTERM: the container exited with $status"
+pgrep -f "effectd serve|nginx" -u "$user" >/dev/null && fail "a process outlived its container"
+# effectd dying on its own stops the container, not zero, for the runtime to restart it.
+start
+pkill -KILL -u "$user" -f "effectd serve"
+timeout 10 tail --pid="$pid" -f /dev/null || fail "the container outlived its effectd by 10 s"
+status=0
+wait "$pid" || status=$?
+[ "$status" != 0 ] || fail "the container exited with 0 after effectd was killed"
+pgrep -u "$user" nginx >/dev/null && fail "nginx outlived its container"
+say "ok: served as user $user from a read-only root through nginx: /healthz, 5 effect endpoints, a render; /readyz and /metrics on the admin port only; effectd on loopback; HEALTHCHECK; SIGTERM exits 0; a dead effectd stops the container ($status)"
 INNER

@@ -92,6 +92,13 @@ const std::vector<Option>& options() {
        "TCP port of an operations listener on --host serving /healthz, /readyz and /metrics, answered even when the "
        "public port is full; /metrics then leaves the public port (default 0 = none)",
        intField(&Config::adminPort, 0, 65535)},
+      {"admin-host", "EFFECTD_ADMIN_HOST",
+       "address of the --admin-port listener, for effectd on loopback behind a proxy with its operations reachable "
+       "from the cluster (default: --host)",
+       [](const std::string& s, Config& c) {
+         c.adminHost = s;
+         return !s.empty();
+       }},
       {"shutdown-grace", "EFFECTD_SHUTDOWN_GRACE",
        "seconds SIGTERM waits for requests being computed; connections idle or still sending close at once (default 20)",
        intField(&Config::shutdownGraceS, 0, 3600)},

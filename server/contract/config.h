@@ -31,6 +31,7 @@ struct Config {
   int threads = 8;           // HTTP threads kept ready
   int maxConnections = 512;  // connections served at once (one thread each); more get 503 at once
   int adminPort = 0;         // /healthz, /readyz and /metrics on their own listener; 0 = none
+  std::string adminHost;     // its address; empty = host
   int shutdownGraceS = 20;   // SIGTERM: longest wait for requests being computed, then exit
   int readTimeoutS = 10;     // a request's headers and body, all of them
   int writeTimeoutS = 10;

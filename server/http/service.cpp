@@ -553,7 +553,7 @@ int Service::bind() {
   // again on a listening socket sets its backlog (Linux), capped by net.core.somaxconn.
   if (port > 0 && listenSocket_ >= 0) ::listen(listenSocket_, SOMAXCONN);
   if (port > 0 && admin_) {
-    if (!admin_->bind_to_port(config_.host, config_.adminPort)) return -1;
+    if (!admin_->bind_to_port(config_.adminHost.empty() ? config_.host : config_.adminHost, config_.adminPort)) return -1;
     adminPort_ = config_.adminPort;
   }
   return port;

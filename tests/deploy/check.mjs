@@ -35,12 +35,11 @@ for (const a of args.slice(1)) {
 }
 const flagValue = (name) => (args.find((a) => a.startsWith(`--${name}=`)) || "").split("=")[1];
 
-// Port: the container port is the one the server is told to listen on, and the image's.
-const port = container.ports.find((p) => p.name === "http");
-check(String(port.containerPort) === flagValue("port"), `containerPort ${port.containerPort} != --port ${flagValue("port")}`);
-check(flagValue("host") === "0.0.0.0", "--host must be 0.0.0.0 inside a pod");
-check(dockerfile.includes(`EXPOSE ${port.containerPort}`), "Dockerfile EXPOSE differs from containerPort");
-check(new RegExp(`EFFECTD_PORT=${port.containerPort}\\b`).test(dockerfile), "Dockerfile EFFECTD_PORT differs");
+// Ports: effectd on the pod's loopback only (the edge is the one way in), its admin port on every
+// address for the kubelet and Prometheus.
+check(flagValue("host") === "127.0.0.1", "--host must be 127.0.0.1: only the edge in the pod reaches effectd");
+check(flagValue("admin-host") === "0.0.0.0", "--admin-host must be 0.0.0.0: probes come from outside the pod");
+check(!container.ports.some((p) => p.name !== "admin"), "effectd must declare no port but the admin one");
 
 // Probes: paths the server serves (in its contract), on the admin port (--admin-port).
 const admin = container.ports.find((p) => p.name === "admin");
@@ -56,13 +55,22 @@ for (const [name, path] of [["startupProbe", "/readyz"], ["readinessProbe", "/re
 // The edge: nginx with edge.conf in front, the only port the Service reaches.
 const edgeConf = edgeConfig.data["edge.conf"], edgeNginx = edgeConfig.data["nginx.conf"];
 check(edgeConf === readFileSync(`${root}/deploy/nginx/edge.conf`, "utf8"), "edge-config.yaml's edge.conf must be deploy/nginx/edge.conf");
+check(edgeNginx === readFileSync(`${root}/deploy/nginx/pod.conf`, "utf8"), "edge-config.yaml's nginx.conf must be deploy/nginx/pod.conf");
 const publicPort = edge?.ports.find((p) => p.name === "public");
 check(publicPort && edgeNginx.includes(`listen ${publicPort.containerPort};`), "the edge's public port must be its nginx's listen port");
 check(edgeNginx.includes(`server 127.0.0.1:${flagValue("port")};`), "the edge's upstream must be effectd's --port");
 check(pod.volumes.some((v) => v.configMap?.name === edgeConfig.metadata.name), "the edge's ConfigMap must be mounted");
 
-// Image: entrypoint and user as the Dockerfile builds them.
-check(/ENTRYPOINT \["\/usr\/local\/bin\/effectd"\]/.test(dockerfile), "Dockerfile ENTRYPOINT must be the effectd binary");
+// Image: the Deployment runs the Dockerfile's runtime target (effectd alone, its entrypoint the
+// binary, so the args above are effectd's); the default target is the edge, published on the
+// same public port as the sidecar's.
+const stage = (name) => (dockerfile.split(/^FROM /m).find((t) => new RegExp(`^\\S+ AS ${name}\\n`).test(t)) || "");
+check(/ENTRYPOINT \["\/usr\/local\/bin\/effectd"\]/.test(stage("runtime")), "the Dockerfile's runtime ENTRYPOINT must be the effectd binary");
+check(/^FROM scratch AS edge\n/m.test(dockerfile.split(/^(?=FROM )/m).pop()), "the Dockerfile's last (default) target must be the edge");
+check(stage("edge").includes(`EXPOSE ${publicPort.containerPort} ${flagValue("admin-port")}`), "the edge image must expose the public and admin ports");
+check(new RegExp(`HEALTHCHECK .*127\\.0\\.0\\.1:${publicPort.containerPort}/healthz`).test(stage("edge")),
+      "the edge image's HEALTHCHECK must call /healthz on the public port");
+check(/^effectd-runtime:/.test(container.image), "the effectd container must run the runtime target");
 check(!container.command, "command would override the image's ENTRYPOINT");
 const user = (dockerfile.match(/^USER (\d+)/m) || [])[1];
 check(String(pod.securityContext.runAsUser) === user, `runAsUser ${pod.securityContext.runAsUser} != Dockerfile USER ${user}`);
@@ -77,8 +85,6 @@ const limitMb = mib(container.resources?.limits?.memory);
 const budgetMb = Number(flagValue("memory-budget-mb"));
 check(budgetMb >= 0.4 * limitMb && budgetMb <= 0.75 * limitMb,
       `--memory-budget-mb=${flagValue("memory-budget-mb")} must be 40-75 % of limits.memory (${limitMb} MiB)`);
-check(new RegExp(`HEALTHCHECK .*127\\.0\\.0\\.1:${port.containerPort}/healthz`).test(dockerfile),
-      "Dockerfile HEALTHCHECK must call /healthz on the container port");
 check(container.resources?.requests?.cpu, "a CPU request is required for the HPA's utilisation target");
 const labels = deployment.spec.template.metadata.labels;
 for (const [k, v] of Object.entries(deployment.spec.selector.matchLabels)) check(labels[k] === v, `selector ${k} does not match the pod`);
@@ -150,4 +156,4 @@ if (failures.length) {
   console.error("deploy/k8s disagrees with the server:\n  " + failures.join("\n  "));
   process.exit(1);
 }
-console.log(`deploy/k8s ok: port ${port.containerPort} behind the edge on ${publicPort.containerPort}, probes /readyz /healthz on admin ${admin.containerPort}, ${args.length - 1} flags, user ${user}, memory budget ${budgetMb} of ${limitMb} MiB`);
+console.log(`deploy/k8s ok: effectd on loopback ${flagValue("port")} behind the edge on ${publicPort.containerPort}, probes /readyz /healthz on admin ${admin.containerPort}, ${args.length - 1} flags, user ${user}, memory budget ${budgetMb} of ${limitMb} MiB`);
