@@ -99,6 +99,9 @@ class Grower {
   Cell regionCellTouching(Cell c) const;
   void reviveFrontier(int from, size_t segmentFirstNode);
   size_t pick(std::vector<double>& logPhi, std::vector<double>& scratch);
+  // Params::progress, at most every kProgressIntervalMs: after cell c joined segment k of
+  // `segments`, aimed at `aim` from `from`. False when the callback asks to stop.
+  bool reportProgress(size_t k, Cell c, Cell from, Cell aim);
   void weighCandidates(std::vector<double>& logPhi);
   void followWaypoints(Cell newest, const std::vector<Cell>& waypoints, size_t& wp);
   double stepError(const std::vector<double>& logPhi);
@@ -107,6 +110,8 @@ class Grower {
 
   const Params& p_;
   detail::Growth s_;
+  Stopwatch sinceProgress_;      // since the last progress report (or the start)
+  double nearestToAim_ = -1;     // the segment's bolt cell nearest its aim: the distance (-1: none yet)
   detail::Stencil stencil_;
   // N counted within radius_ (1: the adjacent cells); the fast method's alone but for 1.
   const int radius_ = screeningRadius(p_);
@@ -359,6 +364,25 @@ void Grower::followWaypoints(Cell newest, const std::vector<Cell>& waypoints, si
   }
 }
 
+bool Grower::reportProgress(size_t k, Cell c, Cell from, Cell aim) {
+  auto distance = [&](Cell a) {
+    return std::sqrt(double(a.x - aim.x) * (a.x - aim.x) + double(a.y - aim.y) * (a.y - aim.y) +
+                     double(a.z - aim.z) * (a.z - aim.z));
+  };
+  const double d = distance(c);
+  if (nearestToAim_ < 0 || d < nearestToAim_) nearestToAim_ = d;
+  if (sinceProgress_.ms() < kProgressIntervalMs) return true;
+  sinceProgress_ = Stopwatch();
+  const size_t segments = p_.targets.size() + (s_.region.empty() ? 0 : 1);
+  const double span = distance(from);
+  const double done = span > 0 ? std::clamp(1.0 - nearestToAim_ / span, 0.0, 1.0) : 1.0;
+  Progress progress;
+  progress.cells = s_.bolt.nodes.size();
+  progress.steps = size_t(step_);
+  progress.fraction = std::min(1.0, (double(k) + done) / double(segments));
+  return p_.progress(progress);
+}
+
 std::optional<Error> Grower::growSegment(size_t k) {
   Bolt& bolt = s_.bolt;
   s_.toRegion = k == p_.targets.size();  // the last segment, when a region is given
@@ -389,6 +413,7 @@ std::optional<Error> Grower::growSegment(size_t k) {
     errorMs_ += w.ms();
   }
 
+  nearestToAim_ = -1;
   // Chain lightning: the new segment grows from the previous target only.
   for (size_t i = s_.cands.size(); i-- > 0;) removeCandidate(i);
   int last = from;
@@ -410,6 +435,8 @@ std::optional<Error> Grower::growSegment(size_t k) {
     last = addNode(cand.cell, cand.parent);
     addCandidatesAround(last);
     followWaypoints(cand.cell, waypoints, wp);
+    if (p_.progress && !reportProgress(k, cand.cell, fromCell, path.back()))
+      return Error{ErrorKind::kCancelled, "", "cancelled while growing, after " + std::to_string(step_) + " steps"};
   }
   method_->endSegment();
   ++step_;

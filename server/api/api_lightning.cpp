@@ -203,7 +203,8 @@ lt::Params boltParams(const LightningRequest& r, const std::string& at) {
   return p;
 }
 
-lt::Bolt growBolt(const lt::Params& p, const std::string& at) {
+lt::Bolt growBolt(lt::Params p, const std::string& at, const JobProgress& progress) {
+  if (progress) p.progress = [&progress](const lt::Progress& g) { return progress(g.fraction, g.cells, g.steps); };
   auto grown = lt::grow(p);
   if (!grown.ok())
     throwError(grown.error(), at, {{"maxSteps", {at + "/maxSteps", 1, "--max-growth-steps / maxSteps"}}});
@@ -237,7 +238,7 @@ JsonReply runLightning(const LightningRequest& request, const json& /*body*/, co
   const bool glbFormat = request.glb;  // include: only timeline applies
   lt::Params p = boltParams(request, ctx.at);
   p.measureError = include.has("error") && !glbFormat;
-  const lt::Bolt bolt = growBolt(p, ctx.at);
+  const lt::Bolt bolt = growBolt(p, ctx.at, ctx.progress);
   JsonReply reply;
   reply.method = bolt.stats.method;
   reply.computeMs = bolt.stats.elapsedMs;  // the method's own: the reference's solves are errorMs

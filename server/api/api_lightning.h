@@ -22,6 +22,8 @@ JsonReply handleLightning(const nlohmann::json& body, const RequestContext& ctx)
 // The bolt's parameters, completed by the heavy step: the obstacles and the region drawn (a
 // mesh voxelised), the calibration for them, and the variant's and the request's overrides.
 effects::lightning::Params boltParams(const LightningRequest& request, const std::string& at);
-effects::lightning::Bolt growBolt(const effects::lightning::Params& params, const std::string& at);  // throws ApiError
+// Grows the bolt; throws ApiError. With `progress` (a job's), reports to it and stops when it says so.
+effects::lightning::Bolt growBolt(effects::lightning::Params params, const std::string& at,
+                                  const JobProgress& progress = {});
 
 }  // namespace effectd

@@ -152,8 +152,9 @@ rd::Fog sceneFog(const FogRequest& f) {
 
 // The bolt grown as /v1/lightning grows it (r: its parser's), in the scene's style; for an
 // animated render, its strike timeline.
-rd::Lightning sceneLightning(const LightningRequest& r, const json& body, Animation* animation) {
-  const effects::lightning::Bolt bolt = growBolt(boltParams(r, "/lightning"), "/lightning");
+rd::Lightning sceneLightning(const LightningRequest& r, const json& body, Animation* animation,
+                             const JobProgress& progress) {
+  const effects::lightning::Bolt bolt = growBolt(boltParams(r, "/lightning"), "/lightning", progress);
   rd::Lightning l;
   l.polylines = effects::lightning::polylines(bolt, r.shape);
   if (r.params.depth) {  // a 3-D bolt lies in the scene: its vertices in world units
@@ -287,7 +288,7 @@ rd::Scene buildScene(const RenderRequest& request, const json& body, const Reque
   if (body.contains("quads")) parseQuads(body["quads"], s);
   if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"], s.quads.size());
   if (parts.fog) s.fog = sceneFog(*parts.fog);
-  if (parts.lightning) s.lightning = sceneLightning(*parts.lightning, body, animation);
+  if (parts.lightning) s.lightning = sceneLightning(*parts.lightning, body, animation, ctx.progress);
   size_t k = 0;  // parts.bubbles: "bubble", then each of "bubbles"
   if (body.contains("bubble"))
     s.bubbles.push_back(sceneBubble(parts.bubbles.at(k++), body["bubble"], body.value("bubbleStyle", json::object()),

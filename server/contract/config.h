@@ -51,6 +51,14 @@ struct Config {
   std::string apiKeysFile;               // "" = no API keys: the service is open
   std::string quotaRedis;                // redis://host:port: quotas shared by replicas; "" = per process
   int keyMaxConcurrent = 8;              // an API key's requests in progress at once (per replica)
+  // Jobs (POST /v1/jobs, Prefer: respond-async; server/http/jobs.h): the work's own limits.
+  int jobWorkers = 1;                    // jobs running at once
+  size_t maxJobGridCells = size_t(1024) * 1024;        // dbm and charges grids in a job (2-D)
+  size_t maxJobVolumeCells = size_t(128) * 128 * 128;  // dbm grids in a job (3-D)
+  int maxJobs = 256;                     // jobs kept at once, in any state
+  int jobTtlS = 3600;                    // a finished job (and its answer) is kept this long
+  size_t jobAnswersMb = 256;             // finished jobs' answers kept at once; past it the oldest go
+  int keyMaxJobs = 2;                    // an API key's jobs queued or running at once
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
   // three.js's ES module the playground's live view imports (it draws through clients/three/);

@@ -65,6 +65,7 @@ ApiError toApiError(const effects::Error& error, const std::string& prefix, cons
     case effects::ErrorKind::kLimitExceeded:
       e = {413, "limit-exceeded", "Request exceeds a configured limit", "", {}, {}};
       break;
+    case effects::ErrorKind::kCancelled: e = {409, "cancelled", "The work was cancelled", "", {}, {}}; break;
   }
   std::string message = error.message;
   if (const FieldPlace* place = placeOf(error.field, table);

@@ -40,9 +40,11 @@ class Access {
   explicit Access(const Config& config);
 
   // The request's right to ask, before its body is read: the problem that refuses it, or none
-  // (with `key` set when it came with one). `now` in Unix seconds.
+  // (with `key` set when it came with one). `now` in Unix seconds. On the jobs' routes
+  // (`jobsRoute`) a GET is asked for a key as a POST is, never for a signature, and the key's
+  // endpoints are checked against the effect a job runs when it is submitted (allows()).
   std::optional<ApiError> check(const httplib::Request& req, const std::string& route, long long now,
-                                std::optional<ApiKey>& key);
+                                std::optional<ApiKey>& key, bool jobsRoute = false);
   // Before the body is read: one of the key's places and its first unit, held by `place` until
   // the request ends. The 429 problem that refuses it (RateLimit headers set), or none.
   std::optional<ApiError> enter(const ApiKey& key, std::shared_ptr<void>& place);

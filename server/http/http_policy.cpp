@@ -203,6 +203,7 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
 
   const Route* route = findRoute(req.path);
   if (!route && req.path.rfind("/v1/schemas/", 0) == 0) route = findRoute("/v1/schemas/");
+  if (!route && req.path.rfind("/v1/jobs/", 0) == 0) route = findRoute("/v1/jobs/");
   auto fail = [&](const ApiError& p) {
     writeProblem(res, p, tl.requestId);
     return true;
@@ -242,14 +243,14 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
                      std::to_string(config_.limits.maxUrlBytes) + " (--max-url-bytes): POST the body instead",
                  {},
                  {{"Cache-Control", "no-store"}}});
-  if (effect) {
-    if (auto problem = access_->check(req, route->path, (long long)std::time(nullptr), tl.key)) {
+  if (effect || route->jobs) {
+    if (auto problem = access_->check(req, route->path, (long long)std::time(nullptr), tl.key, route->jobs)) {
       if (req.method != "POST") problem->headers["Cache-Control"] = "no-store";
       if (req.method == "POST") problem->headers["Connection"] = "close";  // its body stays unread
       return fail(*problem);
     }
-    if (tl.key) {
-      tl.keyId = tl.key->id;
+    if (tl.key) tl.keyId = tl.key->id;
+    if (tl.key && (effect || req.method == "POST")) {  // a job's status, events and answer are free to ask
       // A key that cannot pay, or has all its places taken, is refused before its body is read.
       if (auto problem = access_->enter(*tl.key, tl.keyPlace)) {
         problem->headers[req.method == "POST" ? "Connection" : "Cache-Control"] =
@@ -262,9 +263,9 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
   unsigned long long length = 0;
   if (auto problem = lengthProblem(req, config_.limits.maxBodyBytes, length)) return fail(*problem);
   std::string type = mediaType(req.get_header_value("Content-Type"));
-  bool typeOk = (type == "application/json" && route->json) || route->binary.count(type);
+  bool typeOk = (type == "application/json" && (route->json || route->jobs)) || route->binary.count(type);
   if (!typeOk) {
-    std::string accepted = route->json ? "application/json" : "";
+    std::string accepted = route->json || route->jobs ? "application/json" : "";
     for (const auto& [t, h] : route->binary) accepted += (accepted.empty() ? "" : ", ") + t;
     return fail(unsupportedMediaType(type, accepted));
   }

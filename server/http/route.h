@@ -27,6 +27,12 @@ struct Service::Route {
   };
   std::map<std::string, Binary> binary;  // by media type
   std::function<std::string()> etagSalt;
+  bool jobs = false;  // /v1/jobs and below: API keys apply (no URL signatures), JSON bodies
 };
+
+// Parses a JSON body into `body` and checks it against `schema` (400 problems), adding both
+// steps' times to `stages` (service.cpp).
+void parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema,
+                      nlohmann::json& body, Stages& stages);
 
 }  // namespace effectd

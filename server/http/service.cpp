@@ -62,8 +62,8 @@ void throwIfInvalid(const std::vector<FieldError>& violations) {
   throw ApiError{400, "invalid-field", "Request does not match the schema", detail, violations, {}};
 }
 
-// Parses a JSON body into `body` and checks it against `schema`, adding both steps' times to
-// `stages`.
+}  // namespace
+
 void parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, const std::string& schema, json& body,
                       Stages& stages) {
   effects::Stopwatch parse;
@@ -73,6 +73,8 @@ void parseJsonRequest(const std::string& text, const SchemaRegistry& schemas, co
   throwIfInvalid(schemas.validate(schema, body));
   stages.emplace_back("validate", validate.ms());
 }
+
+namespace {
 
 // What determines a JSON request's answer: its document's CBOR, one encoding per JSON value
 // whatever the spacing, key order or number spelling, in a third of the time of the text.
@@ -224,6 +226,7 @@ Service::Service(Config config)
   schemas_ = std::make_unique<SchemaRegistry>(docs);
   installCore();
   installHttpPolicy();
+  installJobs();
   metrics_.addSource([this] { return access_->metricsText(); });
   metrics_.addSource([this] {
     return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
@@ -364,8 +367,13 @@ std::string Service::reloadAccess() { return access_->reload(); }
 void Service::handlePost(const Route& route, const httplib::Request& req, httplib::Response& res) {
   std::map<std::string, std::string> query;
   for (const auto& [k, v] : req.params) query[k] = v;
-  answer(route, req.body, mediaType(req.get_header_value("Content-Type")), query, req.get_header_value("If-None-Match"),
-         res);
+  const std::string type = mediaType(req.get_header_value("Content-Type"));
+  // RFC 7240: a client that prefers an asynchronous answer gets a job (JSON bodies).
+  if (type == "application/json" && req.get_header_value("Prefer").find("respond-async") != std::string::npos) {
+    submitJob(route, req.body, res);
+    return;
+  }
+  answer(route, req.body, type, query, req.get_header_value("If-None-Match"), res, config_);
 }
 
 void Service::handleGet(const Route& route, const httplib::Request& req, httplib::Response& res) {
@@ -436,7 +444,7 @@ void Service::handleGet(const Route& route, const httplib::Request& req, httplib
   } catch (const ApiError& e) {
     return refuse(e);
   }
-  answer(route, *body, "application/json", {}, req.get_header_value("If-None-Match"), res);
+  answer(route, *body, "application/json", {}, req.get_header_value("If-None-Match"), res, config_);
   if (res.status >= 400) {
     res.set_header("Cache-Control", "no-store");
   } else if (res.has_header("ETag")) {
@@ -454,9 +462,11 @@ void Service::handleGet(const Route& route, const httplib::Request& req, httplib
 }
 
 void Service::answer(const Route& route, const std::string& bodyText, const std::string& type,
-                     const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res) {
-  RequestContext ctx{tl.requestId, config_, compute_.get()};
+                     const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res,
+                     const Config& config, const JobProgress& progress) {
+  RequestContext ctx{tl.requestId, config, compute_.get()};
   ctx.query = query;
+  ctx.progress = progress;
   // Part of what determines a binary answer; as JSON, so that no two queries read the same.
   const std::string queryText = query.empty() ? std::string() : json(query).dump();
   const Coding coding = negotiate(tl.acceptEncoding);
@@ -508,7 +518,7 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
     // answer has been written; then the key's quota is charged it.
     PreparedRequest prepared;
     if (!isBinary) prepared = route.json(body, ctx);
-    const Cost cost = isBinary ? binary->second.cost(bodyText, config_) : prepared.cost;
+    const Cost cost = isBinary ? binary->second.cost(bodyText, config) : prepared.cost;
     // Charged first, what X-Memory-Reserved says (the work's and the body's reservations
     // together), so that a key that cannot pay never waits for admission; a request that
     // admission then refuses (503, 413) gets its units back.

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -23,6 +24,7 @@
 #include "contract/schema.h"
 #include "http/admission.h"
 #include "http/idle_trim.h"
+#include "http/jobs.h"
 #include "http/metrics.h"
 #include "http/response_cache.h"
 
@@ -80,6 +82,9 @@ struct RequestContext {
   std::string at = "";
   // The query string's parameters (binary bodies take their options there; JSON bodies have none).
   std::map<std::string, std::string> query = {};
+  // Set when the work runs as a job (jobs.h): long work reports its progress and stops when
+  // this says so.
+  JobProgress progress = {};
 };
 
 // A JSON endpoint works in two steps. The first reads and checks the body's fields into the
@@ -170,9 +175,24 @@ class Service {
   void handlePost(const Route& route, const httplib::Request& req, httplib::Response& res);
   // GET <endpoint>?r=<base64url of the JSON body>: the POST's answer, cacheable by URL.
   void handleGet(const Route& route, const httplib::Request& req, httplib::Response& res);
-  // The answer to `body` of media type `type` (both methods' common path).
+  // The answer to `body` of media type `type` (both methods' and jobs' common path), under
+  // `config`'s limits (config_, or jobConfig_ for a job, whose progress goes to `progress`).
   void answer(const Route& route, const std::string& body, const std::string& type,
-              const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res);
+              const std::map<std::string, std::string>& query, const std::string& inm, httplib::Response& res,
+              const Config& config, const JobProgress& progress = {});
+  // Jobs (jobs_api.cpp): the routes, queueing a request of `route` (POST /v1/jobs, or an effect's
+  // POST with Prefer: respond-async), and running one.
+  void installJobs();
+  // `at`: where the request sits in the body that came ("/request" in POST /v1/jobs), for problems.
+  void submitJob(const Route& route, const std::string& body, httplib::Response& res, const std::string& at = "");
+  JobAnswer runJob(const std::string& effect, const std::string& body, const JobProgress& progress);
+  void answerJobStatus(const httplib::Request& req, httplib::Response& res);
+  void answerJobEvents(const httplib::Request& req, httplib::Response& res);
+  void answerJobResult(const httplib::Request& req, httplib::Response& res);
+  void cancelJob(const httplib::Request& req, httplib::Response& res);
+  // The job a request's path names, if it is there and the request's key (if any) owns it;
+  // otherwise the answer is a 404 problem.
+  std::optional<JobView> jobOf(const httplib::Request& req, httplib::Response& res);
   const Route* findRoute(const std::string& path) const;
   std::string allowedOrigin(const std::string& origin) const;  // "" when not allowed
 
@@ -192,6 +212,8 @@ class Service {
   std::atomic<bool> stopping_{false};
   std::vector<std::unique_ptr<Route>> routes_;
   std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
+  Config jobConfig_;            // config_ with the job limits in place of the request limits
+  std::unique_ptr<Jobs> jobs_;  // last: its workers stop before what they use goes
 };
 
 // Writes `problem` into `res` as application/problem+json with the request id.

@@ -30,6 +30,7 @@ enum class ErrorKind {
   kInvalidArgument,  // a field breaks its documented range or type rule   -> HTTP 400
   kUnsatisfiable,    // well-formed, but cannot be served (unreachable...)  -> HTTP 422
   kLimitExceeded,    // over a configured resource bound                     -> HTTP 413/422
+  kCancelled,        // the caller's progress callback asked the work to stop (a cancelled job)
 };
 
 struct Error {

@@ -44,6 +44,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -77,6 +78,20 @@ inline constexpr double kCalibratedAxisGrowth8 = 1.2;
 // Cells one bolt may add (Params::maxSteps, Limits::maxGrowthSteps).
 inline constexpr size_t kDefaultMaxGrowthSteps = 2'000'000;
 
+// How far grow() has come, handed to Params::progress.
+struct Progress {
+  size_t cells = 0;   // the bolt's cells so far
+  size_t steps = 0;   // growth steps so far
+  // The share of the way done, in [0, 1]: over the targets (and the region) in turn, how close
+  // the bolt's nearest cell has come to the current one, against the segment's start. Growth
+  // slows as the bolt grows (each DBM step solves a larger problem), so time is not linear in it.
+  double fraction = 0;
+};
+// Called while a bolt grows, at most every kProgressIntervalMs (not at all for a bolt that takes
+// less); returning false stops grow(), which returns an Error of kind kCancelled.
+using ProgressCallback = std::function<bool(const Progress&)>;
+inline constexpr double kProgressIntervalMs = 50;
+
 struct Params {
   int width = 128, height = 128;
   int depth = 0;                   // 0: a 2-D grid; >= 3: a 3-D grid of width*height*depth voxels
@@ -109,6 +124,7 @@ struct Params {
   uint64_t seed = 1;
   size_t maxSteps = kDefaultMaxGrowthSteps;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
+  ProgressCallback progress;    // optional: progress reports and cancellation (Progress)
 };
 
 [[nodiscard]] std::optional<Error> validate(const Params& p);

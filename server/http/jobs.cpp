@@ -1,0 +1,245 @@
+// The job store and its workers (jobs.h).
+#include "http/jobs.h"
+
+#include <algorithm>
+
+#include "http/request_state.h"
+
+namespace effectd {
+
+using Clock = std::chrono::steady_clock;
+
+const char* toString(JobState state) {
+  switch (state) {
+    case JobState::kQueued: return "queued";
+    case JobState::kRunning: return "running";
+    case JobState::kDone: return "done";
+    case JobState::kFailed: return "failed";
+    case JobState::kCancelled: return "cancelled";
+  }
+  return "unknown";
+}
+
+struct Jobs::Job {
+  std::string id, effect, keyId, body;
+  JobState state = JobState::kQueued;
+  double fraction = 0;
+  size_t cells = 0, steps = 0;
+  std::chrono::system_clock::time_point created = std::chrono::system_clock::now();
+  Clock::time_point queuedAt = Clock::now(), startedAt, finishedAt;
+  bool started = false;
+  bool cancel = false;
+  bool expired = false;
+  uint64_t version = 0;
+  std::shared_ptr<const JobAnswer> answer;
+};
+
+Jobs::Jobs(Options options, Runner runner) : o_(options), runner_(std::move(runner)) {
+  for (int i = 0; i < o_.workers; ++i) workers_.emplace_back([this] { work(); });
+}
+
+Jobs::~Jobs() { stop(); }
+
+void Jobs::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    stopping_ = true;
+    for (auto& [id, job] : jobs_)
+      if (!finished(job->state)) {
+        job->cancel = true;
+        changed(*job);
+      }
+  }
+  queued_.notify_all();
+  for (std::thread& t : workers_)
+    if (t.joinable()) t.join();
+  workers_.clear();
+}
+
+void Jobs::changed(Job& job) {
+  ++job.version;
+  change_.notify_all();
+}
+
+JobView Jobs::view(const Job& job) const {
+  JobView v;
+  v.id = job.id, v.effect = job.effect, v.keyId = job.keyId, v.state = job.state;
+  v.fraction = job.fraction, v.cells = job.cells, v.steps = job.steps, v.created = job.created;
+  const Clock::time_point now = Clock::now();
+  const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  const bool started = job.started;
+  v.queuedS = seconds((started ? job.startedAt : finished(job.state) ? job.finishedAt : now) - job.queuedAt);
+  if (started) v.runningS = seconds((finished(job.state) ? job.finishedAt : now) - job.startedAt);
+  // The pace so far, once there is one: a DBM bolt's steps grow dearer as it grows, so this
+  // is a lower bound that tightens towards the end.
+  if (job.state == JobState::kRunning && job.fraction >= 0.02) v.etaS = v.runningS * (1 - job.fraction) / job.fraction;
+  if (finished(job.state)) v.etaS = 0;
+  v.cancelRequested = job.cancel, v.expired = job.expired, v.version = job.version, v.answer = job.answer;
+  return v;
+}
+
+JobView Jobs::submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) {
+  std::lock_guard<std::mutex> lock(mu_);
+  expire();
+  refusal = Refusal::kNone;
+  if (stopping_ || jobs_.size() >= o_.maxJobs) {
+    refusal = Refusal::kFull;
+    return {};
+  }
+  if (!keyId.empty() && std::count_if(jobs_.begin(), jobs_.end(), [&](const auto& j) {
+        return j.second->keyId == keyId && !finished(j.second->state);
+      }) >= o_.perKey) {
+    refusal = Refusal::kKeyBusy;
+    return {};
+  }
+  auto job = std::make_shared<Job>();
+  job->id = newRequestId();
+  job->effect = effect, job->keyId = keyId, job->body = std::move(body);
+  jobs_[job->id] = job;
+  queue_.push_back(job);
+  queued_.notify_one();
+  return view(*job);
+}
+
+std::optional<JobView> Jobs::find(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  expire();
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  return view(*it->second);
+}
+
+std::optional<JobView> Jobs::waitForChange(const std::string& id, uint64_t version, std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(mu_);
+  const Clock::time_point until = Clock::now() + timeout;
+  for (;;) {
+    auto it = jobs_.find(id);
+    if (it == jobs_.end()) return std::nullopt;
+    if (it->second->version != version || stopping_ || change_.wait_until(lock, until) == std::cv_status::timeout) {
+      it = jobs_.find(id);
+      if (it == jobs_.end()) return std::nullopt;
+      return view(*it->second);
+    }
+  }
+}
+
+std::optional<JobView> Jobs::cancel(const std::string& id, std::chrono::milliseconds wait) {
+  std::unique_lock<std::mutex> lock(mu_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end()) return std::nullopt;
+  std::shared_ptr<Job> job = it->second;
+  if (job->state == JobState::kQueued) {
+    queue_.erase(std::remove(queue_.begin(), queue_.end(), job), queue_.end());
+    job->state = JobState::kCancelled;
+    job->cancel = true;
+    job->finishedAt = Clock::now();
+    job->body.clear();
+    ++outcomes_["cancelled"];
+    changed(*job);
+  } else if (job->state == JobState::kRunning) {
+    job->cancel = true;
+    changed(*job);
+    change_.wait_for(lock, wait, [&] { return finished(job->state); });
+  }
+  return view(*job);
+}
+
+bool Jobs::remove(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = jobs_.find(id);
+  if (it == jobs_.end() || !finished(it->second->state)) return false;
+  if (it->second->answer) answerBytes_ -= it->second->answer->body.size();
+  jobs_.erase(it);
+  change_.notify_all();
+  return true;
+}
+
+void Jobs::expire() {
+  const Clock::time_point now = Clock::now();
+  for (auto it = jobs_.begin(); it != jobs_.end();) {
+    const Job& job = *it->second;
+    if (finished(job.state) && now - job.finishedAt > o_.ttl) {
+      if (job.answer) answerBytes_ -= job.answer->body.size();
+      it = jobs_.erase(it);
+      change_.notify_all();
+    } else {
+      ++it;
+    }
+  }
+  while (answerBytes_ > o_.maxAnswerBytes) {  // the oldest finished answer goes first
+    Job* oldest = nullptr;
+    for (auto& [id, job] : jobs_)
+      if (finished(job->state) && job->answer && (!oldest || job->finishedAt < oldest->finishedAt)) oldest = job.get();
+    if (!oldest) break;
+    answerBytes_ -= oldest->answer->body.size();
+    oldest->answer.reset();
+    oldest->expired = true;
+    changed(*oldest);
+  }
+}
+
+void Jobs::work() {
+  for (;;) {
+    std::shared_ptr<Job> job;
+    {
+      std::unique_lock<std::mutex> lock(mu_);
+      queued_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      job = queue_.front();
+      queue_.pop_front();
+      job->state = JobState::kRunning;
+      job->started = true;
+      job->startedAt = Clock::now();
+      changed(*job);
+    }
+    const JobProgress progress = [this, job](double fraction, size_t cells, size_t steps) {
+      std::lock_guard<std::mutex> lock(mu_);
+      job->fraction = std::max(job->fraction, std::clamp(fraction, 0.0, 1.0));
+      job->cells = cells, job->steps = steps;
+      changed(*job);
+      return !job->cancel;
+    };
+    JobAnswer answer;
+    try {
+      answer = runner_(job->effect, job->body, progress);
+    } catch (const std::exception& e) {
+      answer.status = 500;
+      answer.headers["Content-Type"] = "application/problem+json";
+      answer.body = std::string("{\"type\":\"https://effectd.dev/problems/internal\",\"title\":\"Internal Server "
+                                "Error\",\"status\":500,\"detail\":\"the job failed\"}");
+    }
+    std::lock_guard<std::mutex> lock(mu_);
+    job->state = job->cancel ? JobState::kCancelled : answer.status < 400 ? JobState::kDone : JobState::kFailed;
+    if (job->state == JobState::kDone) job->fraction = 1;
+    job->finishedAt = Clock::now();
+    job->body.clear();
+    job->body.shrink_to_fit();
+    if (job->state != JobState::kCancelled) {
+      answerBytes_ += answer.body.size();
+      job->answer = std::make_shared<const JobAnswer>(std::move(answer));
+    }
+    ++outcomes_[toString(job->state)];
+    changed(*job);
+    expire();
+  }
+}
+
+std::string Jobs::metricsText() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  std::map<std::string, size_t> now;
+  for (const char* s : {"queued", "running", "done", "failed", "cancelled"}) now[s] = 0;
+  for (const auto& [id, job] : jobs_) ++now[toString(job->state)];
+  std::string out = "# HELP effectd_jobs Jobs kept, by state.\n# TYPE effectd_jobs gauge\n";
+  for (const auto& [state, n] : now) out += "effectd_jobs{state=\"" + state + "\"} " + std::to_string(n) + "\n";
+  out += "# HELP effectd_jobs_finished_total Jobs finished, by how.\n# TYPE effectd_jobs_finished_total counter\n";
+  for (const char* s : {"done", "failed", "cancelled"}) {
+    auto it = outcomes_.find(s);
+    out += std::string("effectd_jobs_finished_total{state=\"") + s + "\"} " +
+           std::to_string(it == outcomes_.end() ? 0 : it->second) + "\n";
+  }
+  out += "# HELP effectd_job_answer_bytes Bytes of finished jobs' answers kept.\n# TYPE effectd_job_answer_bytes gauge\n"
+         "effectd_job_answer_bytes " + std::to_string(answerBytes_) + "\n";
+  return out;
+}
+
+}  // namespace effectd
