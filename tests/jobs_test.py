@@ -15,12 +15,16 @@ baking tool would call it. Each probe asserts what must hold and prints what it 
   keys       a key's jobs at once are bounded (429), another key cannot see them (404), the
              submission is charged (RateLimit falls by the estimate's units)
   stop       SIGTERM with a job running: the process exits within seconds, not at the job's end
+  bake       `effectd bake` writes the endpoint's answer, with plain progress lines, a bar on a
+             terminal (a pty), and Ctrl-C cancels its job on the server (exit 130)
 """
 import hashlib
 import http.client
 import json
 import os
+import pty
 import re
+import subprocess
 import signal
 import sys
 import tempfile
@@ -236,9 +240,63 @@ def stop(binary):
           (status, code, seconds))
 
 
+def bake(binary):
+    p, port = effectd_process.start(binary, "--access-log", "0", "--max-job-grid-cells", "262144")
+    work = tempfile.mkdtemp(prefix="effectd-bake.")
+    try:
+        body = bolt(300, include=["polylines"])
+        path, out = os.path.join(work, "bolt.json"), os.path.join(work, "bolt-answer.json")
+        with open(path, "w") as f:
+            json.dump(body, f)
+        server = f"http://127.0.0.1:{port}"
+        r = subprocess.run([binary, "bake", "lightning", path, "-o", out, "--server", server], capture_output=True,
+                           text=True, timeout=120)
+        lines = r.stderr.strip().split("\n")
+        progress = [line for line in lines if re.match(r"^ *\d+%  ", line)]
+        print(f"      bake, not a terminal: exit {r.returncode}, {len(progress)} progress lines, last: {lines[-1]}")
+        status, _, direct = request(port, "POST", "/v1/lightning", json.dumps(body))
+        with open(out, "rb") as f:
+            baked = f.read()
+        check(r.returncode == 0 and baked == direct and status == 200, "effectd bake writes the endpoint's answer",
+              (r.returncode, r.stderr[-300:]))
+        check(progress and progress[-1].startswith("100%  done") and "\r" not in r.stderr,
+              "... with plain progress lines off a terminal, the last 100% done", progress[-2:])
+        # On a terminal (a pty): the bar, redrawn in place.
+        leader, follower = pty.openpty()
+        q = subprocess.Popen([binary, "bake", "lightning", path, "-o", out, "--server", server], stderr=follower,
+                             stdout=subprocess.DEVNULL)
+        os.close(follower)
+        seen = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            seen += chunk
+        q.wait(60)
+        check(q.returncode == 0 and b"\r\x1b[K[" in seen and b"#" in seen and b"100%" in seen,
+              "... and a bar redrawn in place on a terminal", seen[-200:])
+        # Ctrl-C: the job is cancelled on the server.
+        with open(path, "w") as f:
+            json.dump(bolt(480), f)
+        q = subprocess.Popen([binary, "bake", "lightning", path, "-o", out, "--server", server],
+                             stderr=subprocess.PIPE, text=True)
+        time.sleep(1.5)
+        q.send_signal(signal.SIGINT)
+        _, err = q.communicate(timeout=30)
+        _, _, metrics = request(port, "GET", "/metrics")
+        check(q.returncode == 130 and b'effectd_jobs{state="cancelled"} 1' in metrics and "cancelled" in err,
+              "Ctrl-C in effectd bake cancels its job on the server (exit 130)", (q.returncode, err[-200:]))
+    finally:
+        p.terminate()
+        p.wait()
+
+
 if __name__ == "__main__":
     binary = sys.argv[1]
-    for probe in (same, limits_cancel_problems, keys, stop):
+    for probe in (same, limits_cancel_problems, keys, stop, bake):
         print(f"-- {probe.__name__}", flush=True)
         probe(binary)
     print(f"{len(failures)} failed" if failures else "all passed")

@@ -1,6 +1,7 @@
 // effectd: the effect-generation HTTP service.
 //   effectd [serve] [flags]                          serve HTTP until SIGTERM/SIGINT
 //   effectd render SCENE.json -o OUT.png [flags]     render a scene without a server
+//   effectd bake EFFECT REQUEST.json -o OUT [--server URL]  a job on a server, with progress
 //   effectd --help
 #include <signal.h>
 #include <unistd.h>
@@ -19,6 +20,7 @@
 #include <thread>
 
 #include "contract/config.h"
+#include "app/bake.h"
 #include "app/endpoints.h"
 #include "http/access_log.h"
 #include "http/idle_trim.h"
@@ -149,6 +151,7 @@ int renderCommand(std::vector<std::string> args) {
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (!args.empty() && args.front() == "render") return renderCommand({args.begin() + 1, args.end()});
+  if (!args.empty() && args.front() == "bake") return effectd::bakeCommand({args.begin() + 1, args.end()});
   if (args.size() == 1 && args.front() == "--version") {
     std::printf("effectd %s\n", effectd::buildVersion().c_str());
     return 0;

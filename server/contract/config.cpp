@@ -247,6 +247,8 @@ std::string usage() {
   os << "usage: effectd [serve] [--flag=value ...]          serve HTTP until SIGTERM/SIGINT\n"
         "       effectd render SCENE.json -o OUT.png [--egl-platform=...] [--max-*=N]\n"
         "                                                   render a /v1/render scene to a PNG, no server\n"
+        "       effectd bake EFFECT REQUEST.json -o OUT [--server URL] [--key SECRET]\n"
+        "                                                   run a request as a job on a server, with progress\n"
         "       effectd --help | --version\n\n"
         "Flags (environment variable in brackets; flags win over the environment):\n";
   for (const auto& o : options()) os << "  --" << o.flag << " [" << o.env << "]\n      " << o.help << "\n";
