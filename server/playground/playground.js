@@ -19,7 +19,7 @@ const EFFECTS = {
 };
 const SIZE = 384;
 const $ = (id) => document.getElementById(id);
-const state = { effect: 'lightning', request: {}, glb: null, runs: 0, last: null };
+const state = { effect: 'lightning', request: {}, glb: null, runs: 0, last: null, job: null, jobRequest: null };
 // The live view once three.js has loaded; until then, or when it cannot, a view that draws
 // nothing (and runLive asks for nothing).
 const NO_VIEW = { clear() {}, showLightning() {}, showFog() {}, showBubble() {}, showTangents() {} };
@@ -116,6 +116,60 @@ async function post(path, body, signal) {
 
 const isJson = (res) => /json/.test(res.headers.get('Content-Type') || '');
 
+// A request over the server's synchronous limits (its 413 names the limit a job lifts) runs as a
+// job: queued with Prefer: respond-async, followed through its events with a progress bar, the
+// ETA and a cancel button, and its answer fetched once done (docs/api.md, "Jobs").
+const overSyncLimit = (problem) => /--max-solver-(grid|volume)-cells/.test((problem && problem.detail) || '');
+
+function seconds(s) {
+  return s < 60 ? `${s.toFixed(1)} s` : `${Math.floor(s / 60)} min ${String(Math.floor(s % 60)).padStart(2, '0')} s`;
+}
+
+async function runJob(path, body, signal) {
+  const started = performance.now();
+  const queued = await fetch(path, { method: 'POST', signal, body: JSON.stringify(body),
+                                     headers: { 'Content-Type': 'application/json', Prefer: 'respond-async' } });
+  if (queued.status !== 202) return { res: queued, blob: await queued.blob(), ms: performance.now() - started };
+  const job = queued.headers.get('Location');
+  const panel = $('job'), bar = $('job-progress'), text = $('job-text');
+  state.job = { location: job, state: 'queued', fraction: 0 };
+  panel.hidden = false;
+  bar.value = 0;
+  text.textContent = 'queued';
+  const cancel = () => fetch(job, { method: 'DELETE' }).catch(() => {});
+  $('job-cancel').onclick = cancel;
+  $('job-cancel').disabled = false;
+  signal.addEventListener('abort', cancel);  // a newer request replaces this one
+  try {
+    const final = await new Promise((resolve) => {
+      const events = new EventSource(`${job}/events`);
+      const show = (e) => {
+        const s = JSON.parse(e.data), p = s.progress;
+        state.job = { location: job, state: s.state, fraction: p.fraction };
+        bar.value = p.fraction;
+        text.textContent = `${(100 * p.fraction).toFixed(0)} %  ${s.state}  ${p.cells} cells  ${seconds(s.runningS)}` +
+          (s.state === 'running' && p.etaS !== null ? `, at least ${seconds(p.etaS)} left` : '');
+        if (s.state === 'done' || s.state === 'failed' || s.state === 'cancelled') {
+          events.close();
+          resolve(s.state);
+        }
+      };
+      for (const name of ['progress', 'done', 'failed', 'cancelled']) events.addEventListener(name, show);
+      events.onerror = () => { if (events.readyState === EventSource.CLOSED) resolve('lost'); };
+      signal.addEventListener('abort', () => { events.close(); resolve('replaced'); });
+    });
+    $('job-cancel').disabled = true;
+    if (final === 'cancelled' || final === 'replaced' || final === 'lost') {
+      text.textContent += final === 'cancelled' ? ' (cancelled)' : '';
+      return null;
+    }
+    const res = await fetch(`${job}/result`, { signal });
+    return { res, blob: await res.blob(), ms: performance.now() - started };
+  } finally {
+    signal.removeEventListener('abort', cancel);
+  }
+}
+
 function serverTiming(res) {
   const h = res.headers.get('Server-Timing');
   if (!h) return '';
@@ -158,6 +212,12 @@ function showProblems(problem) {
     list.append(li);
   }
   return homeless;
+}
+
+function noPreview(why) {
+  $('preview').hidden = true;
+  $('preview-note').textContent = why;
+  return { status: 0 };
 }
 
 async function runPreview(signal) {
@@ -205,7 +265,7 @@ async function runLive(answer, signal) {
   }
   const live = kind && liveRequest(kind, sub);
   if (!live) return view.clear();
-  const same = effect === kind && JSON.stringify(live) === JSON.stringify(req);
+  const same = effect === kind && JSON.stringify(live) === JSON.stringify(state.jobRequest || req);
   let data = same ? answer : null;
   if (!data) {
     const r = await post(EFFECTS[kind].endpoint, live, signal);
@@ -245,7 +305,16 @@ async function run() {
       const p = await runPreview(signal);
       main = p.r;
     } else {
+      $('job').hidden = true;
       main = await post(EFFECTS[state.effect].endpoint, body, signal);
+      state.jobRequest = null;
+      if (main.res.status === 413 && !state.glb && isJson(main.res) && overSyncLimit(JSON.parse(await main.blob.text()))) {
+        // The job asks for what the live view draws too (a bolt's mesh and strike), so that the
+        // long work runs once: its answer holds the request's own fields and those.
+        state.jobRequest = liveRequest(state.effect, body) || body;
+        main = await runJob(EFFECTS[state.effect].endpoint, state.jobRequest, signal);
+      }
+      if (!main && signal.aborted) return;
     }
     if (main) {
       if (isJson(main.res)) answer = JSON.parse(await main.blob.text());
@@ -254,10 +323,13 @@ async function run() {
       $('answer-text').textContent = answer && !state.glb ? JSON.stringify(answer, null, 1).slice(0, 20000)
         : `${main.blob.size} bytes of ${main.res.headers.get('Content-Type')}`;
     }
-    const failed = main && !main.res.ok;
+    const failed = !main || !main.res.ok;
+    const asJob = state.job && state.job.location && !$('job').hidden;
     showProblems(failed && answer ? answer : null);
     const [preview] = await Promise.all([
-      state.effect === 'scene' ? Promise.resolve({ status: main ? main.res.status : 0 }) : failed ? null : runPreview(signal),
+      state.effect === 'scene' ? Promise.resolve({ status: main ? main.res.status : 0 })
+        : failed ? null : asJob ? noPreview('over the synchronous limits, this ran as a job (with the live view\'s mesh and strike): the live view draws its answer')
+          : runPreview(signal),
       failed ? view.clear() : runLive(answer, signal),
     ]);
     state.last = { status: main ? main.res.status : 0, preview: preview ? preview.status : 0, error: null };
