@@ -9,6 +9,9 @@ from a client (ctest deploy_replicas):
      10 % of its quota (burst + perMinute/60 * T) summed over the replicas (Redis);
   C. a replica killed mid-load: the GETs in flight and after are retried by nginx, none fails;
   D. Redis stopped: keyed requests still answered (fail open to per-replica buckets);
+  F. a job through nginx: submitted, followed by its events and polled, its answer fetched, all
+     through nginx (the jobs routes go to one replica); Prefer: respond-async on an effect route
+     is answered at once (nginx drops it);
   E. the public path: readiness, metrics and the playground are not served through nginx (each
      replica's admin port serves them), and with 2 x --max-connections clients trickling their
      headers to nginx, /healthz through nginx and on a replica's admin port answers at once.
@@ -34,6 +37,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 SIGNING_KEY = "replicas-signing-key-0123456789"
 SECRET = "replicas-test-secret"
+BAKER = "replicas-baker-secret"  # F's key, whose quota B leaves alone
 PER_MINUTE, BURST = 600, 20
 MAX_CONNECTIONS = 32  # each replica's --max-connections; E opens twice as many slow connections
 
@@ -87,7 +91,9 @@ def main():
                                            "--appendonly", "no"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         open(os.path.join(work, "signing.txt"), "w").write(SIGNING_KEY + "\n")
         json.dump({"keys": [{"id": "load", "sha256": hashlib.sha256(SECRET.encode()).hexdigest(),
-                             "perMinute": PER_MINUTE, "burst": BURST}]}, open(os.path.join(work, "keys.json"), "w"))
+                             "perMinute": PER_MINUTE, "burst": BURST},
+                            {"id": "baker", "sha256": hashlib.sha256(BAKER.encode()).hexdigest(),
+                             "perMinute": 60000, "burst": 60000}]}, open(os.path.join(work, "keys.json"), "w"))
         ports, admin = [], {}
         for i in range(3):
             log = open(os.path.join(work, f"effectd{i}.log"), "w+")
@@ -214,6 +220,37 @@ def main():
         print(f"     /healthz with {2 * MAX_CONNECTIONS} clients trickling to nginx: through nginx max "
               f"{max(waits['nginx']):.2f} ms, on the admin port max {max(waits['admin']):.2f} ms")
         check(max(waits["nginx"] + waits["admin"]) < 1000, "E: ... each within a second")
+
+        # F. A job through nginx, with the key.
+        keyed = {"Content-Type": "application/json", "Authorization": "Bearer " + BAKER}
+        c = http.client.HTTPConnection("127.0.0.1", lb, timeout=60)
+        c.request("POST", "/v1/jobs", body=json.dumps({"effect": "lightning", "request": {
+            "grid": {"width": 160, "height": 160}, "method": "dbm", "start": [80, 0], "targets": [[80, 159]]}}),
+            headers=keyed)
+        r = c.getresponse()
+        r.read()
+        job = r.getheader("Location") or ""
+        c.request("GET", job + "/events", headers=keyed)
+        events = c.getresponse()
+        stream = events.read().decode()
+        polls = []
+        for _ in range(6):
+            c.request("GET", job, headers=keyed)
+            reply = c.getresponse()
+            polls.append(reply.status)
+            state = json.loads(reply.read())
+        c.request("GET", job + "/result", headers=keyed)
+        result = c.getresponse()
+        bolt = json.loads(result.read())
+        check(r.status == 202 and "event: done" in stream and polls == [200] * 6 and state["state"] == "done" and
+              result.status == 200 and bolt.get("cellCount", 0) > 0,
+              "F: a job submitted, followed, polled and fetched through nginx",
+              (r.status, stream[-200:], polls, result.status))
+        c.request("POST", "/v1/fog", body=json.dumps(fog(4000)), headers={**keyed, "Prefer": "respond-async"})
+        r = c.getresponse()
+        r.read()
+        check(r.status == 200 and not r.getheader("Preference-Applied"),
+              "F: Prefer: respond-async on an effect route through nginx is answered at once", r.status)
 
         # C. A replica killed (SIGKILL) mid-load: the GETs that reach it afterwards, on nginx's
         # kept-alive connections or new ones, are retried on the next replica; none fails. The
