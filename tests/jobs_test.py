@@ -11,7 +11,8 @@ baking tool would call it. Each probe asserts what must hold and prints what it 
              the bolt; a job over the job limit is refused when submitted, naming /request/grid
   cancel     DELETE on a running bolt: cancelled within the request, its reservation returned;
              its result 409; a finished job deleted is gone (404)
-  problems   an unknown effect, an invalid request (its pointer under /request), a wrong method
+  problems   an unknown effect, an invalid request (its pointer under /request), a wrong method,
+             a request over --job-store-mb
   keys       a key's jobs at once are bounded (429), another key cannot see them (404), the
              submission is charged (RateLimit falls by the estimate's units)
   stop       SIGTERM with a job running: the process exits within seconds, not at the job's end
@@ -120,7 +121,7 @@ def same(binary):
 
 def limits_cancel_problems(binary):
     p, port = effectd_process.start(binary, "--access-log", "0", "--max-solver-grid-cells", "16384",
-                                    "--max-job-grid-cells", "262144")
+                                    "--max-job-grid-cells", "262144", "--job-store-mb", "1")
     try:
         big = bolt(300)
         status, _, body = request(port, "POST", "/v1/lightning", json.dumps(big))
@@ -185,6 +186,11 @@ def limits_cancel_problems(binary):
               "an invalid request: 400 with its fields under /request", problem.get("errors"))
         status, headers, _ = request(port, "GET", "/v1/jobs")
         check(status == 405 and "POST" in headers.get("Allow", ""), "GET /v1/jobs: 405, Allow: POST", status)
+        # Queued requests count against --job-store-mb: a 1.7 MB mesh does not fit in 1 MiB.
+        n = 60000
+        mesh = {"mesh": {"positions": [0.5] * (3 * n), "uvs": [0.25] * (2 * n), "indices": list(range(n))}}
+        status, _, body = request(port, "POST", "/v1/jobs", json.dumps({"effect": "tangents", "request": mesh}))
+        check(status == 503 and b"--job-store-mb" in body, "a request larger than --job-store-mb: 503 naming it", status)
         status, _, _ = request(port, "GET", "/v1/jobs/0123456789abcdef")
         check(status == 404, "an unknown job: 404", status)
     finally:

@@ -206,9 +206,10 @@ const std::vector<Option>& options() {
        intField(&Config::maxJobs, 1, 1000000)},
       {"job-ttl", "EFFECTD_JOB_TTL", "seconds a finished job and its answer are kept (default 3600)",
        intField(&Config::jobTtlS, 1, 30 * 86400)},
-      {"job-answers-mb", "EFFECTD_JOB_ANSWERS_MB",
-       "finished jobs' answers kept at once; past it the oldest are dropped (default 256)",
-       intField(&Config::jobAnswersMb, 1, 1LL << 20)},
+      {"job-store-mb", "EFFECTD_JOB_STORE_MB",
+       "queued jobs' requests and finished jobs' answers kept at once; past it the oldest answers are dropped, and "
+       "a job whose request does not fit gets 503 (default 256)",
+       intField(&Config::jobStoreMb, 1, 1LL << 20)},
       {"key-max-jobs", "EFFECTD_KEY_MAX_JOBS", "an API key's jobs queued or running at once; more get 429 (default 2)",
        intField(&Config::keyMaxJobs, 1, 100000)},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",

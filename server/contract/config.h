@@ -57,7 +57,7 @@ struct Config {
   size_t maxJobVolumeCells = size_t(128) * 128 * 128;  // dbm grids in a job (3-D)
   int maxJobs = 256;                     // jobs kept at once, in any state
   int jobTtlS = 3600;                    // a finished job (and its answer) is kept this long
-  size_t jobAnswersMb = 256;             // finished jobs' answers kept at once; past it the oldest go
+  size_t jobStoreMb = 256;               // queued requests and kept answers of jobs at once
   int keyMaxJobs = 2;                    // an API key's jobs queued or running at once
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts

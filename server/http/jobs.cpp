@@ -82,7 +82,7 @@ JobView Jobs::submit(const std::string& effect, std::string body, const std::str
   std::lock_guard<std::mutex> lock(mu_);
   expire();
   refusal = Refusal::kNone;
-  if (stopping_ || jobs_.size() >= o_.maxJobs) {
+  if (stopping_ || jobs_.size() >= o_.maxJobs || requestBytes_ + body.size() > o_.maxStoreBytes) {
     refusal = Refusal::kFull;
     return {};
   }
@@ -95,6 +95,7 @@ JobView Jobs::submit(const std::string& effect, std::string body, const std::str
   auto job = std::make_shared<Job>();
   job->id = newRequestId();
   job->effect = effect, job->keyId = keyId, job->body = std::move(body);
+  requestBytes_ += job->body.size();
   jobs_[job->id] = job;
   queue_.push_back(job);
   queued_.notify_one();
@@ -133,7 +134,9 @@ std::optional<JobView> Jobs::cancel(const std::string& id, std::chrono::millisec
     job->state = JobState::kCancelled;
     job->cancel = true;
     job->finishedAt = Clock::now();
+    requestBytes_ -= job->body.size();
     job->body.clear();
+    job->body.shrink_to_fit();
     ++outcomes_["cancelled"];
     changed(*job);
   } else if (job->state == JobState::kRunning) {
@@ -166,7 +169,7 @@ void Jobs::expire() {
       ++it;
     }
   }
-  while (answerBytes_ > o_.maxAnswerBytes) {  // the oldest finished answer goes first
+  while (answerBytes_ + requestBytes_ > o_.maxStoreBytes) {  // the oldest finished answer goes first
     Job* oldest = nullptr;
     for (auto& [id, job] : jobs_)
       if (finished(job->state) && job->answer && (!oldest || job->finishedAt < oldest->finishedAt)) oldest = job.get();
@@ -212,6 +215,7 @@ void Jobs::work() {
     job->state = job->cancel ? JobState::kCancelled : answer.status < 400 ? JobState::kDone : JobState::kFailed;
     if (job->state == JobState::kDone) job->fraction = 1;
     job->finishedAt = Clock::now();
+    requestBytes_ -= job->body.size();
     job->body.clear();
     job->body.shrink_to_fit();
     if (job->state != JobState::kCancelled) {
@@ -237,8 +241,8 @@ std::string Jobs::metricsText() const {
     out += std::string("effectd_jobs_finished_total{state=\"") + s + "\"} " +
            std::to_string(it == outcomes_.end() ? 0 : it->second) + "\n";
   }
-  out += "# HELP effectd_job_answer_bytes Bytes of finished jobs' answers kept.\n# TYPE effectd_job_answer_bytes gauge\n"
-         "effectd_job_answer_bytes " + std::to_string(answerBytes_) + "\n";
+  out += "# HELP effectd_job_store_bytes Bytes of queued jobs' requests and finished jobs' answers kept.\n"
+         "# TYPE effectd_job_store_bytes gauge\neffectd_job_store_bytes " + std::to_string(answerBytes_ + requestBytes_) + "\n";
   return out;
 }
 

@@ -47,7 +47,7 @@ struct JobView {
   double queuedS = 0, runningS = 0;  // seconds spent in each so far
   double etaS = -1;                  // seconds left, from the fraction's pace; -1: not known yet
   bool cancelRequested = false;
-  bool expired = false;              // finished, its answer dropped for room (Options::maxAnswerBytes)
+  bool expired = false;              // finished, its answer dropped for room (Options::maxStoreBytes)
   uint64_t version = 0;              // grows with every change (Server-Sent Events wait on it)
   std::shared_ptr<const JobAnswer> answer;  // done, failed, or cancelled while running
 };
@@ -58,7 +58,9 @@ class Jobs {
     int workers = 1;
     size_t maxJobs = 256;           // kept at once, in any state
     std::chrono::seconds ttl{3600};  // a finished job is forgotten this long after it finished
-    size_t maxAnswerBytes = 256u << 20;  // answers kept at once; past it the oldest are dropped
+    // Queued requests and kept answers at once: past it the oldest answers are dropped, and a
+    // job whose request would not fit is refused.
+    size_t maxStoreBytes = 256u << 20;
     int perKey = 2;                 // an API key's jobs queued or running at once
   };
   // Answers `body` as the endpoint of `effect` does, reporting progress through `progress`.
@@ -87,7 +89,7 @@ class Jobs {
  private:
   struct Job;
   void work();
-  void expire();  // mu_ held: drops jobs past their ttl, and answers past maxAnswerBytes
+  void expire();  // mu_ held: drops jobs past their ttl, and answers past maxStoreBytes
   JobView view(const Job& job) const;  // mu_ held
   void changed(Job& job);               // mu_ held: bumps the version, wakes waiters
 
@@ -97,7 +99,7 @@ class Jobs {
   std::condition_variable queued_, change_;
   std::map<std::string, std::shared_ptr<Job>> jobs_;
   std::deque<std::shared_ptr<Job>> queue_;
-  size_t answerBytes_ = 0;
+  size_t answerBytes_ = 0, requestBytes_ = 0;  // kept answers, queued requests
   bool stopping_ = false;
   std::map<std::string, uint64_t> outcomes_;  // finished jobs by state, for /metrics
   std::vector<std::thread> workers_;

@@ -83,7 +83,7 @@ void Service::installJobs() {
   o.workers = config_.jobWorkers;
   o.maxJobs = size_t(config_.maxJobs);
   o.ttl = std::chrono::seconds(config_.jobTtlS);
-  o.maxAnswerBytes = config_.jobAnswersMb << 20;
+  o.maxStoreBytes = config_.jobStoreMb << 20;
   o.perKey = config_.keyMaxJobs;
   jobs_ = std::make_unique<Jobs>(
       o, [this](const std::string& effect, const std::string& body, const JobProgress& progress) {
@@ -144,7 +144,9 @@ void Service::submitJob(const Route& route, const std::string& bodyText, httplib
     const JobView v = jobs_->submit(route.path.substr(4), bodyText, tl.keyId, refusal);
     if (refusal == Jobs::Refusal::kFull)
       throw ApiError{503, "overloaded", "Service Unavailable",
-                     "the server keeps " + std::to_string(config_.maxJobs) + " jobs at most (--max-jobs)",
+                     "the server keeps " + std::to_string(config_.maxJobs) + " jobs and " +
+                         std::to_string(config_.jobStoreMb) + " MiB of their requests and answers at most "
+                         "(--max-jobs, --job-store-mb), or is stopping",
                      {}, {{"Retry-After", "10"}}};
     if (refusal == Jobs::Refusal::kKeyBusy)
       throw ApiError{429, "too-many-jobs", "Too Many Requests",
@@ -259,7 +261,7 @@ void Service::answerJobResult(const httplib::Request& req, httplib::Response& re
   if (v->expired)
     return writeProblem(res,
                         {410, "expired", "Gone",
-                         "the job's answer was dropped to keep others (--job-answers-mb): submit it again", {}, {}},
+                         "the job's answer was dropped to keep others (--job-store-mb): submit it again", {}, {}},
                         tl.requestId);
   if (v->state == JobState::kCancelled)
     return writeProblem(res, {409, "cancelled", "Conflict", "the job was cancelled", {}, {}}, tl.requestId);
