@@ -242,7 +242,9 @@ def stop(binary):
         code = None
     seconds = time.monotonic() - t0
     print(f"      SIGTERM with a 480^2 job running: exit {code} after {seconds:.2f} s")
-    check(status == 202 and code == 0 and seconds < 5, "SIGTERM with a job running: the process exits at once (0)",
+    # The job alone would take 20 s (minutes under ASan); it stops at its next progress report,
+    # after the step being solved (up to seconds under ASan).
+    check(status == 202 and code == 0 and seconds < 10, "SIGTERM with a job running: the process exits at once (0)",
           (status, code, seconds))
 
 
