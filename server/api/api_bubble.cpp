@@ -270,20 +270,20 @@ std::shared_ptr<const TranslatedShader> translated(const bb::Features& f, Shader
 
 // `uniforms` (and eqn 9's flowOffset beside them) and `shader`, as `include` asks; a
 // translation's cache state and compile time go to `reply`.
-void addShaderParts(const json& body, const Includes& include, const bb::Params& params, const bb::Features& features,
-                    const bb::ThicknessOptions& film, const std::vector<bb::Light>& lights, double t, json& out,
-                    JsonReply& reply) {
+void addShaderParts(const BubbleRequest& request, double t, json& out, JsonReply& reply) {
+  const Includes& include = request.include;
+  const bb::Params& params = request.params;
+  const bb::Features& features = request.features;
   // Every language declares the same uniforms, so one variant serves uniforms and shader;
   // SPIR-V, HLSL and MSL are translated from the 330 core source.
-  const std::string language = body.value("shader", json::object()).value("language", "glsl-es-300");
+  const std::string& language = request.shaderLanguage;
   const bool es = language == "glsl-es-300";
   bb::ShaderSource s;
   if (include.has("uniforms") || include.has("shader"))
     s = bb::shader(features, es ? bb::Glsl::kEs300 : bb::Glsl::kCore330);
-  if (include.has("uniforms")) {
-    const double radius = body.value("mesh", json::object()).value("radius", 1.0);
-    out["uniforms"] = uniforms(params, film, lights, s.uniforms, t, radius, thicknessRange(body, features, film));
-  }
+  if (include.has("uniforms"))
+    out["uniforms"] = uniforms(params, request.film, request.lights, s.uniforms, t, request.mesh.radius,
+                               request.thicknessRange);
   if (include.has("uniforms") && features.shading == bb::Shading::kPaper && features.textureFlow) {
     const glm::dvec2 off = bb::flowOffset(params, t);  // eqn 9, for clients that offset on the CPU
     out["flowOffset"] = {off.x, off.y};
@@ -378,7 +378,13 @@ BubbleRequest parseBubbleRequest(const json& body, const RequestContext& ctx) {
   r.lights = parseLights(body, ctx.at);
   if (body.contains("time")) r.time = body["time"].get<double>();
   r.thicknessRange = thicknessRange(body, r.features, r.film);
+  r.thicknessRangeGiven = body.value("thinFilm", json::object()).contains("thicknessRange");
   r.thinFilm = readThinFilm(body, r.params, r.thicknessRange);
+  r.shaderLanguage = body.value("shader", json::object()).value("language", r.shaderLanguage);
+  if (body.contains("motion")) {
+    const json& m = body["motion"];
+    r.motion = BubbleRequest::Motion{toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>()};
+  }
   const json m = body.value("mesh", json::object());
   r.meshLevelGiven = m.contains("level");
   r.mesh.level = m.value("level", r.mesh.level);
@@ -396,9 +402,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
   const bb::Features& features = request.features;
   const bool film = features.shading == bb::Shading::kFilm;
   const bb::ThicknessOptions& filmOptions = request.film;
-  const std::vector<bb::Light>& lights = request.lights;
   const double t = request.time.value_or(0.0);
-  const json tf = body.value("thinFilm", json::object());
   const json& range = request.thicknessRange;
   // glTF: the film model's own thickness (the field's texture over [0, its thickest], or one
   // thickness); the paper's iridescence the thin-film range (glTF's default 100-400 nm unless given).
@@ -408,7 +412,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
     gltf.minNm = 0;
     gltf.maxNm = features.thickness ? std::max({filmOptions.bottomStartNm, filmOptions.bottomEndNm, 1.0})
                                     : bb::equatorThickness(params, filmOptions, t);
-  } else if (tf.contains("thicknessRange")) {
+  } else if (request.thicknessRangeGiven) {
     gltf.minNm = range[0].get<double>();
     gltf.maxNm = range[1].get<double>();
   }
@@ -430,12 +434,11 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
   json stats = json::array();
   effects::Stopwatch watch;
 
-  if (body.contains("motion")) {
-    const json& m = body["motion"];
-    glm::dvec3 c = bb::moveTowards(toVec3(m["from"]), toVec3(m["to"]), m["s"].get<double>());
+  if (request.motion) {
+    const glm::dvec3 c = bb::moveTowards(request.motion->from, request.motion->to, request.motion->s);
     out["position"] = {c.x, c.y, c.z};
   }
-  addShaderParts(body, include, params, features, filmOptions, lights, t, out, reply);
+  addShaderParts(request, t, out, reply);
   reply.computeMs += watch.ms();
   if (include.has("mesh")) {
     // One wobble, not two: with the shader (whose vertex stage wobbles by uWobble*) the mesh is
@@ -454,7 +457,7 @@ JsonReply runBubble(const BubbleRequest& request, const json& body, const Reques
   }
   if (include.has("thinFilm")) {
     effects::Stats st;
-    out["thinFilm"] = thinFilmJson(request, tf, ctx, st);
+    out["thinFilm"] = thinFilmJson(request, body.value("thinFilm", json::object()), ctx, st);
     reply.computeMs += st.elapsedMs;
     reply.errorMs += st.errorMs;
     stats.push_back(statsJson(st));

@@ -75,7 +75,6 @@ JsonReply runScene(const SceneRequest& request, const json& body, const RequestC
   return reply;
 }
 
-
 // The bubble ray traced on the CPU (render::referenceRender), a still of at most
 // kMaxReferencePixels: the answer of `reference: true` and what `measureError` compares with.
 rd::Reference traceReference(const RenderRequest& request, const rd::Scene& scene, const json& body,
@@ -174,7 +173,6 @@ RenderRequest parseRenderRequest(const json& body, const RequestContext& ctx) {
   r.backgroundImage = body.contains("background") && body["background"].contains("image");
   return r;
 }
-
 
 void addRenderEndpoints(Service& service) {
   const Config& config = service.config();

@@ -82,7 +82,14 @@ struct BubbleRequest {
   bool meshLevelGiven = false;        // else a rendered bubble's own default level
   std::optional<double> time;         // seconds; absent: 0, or a scene's time
   nlohmann::json thicknessRange;  // the thin-film table's axis, nm
+  bool thicknessRangeGiven = false;  // thinFilm.thicknessRange was in the body
   effects::bubble::ThinFilmOptions thinFilm;
+  std::string shaderLanguage = "glsl-es-300";
+  struct Motion {
+    glm::dvec3 from{0.0}, to{0.0};
+    double s = 0;
+  };
+  std::optional<Motion> motion;  // the bubble carried by the air (seed 000 eqn 10)
 };
 
 // /v1/scene: the parts a scene has, each read by its endpoint's parser at its pointer.

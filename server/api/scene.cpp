@@ -234,9 +234,9 @@ rd::Bubble sceneBubble(const BubbleRequest& r, const json& bj, const json& style
 }
 
 // "frames": how many, how fast, and into what; frames x pixels within --max-render-pixels.
-Frames parseFrames(const json& f, const rd::Scene& s, const Config& config) {
+Frames parseFrames(const json& f, int count, const rd::Scene& s, const Config& config) {
   Frames out;
-  out.count = f["count"];
+  out.count = count;
   out.fps = f.value("fps", out.fps);
   out.flipbook = f.value("format", "gif") == "flipbook";
   if (!out.flipbook && out.fps > 50)
@@ -261,8 +261,8 @@ rd::Scene buildScene(const RenderRequest& request, const json& body, const Reque
   const Config& config = ctx.config;
   effects::Stopwatch watch;
   rd::Scene s;
-  s.width = body.value("width", s.width);
-  s.height = body.value("height", s.height);
+  s.width = request.width;  // as parseRenderRequest read them
+  s.height = request.height;
   if (size_t(s.width) * size_t(s.height) > config.limits.maxRenderPixels)
     throw fieldError(413, "/width",
                      std::to_string(s.width) + "x" + std::to_string(s.height) + " exceeds the limit of " +
@@ -271,7 +271,7 @@ rd::Scene buildScene(const RenderRequest& request, const json& body, const Reque
   s.time = body.value("time", 0.0);
   if (animation) {
     animation->time = s.time;
-    if (body.contains("frames")) animation->frames = parseFrames(body["frames"], s, config);
+    if (request.frames) animation->frames = parseFrames(body["frames"], *request.frames, s, config);
   }
   parseCamera(body, s);
   if (body.contains("background")) parseBackground(body["background"], config, s);
