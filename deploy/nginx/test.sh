@@ -79,4 +79,17 @@ for path in /readyz /metrics / /index.html; do
 done
 code=$(curl -s --max-time 5 -o /dev/null -w '%{http_code}' "http://127.0.0.1:$lb/healthz")
 [ "$code" = "200" ] || { echo "/healthz through nginx: $code"; exit 1; }
-echo "nginx test ok: replicas on $a and $b agree, cache MISS then HIT through $lb"
+# A job through nginx: every jobs route reaches the process that took it.
+job=$(curl -s --max-time 20 -D - -o /dev/null -H 'Content-Type: application/json' \
+  -d '{"effect":"fog","request":{"fog":{"fogType":"GL_EXP2","density":0.08},"table":{"size":16}}}' \
+  "http://127.0.0.1:$lb/v1/jobs" | tr -d '\r' | sed -n 's/^Location: //p')
+[ -n "$job" ] || { echo "POST /v1/jobs through nginx: no Location"; exit 1; }
+for i in $(seq 100); do  # polls until done, each answered by the process that has the job
+  code=$(curl -s --max-time 5 -o "$work/job" -w '%{http_code}' "http://127.0.0.1:$lb$job")
+  [ "$code" = "200" ] || { echo "GET $job through nginx (poll $i): $code"; exit 1; }
+  [ "$i" -ge 4 ] && grep -q '"state":"done"' "$work/job" && break
+  sleep 0.05
+done
+code=$(curl -s --max-time 5 -o /dev/null -w '%{http_code}' "http://127.0.0.1:$lb$job/result")
+[ "$code" = "200" ] || { echo "GET $job/result through nginx: $code"; exit 1; }
+echo "nginx test ok: replicas on $a and $b agree, cache MISS then HIT through $lb; a job followed through it"
