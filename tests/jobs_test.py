@@ -114,6 +114,10 @@ def same(binary):
                       (state["state"], j_status, s_status, j_headers.get("ETag"), s_headers.get("ETag")))
                 status, _, _ = request(port, "GET", location + "/result", headers={"If-None-Match": s_headers["ETag"]})
                 check(status == 304, f"{name} by {how}: If-None-Match on the result gives 304", status)
+                status, headers, coded = request(port, "GET", location + "/result", headers={"Accept-Encoding": "br, gzip"})
+                check(status == 200 and coded == s_body and "Content-Encoding" not in headers,
+                      f"{name} by {how}: the result goes as stored whatever the client accepts (its ETag names those bytes)",
+                      headers.get("Content-Encoding"))
     finally:
         p.terminate()
         p.wait()

@@ -253,6 +253,7 @@ void Service::answerJobResult(const httplib::Request& req, httplib::Response& re
     for (const auto& [name, value] : a.headers)
       if (name != "Content-Type" && name != "Content-Length") res.set_header(name, value);
     res.status = a.status;
+    tl.encoded = true;  // sent as stored (identity): its ETag names these bytes, not a coding of them
     auto type = a.headers.find("Content-Type");
     res.set_content(a.body, type == a.headers.end() ? "application/octet-stream" : type->second);
     return;
