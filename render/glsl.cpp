@@ -124,26 +124,30 @@ std::string boltVertex(bool world) {
   return std::string(kVertexHeader) +
          "layout(location = 0) in vec2 aPixel;\n"
          "layout(location = 1) in vec3 aLine;  // x: intensity, y: signed distance across (px), z: half width\n" +
-         (world ? "layout(location = 2) in float aDepth;\n" : "") +
-         "uniform vec2 uSize;\nout vec3 vLine;\n"
-         "void main() {\n  vLine = aLine;\n"
+         (world ? "layout(location = 2) in vec2 aDepth;  // x: NDC depth, y: the fog's transmittance\n" : "") +
+         "uniform vec2 uSize;\nout vec3 vLine;\nout float vThrough;\n"
+         "void main() {\n  vLine = aLine;\n  vThrough = " + (world ? "aDepth.y" : "1.0") + ";\n"
          "  gl_Position = vec4(2.0 * aPixel.x / uSize.x - 1.0, 1.0 - 2.0 * aPixel.y / uSize.y, " +
-         (world ? "aDepth" : "0.0") + ", 1.0);\n}\n";
+         (world ? "aDepth.x" : "0.0") + ", 1.0);\n}\n";
 }
 
 std::string boltFragment() {
+  // Red: the light as emitted (what a glow spreads); green: as it reaches the eye through fog.
   return std::string(kFragmentHeader) +
-         "in vec3 vLine;\nout vec4 fragColor;\n"
+         "in vec3 vLine;\nin float vThrough;\nout vec4 fragColor;\n"
          "void main() {  // a one-pixel anti-aliased edge\n"
          "  float cover = clamp(vLine.z + 0.5 - abs(vLine.y), 0.0, 1.0);\n"
-         "  fragColor = vec4(vec3(vLine.x * cover), cover);\n}\n";
+         "  fragColor = vec4(vLine.x * cover, vLine.x * vThrough * cover, 0.0, cover);\n}\n";
 }
 
-std::string blurFragment() {
+std::string blurFragment(bool lod) {
   // Runs at half resolution: the glow is low-frequency. Samples sit on half-resolution texel
   // centres, so bilinear filtering of a full-resolution source averages 2x2 texels for free.
+  // lod: the source read at mip level uLod (the APSF's wide Gaussians run at 1/2^uLod).
+  const std::string fetch = lod ? "textureLod(uSource, " : "texture(uSource, ";
+  const std::string lodArg = lod ? ", uLod)" : ")";
   return std::string(kFragmentHeader) +
-         "uniform sampler2D uSource;\n"
+         "uniform sampler2D uSource;\n" + (lod ? "uniform float uLod;\n" : "") +
          "uniform vec2 uStep;          // one half-resolution texel along the blur axis, in uv\n"
          "uniform vec2 uTargetSize;\n"
          "uniform int uRadius;\n"
@@ -151,22 +155,27 @@ std::string blurFragment() {
          "out vec4 fragColor;\n"
          "void main() {\n"
          "  vec2 uv = gl_FragCoord.xy / uTargetSize;\n"
-         "  vec4 sum = uWeights[0] * texture(uSource, uv);\n"
+         "  vec4 sum = uWeights[0] * " + fetch + "uv" + lodArg + ";\n"
          "  for (int i = 1; i <= uRadius; ++i)\n"
-         "    sum += uWeights[i] * (texture(uSource, uv + float(i) * uStep) + texture(uSource, uv - float(i) * "
-         "uStep));\n"
+         "    sum += uWeights[i] * (" + fetch + "uv + float(i) * uStep" + lodArg + " + " + fetch + "uv - float(i) * uStep" +
+         lodArg + ");\n"
          "  fragColor = sum;\n}\n";
 }
 
-std::string compositeFragment(bool glow) {
+std::string compositeFragment(bool glow, int apsf) {
   std::string s = std::string(kFragmentHeader) + "uniform sampler2D uCore;\n";
   if (glow) s += "uniform sampler2D uGlow;\nuniform float uGlowStrength;\n";
+  for (int k = 0; k < apsf; ++k) s += "uniform sampler2D uApsf" + std::to_string(k) + ";\n";
+  if (apsf > 0) s += "uniform float uApsfWeight[" + std::to_string(apsf) + "];\n";
   s += "uniform vec3 uColor;\nout vec4 fragColor;\n"
        "void main() {  // added over the scene\n"
        "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
-       "  float light = texelFetch(uCore, p, 0).r;\n";
+       "  float light = texelFetch(uCore, p, 0).g;  // through the fog\n";
   if (glow)
     s += "  light += uGlowStrength * texture(uGlow, gl_FragCoord.xy / vec2(textureSize(uCore, 0))).r;  // upsampled\n";
+  for (int k = 0; k < apsf; ++k)
+    s += "  light += uApsfWeight[" + std::to_string(k) + "] * texture(uApsf" + std::to_string(k) +
+         ", gl_FragCoord.xy / vec2(textureSize(uCore, 0))).r;\n";
   return s + "  fragColor = vec4(uColor * light, min(light, 1.0));\n}\n";
 }
 

@@ -9,6 +9,7 @@ Gpu::~Gpu() {
     if (emptyVao) glDeleteVertexArrays(1, &emptyVao);
     normalA = Texture(), normalB = Texture(), waveAlpha = Texture(), defaultFlow = Texture();
     for (Target* t : {&main, &resolved, &boltCore, &blurred, &glow}) t->release();
+    for (int i = 0; i < 3; ++i) apsfBlurred[i].release(), apsfGlow[i].release();
     environment = Texture();
     thinFilms.entries.clear(), spheres.entries.clear();
     if (environmentFbo) glDeleteFramebuffers(1, &environmentFbo);

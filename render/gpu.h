@@ -7,6 +7,8 @@
 #include <array>
 
 #include <deque>
+#include <map>
+#include <tuple>
 #include <memory>
 #include <optional>
 #include <string>
@@ -60,6 +62,9 @@ struct Gpu {
   // Kept from frame to frame (made again only when a frame's size or format differs): the
   // frame, its 8-bit resolve, the bolt's core and glow buffers, the environment cube.
   Target main, resolved, boltCore, blurred, glow;
+  Target apsfBlurred[3], apsfGlow[3];  // the APSF glow's Gaussians, each at its own resolution
+  // Fitted APSF kernels by (T, q, method): an animation's frames share one.
+  std::map<std::tuple<double, double, int>, glow::Kernel> apsfKernels;
   Texture environment;
   GLuint environmentFbo = 0;
   Uploads<bubble::ThinFilmTable, Texture> thinFilms;

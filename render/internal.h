@@ -36,8 +36,9 @@ std::string quadVertex();
 std::string quadFragment(const fog::ShaderVariant* fog);
 std::string boltVertex(bool world);
 std::string boltFragment();
-std::string blurFragment();
-std::string compositeFragment(bool glow);
+std::string blurFragment(bool lod = false);
+// glow: today's Gaussian; apsf: that many Gaussians of the APSF glow (0 ... 3), uApsf0 ... 2.
+std::string compositeFragment(bool glow, int apsf = 0);
 std::string blendFragment();
 // The frame (premultiplied, rows bottom-up) as an 8-bit PNG's rows: straight alpha, top-down,
 // each value floor(255 v + 0.5) / 255 so that the RGBA8 target stores round(255 v) exactly.

@@ -1072,5 +1072,71 @@ TEST(Render, BackgroundImageFillsTheFrame) {
   EXPECT_GT(pixel(out, 61, 61).r + pixel(out, 61, 61).g + pixel(out, 61, 61).b, 2.85f);
 }
 
+
+// A 3-D bolt seen through fog glows by the fog's APSF; without fog, today's Gaussian.
+// The glow alone (the frame minus the same frame with glowStrength 0) spreads wider as the fog
+// between the camera and the bolt thickens, and the header names the kernel that ran.
+TEST(Render, BoltInFogGlowsByItsApsf) {
+  TestServer s;
+  json scene = json::parse(slurp(fs::path(EFFECTD_EXAMPLES_DIR) / "09-bolt-3d.json"));
+  scene["width"] = scene["height"] = 256;
+  scene["camera"]["fovY"] = 90;
+  scene.erase("quads");
+  scene["lightningStyle"]["forwardScattering"] = 0.99;
+  auto render = [&](const json& body, std::string* glow = nullptr, std::string* passes = nullptr) {
+    auto r = s.postJson("/v1/render", body.dump());
+    EXPECT_TRUE(r && r->status == 200);
+    if (!r || r->status != 200) return rd::Image{};
+    if (glow) *glow = r->get_header_value("X-Glow");
+    if (passes) *passes = r->get_header_value("X-Render-Passes");
+    return decode(r->body);
+  };
+  {
+    json clear = scene;
+    clear.erase("fog");
+    std::string glow, passes;
+    render(clear, &glow, &passes);
+    EXPECT_EQ(glow.rfind("gaussian sigma", 0), 0u) << glow;
+    EXPECT_EQ(passes.find("glowApsf"), std::string::npos) << passes;
+  }
+  double previousT = 0, previousRadius = 0;
+  for (double density : {0.055, 0.08, 0.14}) {
+    json fogged = scene;
+    fogged["fog"] = {{"fog", {{"fogType", "GL_EXP"}, {"color", {0, 0, 0}}, {"density", density}}}};
+    std::string glow, passes;
+    const rd::Image with = render(fogged, &glow, &passes);
+    fogged["lightningStyle"]["glowStrength"] = 0;
+    const rd::Image without = render(fogged);
+    ASSERT_EQ(with.rgba.size(), without.rgba.size());
+    EXPECT_NE(passes.find("glowApsf"), std::string::npos) << passes;
+    ASSERT_EQ(glow.rfind("apsf T ", 0), 0u) << glow;
+    const double t = std::stod(glow.substr(7));
+    // The glow's light and its centre, then the radius holding half of it.
+    std::vector<std::tuple<double, double, double>> light;  // x, y, amount
+    double total = 0, cx = 0, cy = 0;
+    for (int y = 0; y < with.height; ++y)
+      for (int x = 0; x < with.width; ++x) {
+        const size_t i = 4 * (size_t(y) * size_t(with.width) + size_t(x));
+        const double a = std::max(0.0, double(with.at(i) - without.at(i)));
+        light.emplace_back(x, y, a);
+        total += a, cx += a * x, cy += a * y;
+      }
+    ASSERT_GT(total, 1.0) << "no glow at density " << density;
+    cx /= total, cy /= total;
+    std::vector<std::pair<double, double>> byDistance;
+    for (auto [x, y, a] : light) byDistance.emplace_back(std::hypot(x - cx, y - cy), a);
+    std::sort(byDistance.begin(), byDistance.end());
+    double sum = 0, radius = 0;
+    for (auto [d, a] : byDistance)
+      if ((sum += a) >= total / 2) {
+        radius = d;
+        break;
+      }
+    EXPECT_GT(t, previousT) << glow;
+    EXPECT_GT(radius, previousRadius) << "density " << density << ": " << glow;
+    previousT = t, previousRadius = radius;
+  }
+}
+
 }  // namespace
 }  // namespace effectd::testing

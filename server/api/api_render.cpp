@@ -208,6 +208,7 @@ void addRenderEndpoints(Service& service) {
     if (!drawn.ok()) throwError(drawn.error());
     const rd::Frame& f = drawn.value().frame;
     reply.headers = {{"X-Renderer", pool->description()}, {"X-Render-Passes", f.passList()}};
+    if (!f.glow.empty()) reply.headers["X-Glow"] = f.glow;
     reply.binary = std::move(drawn.value().output.bytes);
     reply.contentType = drawn.value().output.contentType;
     for (auto& [name, value] : drawn.value().output.headers) reply.headers[name] = std::move(value);

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include <effects/bubble.h>
+#include <effects/glow.h>
 
 #include "api/api_bubble.h"
 #include "api/api_common.h"
@@ -185,6 +186,9 @@ rd::Lightning sceneLightning(const LightningRequest& r, const json& body, Animat
   l.coreWidth = st.value("coreWidth", l.coreWidth);
   l.glowSigma = st.value("glowSigma", l.glowSigma);
   l.glowStrength = st.value("glowStrength", l.glowStrength);
+  l.radiance = st.value("radiance", l.radiance);
+  if (st.contains("forwardScattering")) l.forwardScattering = st["forwardScattering"].get<double>();
+  l.apsfMethod = *effects::glow::methodFromString(st.value("glowKernel", "gaussians-3"));  // enum checked by the schema
   return l;
 }
 

@@ -36,6 +36,7 @@
 #include <effects/bubble.h>
 #include <effects/common.h>
 #include <effects/fog.h>
+#include <effects/glow.h>
 #include <effects/lightning.h>
 #include <effects/parallel.h>
 
@@ -123,6 +124,15 @@ struct Lightning {
   double coreWidth = 1.5;  // pixels per unit of polyline width (main 2, branch 1)
   double glowSigma = 6;    // Gaussian sigma in pixels; 0 = no glow (no blur pass)
   double glowStrength = 1.5;
+  // A 3-D bolt in a scene with fog is seen through it (docs/rendering.md "The bolt in fog"):
+  // each vertex dimmed by the fog's transmittance along its ray, and the glow, instead of the
+  // Gaussian, the atmospheric point spread function (effects/glow.h) of the fog between the
+  // camera and the bolt's middle: glowStrength x radiance x (1 - e^-T) x the kernel, drawn as
+  // its fitted Gaussians. radiance is the core's brightness in display units (lightning is far
+  // brighter than what a display shows, and the halo is that light spread over tens of degrees).
+  double radiance = 100;
+  std::optional<double> forwardScattering;  // q; none: the fog's own (glow::forwardScatteringOf)
+  glow::Method apsfMethod = glow::Method::kGaussians3;  // kGaussian, kGaussians2 or kGaussians3
 };
 
 struct Fog {
@@ -179,6 +189,8 @@ struct Frame {
   double drawMs = 0;                // the passes issued and finished (glFinish), + preparation
   double readMs = 0;                // the pixels read back and converted
   double queueMs = 0;               // waiting for a render thread, before ms
+  std::string glow;                 // which glow the bolt got, e.g. "gaussian sigma 6 px" or
+                                    // "apsf T 2.1 q 0.9 gaussians-3 (misplaced 0.0005)"; "" without a bolt
   std::string passList() const;     // "background,quads,...": the passes, comma-separated
 };
 
