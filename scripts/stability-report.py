@@ -1422,7 +1422,109 @@ def cases(quick):
          tangents_equal_at_scales({"mesh": QUAD}, [1e-30, 1e6, 1e38]),
          "tangents are directions: the same as at scale 1 within 1e-6, along ∂p/∂u at every scale"),
     ]
-    return out + scene_rows() + render_rows()
+    return out + scene_rows() + render_rows() + glow_rows()
+
+
+# ---- the glow through fog: the APSF (docs/effects.md §5) -----------------------------------------
+def apsf_py(t, q, mu):
+    """The series written out again here (log-space terms, Legendre recurrence), per steradian over
+    4 pi T^-2: the server's code is not used. T below 1.05 takes 1.05's shape (glow.h)."""
+    t = min(max(t, 1.05), 1e4)
+    total, lp, lc, m = 0.0, 1.0, mu, 1
+    while True:
+        beta = 0.0 if m == 1 else (2 * m + 1) / m * (1 - q ** (m - 1))
+        r = math.exp(-beta * t - (m - 1) * math.log(t))
+        total += r * (lp + lc)
+        if m > 3 and r < 1e-18 and (m - 1) * math.log(t) > 40:
+            break
+        lp, lc = lc, ((2 * m + 1) * mu * lc - m * lp) / (m + 1)
+        m += 1
+    return max(total, 0.0) / (4 * math.pi)
+
+
+def glow_body(glow, fog_def=None):
+    return {"fog": fog_def or {"fogType": "GL_EXP", "density": 0.01}, "glow": glow, "include": ["glow"]}
+
+
+def glow_table(expected, must_direct=None, tol=2e-7):
+    """Every table entry against expected(theta) within tol relative (the answer's numbers are
+    floats: 6e-8) or 1e-9 absolute (the entries that should be 0), and direct = must_direct when given."""
+    def check(answers):
+        s, a = answers[0]
+        if s != 200:
+            return False, f"status {s}"
+        g = a["glow"]
+        t = g["table"]
+        exp = [expected(math.radians(x)) for x in t["angleDeg"]]
+        got = t["perSteradian"]
+        err = max((abs(o - e) / e for o, e in zip(got, exp) if e > 1e-9), default=0.0)
+        ok = len(got) == len(exp) and all(math.isfinite(o) and (abs(o - e) <= 1e-9 or abs(o - e) <= tol * e)
+                                          for o, e in zip(got, exp))
+        if must_direct is not None:
+            ok = ok and all(abs(o - e) <= 1e-12 + tol * e for o, e in ((g["direct"], must_direct), (g["scattered"], 1 - must_direct)))
+        return ok, (f"{len(got)} entries, K(0) = {got[0]:.6g}; max relative |K − closed form| {err:.2g} (above 1e-9); "
+                    f"direct {g['direct']:.3g}, scattered {g['scattered']:.3g} (T {g['opticalThickness']:.4g})")
+    def change(answers):
+        answers[0][1]["glow"]["table"]["perSteradian"][0] *= 1.001
+    return with_mutation(check, "K(0) ×1.001", change)
+
+
+def glow_invariant(answers):
+    """The glow of a fog's ray equals the glow of its optical thickness given: T = density × length."""
+    (s1, a1), (s2, a2) = answers
+    if s1 != 200 or s2 != 200:
+        return False, f"status {s1}, {s2}"
+    g1, g2 = a1["glow"], a2["glow"]
+    ok = abs(g1["opticalThickness"] - 2) <= 1e-9 and g1["table"] == g2["table"] and g1["gaussians"] == g2["gaussians"]
+    return ok, f"T from the fog {g1['opticalThickness']:.12g} (2 given); tables and Gaussians equal: {g1['table'] == g2['table']}"
+
+
+def halo_grows(answers):
+    radii = [a["glow"]["haloRadiusDeg"] for s, a in answers if s == 200]
+    ok = len(radii) == len(answers) and all(b > a for a, b in zip(radii, radii[1:]))
+    return ok, "halo radius " + ", ".join(f"{r:.3g}°" for r in radii)
+
+
+def glow_rows():
+    table = {"kernel": "table", "samples": 19, "maxAngleDeg": 180}
+    def closed_q1(t):
+        def k(theta):
+            x = 1 / t
+            g = 1 / math.sqrt(1 - 2 * math.cos(theta) * x + x * x)
+            return (g / t ** 2 + (g - 1) / t) * t * t / (4 * math.pi)
+        return k
+    diffuse = lambda theta: (1 + math.cos(theta)) / (4 * math.pi)
+    return [
+        ("glow", "APSF, q = 1 (all forward), T = 1.3", "fog", glow_body({**table, "opticalThickness": 1.3, "forwardScattering": 1}),
+         glow_table(closed_q1(1.3), math.exp(-1.3)),
+         "β_m = 0: the Legendre generating function, K = (G/T² + (G − 1)/T)·T²/4π, G = (1 − 2μ/T + 1/T²)^−½, within 2e-7 (the answer's floats); direct e^−T"),
+        ("glow", "APSF, T = 1e300 (every g_m past g_1 underflows)", "fog", glow_body({**table, "opticalThickness": 1e300, "forwardScattering": 0.9}),
+         glow_table(diffuse, 0.0),
+         "the diffuse limit (1 + μ)/4π in log space, finite; direct 0, scattered 1"),
+        ("glow", "APSF, T = 0 (clear air)", "fog", glow_body({**table, "opticalThickness": 0, "forwardScattering": 0.9}),
+         glow_table(lambda th: apsf_py(0, 0.9, math.cos(th)), 1.0),
+         "nothing scattered (direct 1, scattered 0: the halo gone); the shape at the series' floor T = 1.05, as the series summed here"),
+        ("glow", "APSF, q = 0 (isotropic), T = 3 (0⁰ at m = 1)", "fog", glow_body({**table, "opticalThickness": 3, "forwardScattering": 0}),
+         glow_table(lambda th: apsf_py(3, 0.0, math.cos(th)), math.exp(-3)),
+         "the series summed here in Python (β_1 = 0 for every q) within 2e-7 relative"),
+        ("glow", "fog GL_EXP density 1e300 between camera and light 1 apart", "fog",
+         glow_body({**table, "camera": [0, 0, 0], "source": [0, 0, -1]}, {"fogType": "GL_EXP", "density": 1e300}),
+         glow_table(diffuse, 0.0),
+         "T = −ln 0 held at 745 (e^−745, the last double): finite, the diffuse shape, direct 0"),
+        ("glow", "T from the fog = T given (GL_EXP 0.01 over 200)", "fog",
+         [glow_body({"camera": [0, 0, 0], "source": [0, 0, -200], "forwardScattering": 0.9}),
+          glow_body({"opticalThickness": 2, "forwardScattering": 0.9})],
+         with_mutation(glow_invariant, "T from the fog 1 % off",
+                       lambda answers: answers[0][1]["glow"].__setitem__("opticalThickness", 2.02)),
+         "an invariance: the ray's T = density·length = 2, and the same kernel as T = 2 given"),
+        ("glow", "halo radius against T (q 0.95): 1.2, 2, 4, 8, 40", "fog",
+         [glow_body({"opticalThickness": t, "forwardScattering": 0.95, "kernel": "table", "samples": 256}) for t in (1.2, 2, 4, 8, 40)],
+         with_mutation(halo_grows, "T 2's radius past T 4's",
+                       lambda answers: answers[1][1]["glow"].__setitem__("haloRadiusDeg", answers[2][1]["glow"]["haloRadiusDeg"] + 1)),
+         "the half-light radius grows strictly with T (the issue's monotone halo)"),
+        ("glow", "neither T nor a ray", "fog", glow_body({"kernel": "gaussian"}), problem(400, "/glow"),
+         "a 400 naming /glow"),
+    ]
 
 
 SERVER = None

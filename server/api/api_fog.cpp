@@ -1,10 +1,12 @@
 // POST /v1/fog — fog definitions -> weight tables (with their error), region lookups.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <glm/geometric.hpp>
 
 #include <effects/fog.h>
+#include <effects/glow.h>
 #include <render/render.h>
 
 #include "api/api_common.h"
@@ -234,6 +236,59 @@ json fogShaderJson(const FogRequest& request, const RequestContext& ctx, JsonRep
   return out;
 }
 
+// The glow of a light seen through this fog (include "glow"): its APSF kernel, as fitted
+// Gaussians and as a radial table, with the light it misplaces against the series.
+json glowJson(const FogRequest& request, const RequestContext& ctx, JsonReply& reply) {
+  namespace gw = effects::glow;
+  if (!request.glow) throw fieldError(400, ctx.at + "/glow", "is required when include has \"glow\"");
+  const FogRequest::Glow& g = *request.glow;
+  gw::Medium m;
+  std::string thicknessFrom = "given";
+  if (g.opticalThickness) {
+    m.thickness = *g.opticalThickness;
+  } else {
+    m.thickness = gw::thicknessAlong(request.fog, request.regions, *g.camera, *g.source);
+    thicknessFrom = "-ln(the fog's mean transmittance from camera to source)";
+  }
+  const int region = g.source ? fog::regionAt(request.regions, *g.source) : -1;
+  m.forwardScattering = g.forwardScattering.value_or(
+      gw::forwardScatteringOf(region < 0 ? request.fog : request.regions[size_t(region)].fog));
+  auto k = gw::kernel(m, g.kernel);
+  if (!k.ok()) throwError(k.error(), ctx.at + "/glow", {{"maxAngle", {ctx.at + "/glow/maxAngleDeg"}}});
+  const gw::Kernel& kernel = k.value();
+  reply.computeMs += kernel.stats.elapsedMs;
+  reply.errorMs += kernel.stats.errorMs;
+  constexpr double kDeg = 180 / std::numbers::pi;
+  json table = {{"angleDeg", json::array()}, {"perSteradian", json::array()}};
+  for (int i = 0; i < g.kernel.samples; ++i) {
+    const double a = g.kernel.maxAngle * i / (g.kernel.samples - 1);
+    table["angleDeg"].push_back(wire(a * kDeg));
+    table["perSteradian"].push_back(wire(gw::kernelAt(kernel, a)));
+  }
+  json out = {{"opticalThickness", m.thickness},  // a double: T may pass a float's range
+              {"opticalThicknessFrom", thicknessFrom},
+              {"forwardScattering", wire(m.forwardScattering)},
+              {"shapeThickness", kernel.shapeThickness},
+              {"direct", wire(kernel.direct)},
+              {"scattered", wire(kernel.scattered)},
+              {"method", gw::toString(kernel.method)},
+              {"haloRadiusDeg", wire(kernel.haloRadius * kDeg)},
+              {"maxAngleDeg", wire(kernel.maxAngle * kDeg)},
+              {"table", std::move(table)},
+              {"seriesTerms", int(kernel.stats.counters.at("seriesTerms"))}};
+  if (!kernel.gaussians.empty()) {
+    json list = json::array();
+    for (const gw::Gaussian& gs : kernel.gaussians) list.push_back({{"weight", wire(gs.weight)}, {"sigmaDeg", wire(gs.sigma * kDeg)}});
+    out["gaussians"] = std::move(list);
+  }
+  if (kernel.misplaced)
+    out["error"] = {{"misplaced", wire(*kernel.misplaced)},
+                    {"metric", kernel.stats.errorMetric},
+                    {"reference", kernel.stats.reference},
+                    {"kind", "measured"}};
+  return out;
+}
+
 }  // namespace
 
 FogRequest parseFogRequest(const json& body, const RequestContext& ctx) {
@@ -257,6 +312,21 @@ FogRequest parseFogRequest(const json& body, const RequestContext& ctx) {
   const json shader = body.value("shader", json::object());
   r.shaderLanguage = shader.value("language", r.shaderLanguage);
   if (shader.contains("camera")) r.shaderCamera = toVec3(shader["camera"]);
+  if (body.contains("glow")) {
+    const json& g = body["glow"];
+    FogRequest::Glow glow;
+    if (g.contains("camera")) glow.camera = toVec3(g["camera"]);
+    if (g.contains("source")) glow.source = toVec3(g["source"]);
+    if (g.contains("opticalThickness")) glow.opticalThickness = g["opticalThickness"].get<double>();
+    if (g.contains("forwardScattering")) glow.forwardScattering = g["forwardScattering"].get<double>();
+    glow.kernel.method = *effects::glow::methodFromString(g.value("kernel", "gaussians-3"));  // the schema's enum
+    glow.kernel.samples = g.value("samples", glow.kernel.samples);
+    if (g.contains("maxAngleDeg")) glow.kernel.maxAngle = g["maxAngleDeg"].get<double>() * std::numbers::pi / 180;
+    glow.kernel.measureError = g.value("measureError", glow.kernel.measureError);
+    if (!glow.opticalThickness && !(glow.camera && glow.source))
+      throw fieldError(400, ctx.at + "/glow", "needs opticalThickness, or camera and source (the ray through the fog)");
+    r.glow = glow;
+  }
   return r;
 }
 
@@ -322,6 +392,7 @@ JsonReply runFog(const FogRequest& request, const json& /*body*/, const RequestC
     out["samples"] = std::move(list);
   }
   if (include.has("shader")) out["shader"] = fogShaderJson(request, ctx, reply);
+  if (include.has("glow")) out["glow"] = glowJson(request, ctx, reply);
   if (include.has("stats")) out["stats"] = std::move(stats);
   reply.body = std::move(out);
   return reply;

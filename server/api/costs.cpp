@@ -29,7 +29,8 @@ Cost fogCost(const FogRequest& r, const Config& config) {
   size_t entries = height ? size * effects::fog::tableRows(r.table, size) : size;
   entries = std::min(entries, config.limits.maxTableSize);
   return {kBase + entries * (64 + kAnswerNumber * (4 + 3 * (r.objectColors ? r.objectColors->size() : 0))) +
-             (r.samples ? r.samples->points.size() : 0) * 8 * kAnswerNumber,
+             (r.samples ? r.samples->points.size() : 0) * 8 * kAnswerNumber +
+             (r.glow ? size_t(r.glow->kernel.samples) * (8 * 4 + 2 * kAnswerNumber) : 0),  // the series at 4x samples
           false};
 }
 

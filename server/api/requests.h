@@ -13,6 +13,7 @@
 
 #include <effects/bubble.h>
 #include <effects/fog.h>
+#include <effects/glow.h>
 #include <effects/lightning.h>
 #include <effects/tangents.h>
 
@@ -50,6 +51,13 @@ struct FogRequest {
   std::optional<Samples> samples;  // exact fog at points seen from a camera
   std::string shaderLanguage = "glsl-es-300";  // include "shader": shader.language
   glm::dvec3 shaderCamera{0};                  // ... and the camera its uniforms are for
+  struct Glow {  // include "glow": the APSF of this fog between a camera and a light
+    std::optional<glm::dvec3> camera, source;  // T along this ray through the fog (and regions) ...
+    std::optional<double> opticalThickness;    // ... or given
+    std::optional<double> forwardScattering;   // q; none: the fog's own at the source
+    effects::glow::KernelOptions kernel;
+  };
+  std::optional<Glow> glow;
 };
 
 struct LightningRequest {

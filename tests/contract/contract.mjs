@@ -93,7 +93,7 @@ function includeItems(schemaFile) {
 }
 function variants(kind, body) {
   const out = [['as given', body]];
-  const all = includeItems(`${kind}.json`).filter((i) => !(kind === 'fog' && i === 'samples' && !body.samples));
+  const all = includeItems(`${kind}.json`).filter((i) => !(kind === 'fog' && ((i === 'samples' && !body.samples) || (i === 'glow' && !body.glow))));
   out.push(['include all', { ...body, include: all }]);
   if (kind === 'fog') {
     for (const encoding of ['rgba8', 'rgba16f']) out.push([encoding, { ...body, table: { ...(body.table || {}), encoding } }]);
