@@ -9,6 +9,8 @@
 //   fog       fogTexture(answer) and applyFog(material, answer): /v1/fog's table as a DataTexture,
 //             applied per fragment to any built-in material through onBeforeCompile
 //   tangents  /v1/tangents' GLB needs nothing: GLTFLoader reads TANGENT and normal maps use it
+//   glow      apsfGlow(renderer, fogAnswer.glow): a bolt seen through fog, its core dimmed and its
+//             glow the fog's point spread function, as the preview draws it
 //
 // Colours: effectd's shaders and tables work in the values its previews write (no sRGB encoding
 // of their own), so the raw shaders here write them unchanged, and fog is applied after three's
@@ -63,12 +65,13 @@ uniform sampler2D uProfile;
 uniform vec3 uColor;
 uniform bool uGlow;
 uniform float uGain;
+uniform float uThrough;  // what the fog between the camera and the bolt lets through (apsfGlow sets it)
 varying vec2 vUv;
 varying float vBrightness;
 void main() {
   float v = 2.0 * vUv.y - 1.0;
   float across = uGlow ? uGain * exp(-4.0 * v * v) : texture2D(uProfile, vec2(0.5, vUv.y)).a;
-  gl_FragColor = vec4(uColor * (vBrightness * across), 1.0);
+  gl_FragColor = vec4(uColor * (vBrightness * across * uThrough), 1.0);
 }`;
 
 // Each vertex's offset from its ribbon's middle: the ribbons' vertices come in pairs (2k, 2k + 1),
@@ -126,7 +129,7 @@ function makeBolt(parts, timeline, { color = [0.75, 0.85, 1.0], profile = null, 
           uMain: { value: main }, uProfile: { value: profile || profileTexture() },
           uColor: { value: new THREE.Color(...color) },  // display values, as the preview's
           uGlow: { value: layer === 'glow' }, uWiden: { value: layer === 'glow' ? glow.width : 1 },
-          uGain: { value: layer === 'glow' ? glow.strength : 1 },
+          uGain: { value: layer === 'glow' ? glow.strength : 1 }, uThrough: { value: 1 },
         },
         blending: THREE.AdditiveBlending, transparent: true, depthWrite: false, side: THREE.DoubleSide,
       });
@@ -143,6 +146,8 @@ function makeBolt(parts, timeline, { color = [0.75, 0.85, 1.0], profile = null, 
     duration: timeline ? timeline.duration : 0,
     // Game seconds since the leader set off (the answer's timeline times).
     setTime(t) { for (const m of materials) m.uniforms.uTime.value = t; },
+    // The share of its light the fog lets through to the eye (1: clear air); apsfGlow sets it.
+    setThrough(f) { for (const m of materials) m.uniforms.uThrough.value = f; },
     dispose() { for (const m of materials) m.dispose(); for (const c of group.children) c.geometry.dispose(); if (keys) keys.dispose(); },
   };
 }
@@ -181,6 +186,128 @@ export function boltFromAnswer(answer, options = {}) {
     return { main: p.channel === 'main', geometry: g };
   });
   return makeBolt(parts, answer.timeline || null, options);
+}
+
+// ---- the glow through fog -----------------------------------------------------------------------
+
+const SCREEN_VS = `in vec3 position;
+out vec2 vUv;
+void main() { vUv = position.xy * 0.5 + 0.5; gl_Position = vec4(position.xy, 0.0, 1.0); }`;
+const BLUR_FS = `precision highp float;
+uniform sampler2D uSource;
+uniform float uLod;
+uniform vec2 uStep;
+uniform int uRadius;
+uniform float uWeights[65];
+in vec2 vUv;
+out vec4 fragColor;
+void main() {
+  vec4 sum = uWeights[0] * textureLod(uSource, vUv, uLod);
+  for (int i = 1; i <= uRadius; ++i)
+    sum += uWeights[i] * (textureLod(uSource, vUv + float(i) * uStep, uLod) + textureLod(uSource, vUv - float(i) * uStep, uLod));
+  fragColor = sum;
+}`;
+const GLOW_FS = `precision highp float;
+uniform sampler2D uGlow0, uGlow1, uGlow2;
+uniform vec3 uWeights;
+uniform vec3 uColor;
+in vec2 vUv;
+out vec4 fragColor;
+void main() {
+  float light = uWeights.x * texture(uGlow0, vUv).r + uWeights.y * texture(uGlow1, vUv).r + uWeights.z * texture(uGlow2, vUv).r;
+  fragColor = vec4(uColor * light, 1.0);
+}`;
+
+// The glow of a bolt seen through fog, as effectd's preview draws it (docs/rendering.md "The bolt
+// in fog"): `glow` is /v1/fog's answer.glow (include ["glow"], the camera and the bolt's middle
+// as its ray, or the optical thickness). render(scene, camera, bolt) draws the scene with the
+// bolt's core dimmed to glow.direct, then adds glowStrength x radiance x glow.scattered x each
+// fitted Gaussian's weight x the bolt's light blurred by that Gaussian (sigma in radians times
+// the camera's focal length in pixels, at the mip level where it is 8 to 16 texels wide).
+// The bolt is a boltFromGltf / boltFromAnswer object already in `scene`. Simplified: one
+// transmittance for the whole core (the preview's is per vertex), and the glow is not hidden by
+// the scene's geometry (neither is the preview's).
+export function apsfGlow(renderer, glow, { radiance = 100, glowStrength = 1.5, color = [0.75, 0.85, 1.0] } = {}) {
+  if (!glow || !glow.gaussians) throw new Error('glow: /v1/fog answer.glow with a gaussian kernel (include ["glow"])');
+  const half = { type: THREE.HalfFloatType, depthBuffer: false };
+  const core = new THREE.WebGLRenderTarget(1, 1, { ...half, generateMipmaps: true, minFilter: THREE.LinearMipmapNearestFilter });
+  const temps = glow.gaussians.map(() => new THREE.WebGLRenderTarget(1, 1, half));
+  const outs = glow.gaussians.map(() => new THREE.WebGLRenderTarget(1, 1, half));
+  const quad = new THREE.Mesh(new THREE.PlaneGeometry(2, 2));
+  quad.frustumCulled = false;
+  const screen = new THREE.Scene().add(quad), screenCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
+  const blur = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: SCREEN_VS, fragmentShader: BLUR_FS, depthTest: false, depthWrite: false,
+    uniforms: { uSource: { value: null }, uLod: { value: 0 }, uStep: { value: new THREE.Vector2() }, uRadius: { value: 1 },
+                uWeights: { value: new Array(65).fill(0) } },
+  });
+  const add = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: SCREEN_VS, fragmentShader: GLOW_FS, depthTest: false, depthWrite: false,
+    blending: THREE.AdditiveBlending, transparent: true,
+    uniforms: { uGlow0: { value: null }, uGlow1: { value: null }, uGlow2: { value: null }, uWeights: { value: new THREE.Vector3() },
+                uColor: { value: new THREE.Color(...color) } },
+  });
+  const size = new THREE.Vector2();
+  const pass = (material, target) => {
+    quad.material = material;
+    renderer.setRenderTarget(target);
+    renderer.render(screen, screenCamera);
+  };
+  return {
+    render(scene, camera, bolt) {
+      const output = renderer.getRenderTarget(), autoClear = renderer.autoClear, clear = renderer.getClearColor(new THREE.Color());
+      const clearAlpha = renderer.getClearAlpha();
+      renderer.getDrawingBufferSize(size);
+      const w = size.x, h = size.y, maxLevel = Math.floor(Math.log2(Math.max(w, h)));
+      // The bolt's light as emitted, alone, with its mip levels.
+      const parent = bolt.object.parent, alone = new THREE.Scene();
+      alone.add(bolt.object);
+      bolt.setThrough(1);
+      core.setSize(w, h);
+      renderer.setClearColor(0x000000, 0);
+      renderer.setRenderTarget(core);
+      renderer.clear();
+      renderer.render(alone, camera);
+      if (parent) parent.add(bolt.object);
+      const focal = 0.5 * h / Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2);
+      const weights = [0, 0, 0];
+      glow.gaussians.slice(0, 3).forEach((g, k) => {
+        const sigma = Math.max(0.5, THREE.MathUtils.degToRad(g.sigmaDeg) * focal);
+        const level = Math.min(Math.max(Math.floor(Math.log2(sigma / 8)), 0), maxLevel);
+        const tw = Math.max(1, Math.ceil(w / 2 ** level)), th = Math.max(1, Math.ceil(h / 2 ** level));
+        temps[k].setSize(tw, th), outs[k].setSize(tw, th);
+        const s = sigma / 2 ** level, radius = Math.min(64, Math.max(1, Math.ceil(3 * s)));
+        const taps = Array.from({ length: 65 }, (_, i) => (i <= radius ? Math.exp(-i * i / (2 * s * s)) : 0));
+        const total = taps.reduce((a, x, i) => a + (i ? 2 : 1) * x, 0);
+        blur.uniforms.uWeights.value = taps.map((x) => x / total);
+        blur.uniforms.uRadius.value = radius;
+        Object.assign(blur.uniforms.uSource, { value: core.texture });
+        blur.uniforms.uLod.value = level;
+        blur.uniforms.uStep.value.set(1 / tw, 0);
+        pass(blur, temps[k]);
+        blur.uniforms.uSource.value = temps[k].texture;
+        blur.uniforms.uLod.value = 0;
+        blur.uniforms.uStep.value.set(0, 1 / th);
+        pass(blur, outs[k]);
+        weights[k] = glowStrength * radiance * glow.scattered * g.weight;
+      });
+      // The frame, the core dimmed by the fog, then the glow added over it.
+      renderer.setClearColor(clear, clearAlpha);
+      bolt.setThrough(glow.direct);
+      renderer.setRenderTarget(output);
+      renderer.render(scene, camera);
+      renderer.autoClear = false;
+      outs.forEach((o, k) => { add.uniforms[`uGlow${k}`].value = o.texture; });
+      for (let k = outs.length; k < 3; ++k) add.uniforms[`uGlow${k}`].value = outs[0].texture;
+      add.uniforms.uWeights.value.set(...weights);
+      pass(add, output);
+      renderer.autoClear = autoClear;
+    },
+    dispose() {
+      for (const t of [core, ...temps, ...outs]) t.dispose();
+      blur.dispose(), add.dispose(), quad.geometry.dispose();
+    },
+  };
 }
 
 // ---- bubble -----------------------------------------------------------------------------------

@@ -32,7 +32,7 @@ try {
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
     const kit = await import('/effectd-three.js');
     const { foundWithinAPixel, litMask, readTopDown, skyCubeFaces } = await import('/page_helpers.mjs');
-    const size = 128, out = {};
+    const size = 128, out = { pictures: {} };
     const post = (route, body) => fetch(`${api}${route}`, { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                                             body: JSON.stringify(body) });
     const canvas = document.getElementById('gl');
@@ -122,6 +122,58 @@ try {
     const tl = timed.timeline;
     out.strike = { before: litShare(-1), stroke: litShare(tl.strokes[0].t + 1e-4), after: litShare(tl.duration + 1), whole: mk.filter(Boolean).length / (size * size) };
 
+    // ---- glow through fog ----
+    // examples/09's 3-D bolt through GL_EXP fog, no geometry: the glow alone (the frame minus the
+    // frame without glow) from apsfGlow with /v1/fog's glow for the camera and the bolt's middle,
+    // against the preview's glow alone (glowStrength 1.5 minus 0). Its total light and the radius
+    // that holds half of it.
+    {
+      const lightning = { grid: { width: 64, height: 64, depth: 32 }, world: { origin: [-8, 14, 4], cellSize: 0.25 },
+                          start: [12, 0, 28], targets: [[48, 39, 18]], eta: 2, seed: 4 };
+      const fogDef = { fog: { fogType: 'GL_EXP', color: [0, 0, 0], density: 0.08 } };
+      const eyeG = [4, 4.5, 19], look = [0, 6.5, 0], fovY = 70;
+      const boltAnswer = await (await post('/v1/lightning', { ...lightning, include: ['mesh'] })).json();
+      const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+      for (const prim of boltAnswer.mesh.primitives)
+        for (let i = 0; i < prim.positions.length; ++i) lo[i % 3] = Math.min(lo[i % 3], prim.positions[i]), hi[i % 3] = Math.max(hi[i % 3], prim.positions[i]);
+      const middle = lo.map((l, k) => (l + hi[k]) / 2);
+      const fogGlow = (await (await post('/v1/fog', { ...fogDef, glow: { camera: eyeG, source: middle }, include: ['glow'] })).json()).glow;
+      const glowCamera = new THREE.PerspectiveCamera(fovY, 1, 0.05, 1000);
+      glowCamera.position.set(...eyeG);
+      glowCamera.lookAt(...look);
+      const glowScene = new THREE.Scene();
+      glowScene.background = new THREE.Color(0, 0, 0);
+      const drawnBolt = kit.boltFromAnswer(boltAnswer);
+      glowScene.add(drawnBolt.object);
+      const glowPass = kit.apsfGlow(renderer, fogGlow, { radiance: 20 });  // unsaturated: compared per ring
+      glowPass.render(glowScene, glowCamera, drawnBolt);
+      const kitWith = readTopDown(renderer.getContext(), size);
+      drawnBolt.setThrough(fogGlow.direct);
+      const kitWithout = frame(glowScene, glowCamera);
+      out.pictures['glow-kit'] = (glowPass.render(glowScene, glowCamera, drawnBolt), canvas.toDataURL('image/png'));
+      const sceneG = { camera: { position: eyeG, target: look, fovY }, background: { color: [0, 0, 0, 1] }, fog: fogDef, lightning };
+      const previewWith = await preview({ ...sceneG, lightningStyle: { glowStrength: 1.5, radiance: 20 } });
+      const previewWithout = await preview({ ...sceneG, lightningStyle: { glowStrength: 0, radiance: 20 } });
+      const measure = (a, b) => {  // the glow's light (blue channel, 0-255 summed), and its half-light radius
+        let total = 0, cx = 0, cy = 0;
+        const light = [];
+        for (let i = 0; i < size * size; ++i) {
+          const v = Math.max(0, a[4 * i + 2] - b[4 * i + 2]);
+          light.push(v), total += v, cx += v * (i % size), cy += v * Math.floor(i / size);
+        }
+        cx /= total, cy /= total;
+        const byDistance = light.map((v, i) => [Math.hypot((i % size) - cx, Math.floor(i / size) - cy), v]).sort((x, y) => x[0] - y[0]);
+        let sum = 0, radius = 0;
+        for (const [d, v] of byDistance) if ((sum += v) >= total / 2) { radius = d; break; }
+        const rings = Array(8).fill(0), counts = Array(8).fill(0);  // the mean glow in rings 8 px wide
+        for (const [d, v] of byDistance) if (d < 64) rings[Math.floor(d / 8)] += v, counts[Math.floor(d / 8)] += 1;
+        return { total, radius, cx, cy, rings: rings.map((x, i) => x / Math.max(counts[i], 1)) };
+      };
+      out.apsf = { kit: measure(kitWith, kitWithout), preview: measure(previewWith, previewWithout), T: fogGlow.opticalThickness,
+                   gaussians: fogGlow.gaussians.length };
+      glowPass.dispose(), drawnBolt.dispose();
+    }
+
     // ---- bubble ----
     const sky = { zenith: [0.35, 0.6, 1.0], horizon: [1.0, 0.98, 0.95], ground: [0.16, 0.18, 0.12] };
     const faces = skyCubeFaces(sky, 128).map((px) => Object.assign(new THREE.DataTexture(px, 128, 128, THREE.RGBAFormat, THREE.FloatType), { needsUpdate: true }));
@@ -170,7 +222,6 @@ try {
     ];
     // A distance fog in a linear table, and a two-layer height fog in a warped 64 x 32 one.
     out.fog = {};
-    out.pictures = {};
     for (const [name, fog, table] of [
       ['EXPONENTIAL', { fog: { fogType: 'EXPONENTIAL', color: [0.55, 0.6, 0.68], visibilityRange: 40 } }, { size: 256, range: [0, 80] }],
       ['HEIGHT warped', { fog: { fogType: 'HEIGHT', color: [0.55, 0.6, 0.68], density: 0.08, heightFalloff: 0.5, startDistance: 2,
@@ -226,6 +277,15 @@ try {
   check(r.strike.before === 0 && r.strike.stroke >= 0.5 * r.strike.whole && r.strike.after === 0,
         `setTime plays the strike: lit share ${r.strike.before} before the leader, ${r.strike.stroke.toFixed(4)} at the first stroke ` +
         `(the whole bolt ${r.strike.whole.toFixed(4)}), ${r.strike.after} after the end`, r.strike);
+  {
+    const { kit: k, preview: p } = r.apsf, total = k.total / p.total, radius = k.radius / p.radius;
+    const ring = Math.max(...k.rings.map((x, i) => Math.abs(x / p.rings[i] - 1)));
+    check(p.total > 1000 && Math.abs(total - 1) < 0.12 && Math.abs(radius - 1) < 0.05 && ring < 0.15,
+          `the bolt's glow through fog (T ${r.apsf.T.toFixed(3)}, ${r.apsf.gaussians} Gaussians) by apsfGlow against the preview's: ` +
+          `light ×${total.toFixed(3)}, half-light radius ${k.radius.toFixed(1)} px against ${p.radius.toFixed(1)} (×${radius.toFixed(3)}), ` +
+          `the mean glow in 8-px rings around its centre at most ${(100 * ring).toFixed(1)} % apart ` +
+          `(tolerances 12 %, 5 %, 15 %)`, r.apsf);
+  }
   for (const [name, d] of Object.entries(r.bubble))
     check(d.pixels > 1500 && d.mean < 1 && d.p99 <= 6 && d.silhouette < 0.02, `the ${name} bubble through the kit against the preview: ${d.pixels} ` +
           `pixels, mean ${d.mean.toFixed(2)}, p99 ${d.p99}, silhouettes apart on ${(100 * d.silhouette).toFixed(2)} % (tolerances 1, 6, 2 %)`, d);
