@@ -1138,5 +1138,37 @@ TEST(Render, BoltInFogGlowsByItsApsf) {
   }
 }
 
+// The core of a 3-D bolt in fog reaches the eye through it: under a GL_EXP fog dense enough to be
+// complete within a hundredth of a unit but capped at maxOpacity 0.6, the closed form lets 0.4
+// through at every vertex, so every lit pixel of the core (glow off) is 0.4 of its clear-air value.
+TEST(Render, BoltCoreIsDimmedByItsFog) {
+  TestServer s;
+  json scene = json::parse(slurp(fs::path(EFFECTD_EXAMPLES_DIR) / "09-bolt-3d.json"));
+  scene["width"] = scene["height"] = 256;
+  scene.erase("quads");
+  scene["background"] = {{"color", {0, 0, 0, 1}}};
+  scene["lightningStyle"]["glowStrength"] = 0;
+  scene.erase("fog");  // the example's own GL_EXP2
+  auto render = [&](const json& body) {
+    auto r = s.postJson("/v1/render", body.dump());
+    EXPECT_TRUE(r && r->status == 200);
+    return r && r->status == 200 ? decode(r->body) : rd::Image{};
+  };
+  const rd::Image clear = render(scene);
+  scene["fog"] = {{"fog", {{"fogType", "GL_EXP"}, {"color", {0, 0, 0}}, {"density", 1000}, {"maxOpacity", 0.6}}}};
+  const rd::Image fogged = render(scene);
+  ASSERT_EQ(clear.rgba.size(), fogged.rgba.size());
+  size_t lit = 0;
+  double worst = 0;
+  for (size_t i = 0; i < clear.values(); i += 4) {
+    const double before = clear.at(i), after = fogged.at(i);  // red: 0.72 at the core, never saturated
+    if (before < 100.0 / 255) continue;
+    ++lit;
+    worst = std::max(worst, std::abs(after - 0.4 * before));
+  }
+  EXPECT_GT(lit, 100u);
+  EXPECT_LE(worst, 1.01 / 255) << "over " << lit << " lit pixels";
+}
+
 }  // namespace
 }  // namespace effectd::testing
