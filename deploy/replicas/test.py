@@ -8,10 +8,14 @@ from a client (ctest deploy_replicas):
   B. one API key's admissions over T seconds from 4 clients, spread over the replicas, within
      10 % of its quota (burst + perMinute/60 * T) summed over the replicas (Redis);
   C. a replica killed mid-load: the GETs in flight and after are retried by nginx, none fails;
-  D. Redis stopped: keyed requests still answered (fail open to per-replica buckets);
+  D. Redis stopped: keyed requests still answered (fail open to per-replica buckets); the job
+     routes answer 503;
   F. a job through nginx: submitted, followed by its events and polled, its answer fetched, all
-     through nginx (the jobs routes go to one replica); Prefer: respond-async on an effect route
-     is answered at once (nginx drops it);
+     through nginx (round robin over the replicas: the jobs live in Redis, --jobs-redis), and its
+     state the same from every replica; Prefer: respond-async on an effect route is answered at
+     once (nginx drops it);
+  G. the replica running a job SIGKILLed: its lease runs out, another replica runs the job again
+     and the answer is fetched through nginx (never left "running");
   E. the public path: readiness, metrics and the playground are not served through nginx (each
      replica's admin port serves them), and with 2 x --max-connections clients trickling their
      headers to nginx, /healthz through nginx and on a replica's admin port answers at once.
@@ -101,6 +105,7 @@ def main():
             # As README.md runs them: the playground off, operations on the admin port.
             procs[f"effectd{i}"] = subprocess.Popen(
                 [binary, "--port", "0", "--threads", "8", "--access-log", "0", "--quota-redis", f"redis://127.0.0.1:{redis_port}",
+                 "--jobs-redis", f"redis://127.0.0.1:{redis_port}",
                  "--api-keys", os.path.join(work, "keys.json"), "--url-signing-key-file", os.path.join(work, "signing.txt"),
                  "--playground", "off", "--admin-port", str(admin_port), "--max-connections", str(MAX_CONNECTIONS)],
                 stderr=log)
@@ -246,6 +251,13 @@ def main():
               result.status == 200 and bolt.get("cellCount", 0) > 0,
               "F: a job submitted, followed, polled and fetched through nginx",
               (r.status, stream[-200:], polls, result.status))
+        seen = []
+        for p in ports:  # each replica, directly: the job is in Redis, not in the one that took it
+            d = http.client.HTTPConnection("127.0.0.1", p, timeout=10)
+            d.request("GET", job, headers=keyed)
+            reply = d.getresponse()
+            seen.append((reply.status, json.loads(reply.read()).get("state")))
+        check(seen == [(200, "done")] * 3, "F: every replica answers the job's state (done)", seen)
         c.request("POST", "/v1/fog", body=json.dumps(fog(4000)), headers={**keyed, "Prefer": "respond-async"})
         r = c.getresponse()
         r.read()
@@ -281,6 +293,47 @@ def main():
         check(len(statuses) == 150 and all(s == 200 for s in statuses),
               "C: replica 2 SIGKILLed after 50 of 150 GETs: all 150 answered 200", [s for s in statuses if s != 200][:5])
 
+        # G. The replica running a job killed: the job is run again by another and answered.
+        c = http.client.HTTPConnection("127.0.0.1", lb, timeout=60)
+        c.request("POST", "/v1/jobs", body=json.dumps({"effect": "lightning", "request": {
+            "grid": {"width": 256, "height": 256}, "method": "dbm", "start": [128, 0], "targets": [[128, 255]], "seed": 3}}),
+            headers=keyed)
+        r = c.getresponse()
+        r.read()
+        job, victim, first = r.getheader("Location") or "", None, None
+        deadline = time.monotonic() + 30
+        while victim is None and time.monotonic() < deadline:
+            c.request("GET", job, headers=keyed)
+            state = json.loads(c.getresponse().read())
+            if state.get("state") == "running" and state.get("worker"):
+                first = state["worker"]
+                pid = int(first.split(":")[1])
+                victim = next((name for name, p in procs.items() if p.pid == pid), None)
+            elif state.get("state") in ("done", "failed", "cancelled"):
+                break
+            time.sleep(0.02)
+        if victim:
+            procs[victim].send_signal(signal.SIGKILL)
+            procs[victim].wait()
+        killed_at = time.monotonic()
+        states = []
+        while time.monotonic() < killed_at + 60:
+            c.request("GET", job, headers=keyed)
+            state = json.loads(c.getresponse().read())
+            if not states or states[-1] != state["state"]:
+                states.append(state["state"])
+            if state["state"] in ("done", "failed", "cancelled"):
+                break
+            time.sleep(0.2)
+        c.request("GET", job + "/result", headers=keyed)
+        result = c.getresponse()
+        bolt = json.loads(result.read())
+        check(victim is not None and state["state"] == "done" and state.get("worker") not in (None, first) and
+              result.status == 200 and bolt.get("cellCount", 0) > 0,
+              f"G: {victim} killed while running the job: {' -> '.join(states)} after "
+              f"{time.monotonic() - killed_at:.1f} s, run again by another replica and fetched through nginx",
+              (victim, first, state, result.status))
+
         # D. Redis stopped: fail open to each replica's own bucket.
         procs["redis"].terminate()
         procs["redis"].wait()
@@ -294,10 +347,15 @@ def main():
             r.read()
             statuses.append(r.status)
         fallbacks = sum(metric(admin[p], 'effectd_quota_charges_total{store="local-fallback"}')
-                        for i, p in enumerate(ports) if i != 1)
+                        for i, p in enumerate(ports) if procs[f"effectd{i}"].poll() is None)
         check(statuses == [200] * 5 and fallbacks >= 5,
               f"D: Redis stopped: keyed requests answered from per-replica buckets ({fallbacks:.0f} local charges)",
               statuses)
+        c.request("GET", job, headers=keyed)
+        r = c.getresponse()
+        problem = json.loads(r.read())
+        check(r.status == 503 and r.getheader("Retry-After") == "5" and "--jobs-redis" in problem.get("detail", ""),
+              "D: ... and a job's status is 503 with Retry-After (the job store is away)", (r.status, problem))
     finally:
         for p in procs.values():
             if p.poll() is None:

@@ -212,6 +212,14 @@ const std::vector<Option>& options() {
        intField(&Config::jobStoreMb, 1, 1LL << 20)},
       {"key-max-jobs", "EFFECTD_KEY_MAX_JOBS", "an API key's jobs queued or running at once; more get 429 (default 2)",
        intField(&Config::keyMaxJobs, 1, 100000)},
+      {"jobs-redis", "EFFECTD_JOBS_REDIS",
+       "redis://host:port holding the jobs (queue, states, progress, answers), so that every replica sharing it answers "
+       "any job and idle ones take queued work; unreachable, the job routes answer 503 (default none: jobs in this "
+       "process)",
+       [](const std::string& s, Config& c) {
+         c.jobsRedis = s;
+         return s.empty() || s.rfind("redis://", 0) == 0;
+       }},
       {"cors-origins", "EFFECTD_CORS_ORIGINS",
        "browser origins allowed to call the API: comma list (https://a.example,http://localhost:5173) or * (default "
        "none)",

@@ -59,6 +59,7 @@ struct Config {
   int jobTtlS = 3600;                    // a finished job (and its answer) is kept this long
   size_t jobStoreMb = 256;               // queued requests and kept answers of jobs at once
   int keyMaxJobs = 2;                    // an API key's jobs queued or running at once
+  std::string jobsRedis;                 // redis://host:port: jobs shared by replicas; "" = in this process
   std::vector<std::string> corsOrigins;  // allowed browser origins; {"*"} = any; empty = no CORS
   std::string playground = "auto";       // auto | on | off: the page at /; auto = on for loopback hosts
   // three.js's ES module the playground's live view imports (it draws through clients/three/);

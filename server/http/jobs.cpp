@@ -1,7 +1,12 @@
-// The job store and its workers (jobs.h).
+// The job store in this process and its workers (jobs.h).
 #include "http/jobs.h"
 
 #include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <thread>
 
 #include "http/request_state.h"
 
@@ -20,7 +25,43 @@ const char* toString(JobState state) {
   return "unknown";
 }
 
-struct Jobs::Job {
+class LocalJobs final : public Jobs {
+ public:
+  LocalJobs(Options options, Runner runner);
+  ~LocalJobs() override { stop(); }
+  JobView submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) override;
+  std::optional<JobView> find(const std::string& id, bool withBody) override;
+  std::optional<JobView> waitForChange(const std::string& id, uint64_t version, std::chrono::milliseconds timeout) override;
+  std::optional<JobView> cancel(const std::string& id, std::chrono::milliseconds wait) override;
+  bool remove(const std::string& id) override;
+  void stop() override;
+  std::string metricsText() const override;
+  bool shared() const override { return false; }
+
+ private:
+  struct Job;
+  void work();
+  void expire();  // mu_ held: drops jobs past their ttl, and answers past maxStoreBytes
+  JobView view(const Job& job) const;  // mu_ held
+  void changed(Job& job);               // mu_ held: bumps the version, wakes waiters
+
+  const Options o_;
+  const Runner runner_;
+  mutable std::mutex mu_;
+  std::condition_variable queued_, change_;
+  std::map<std::string, std::shared_ptr<Job>> jobs_;
+  std::deque<std::shared_ptr<Job>> queue_;
+  size_t answerBytes_ = 0, requestBytes_ = 0;  // kept answers, queued requests
+  bool stopping_ = false;
+  std::map<std::string, uint64_t> outcomes_;  // finished jobs by state, for /metrics
+  std::vector<std::thread> workers_;
+};
+
+std::unique_ptr<Jobs> Jobs::inProcess(Options options, Runner runner) {
+  return std::make_unique<LocalJobs>(options, std::move(runner));
+}
+
+struct LocalJobs::Job {
   std::string id, effect, keyId, body;
   JobState state = JobState::kQueued;
   double fraction = 0;
@@ -34,13 +75,11 @@ struct Jobs::Job {
   std::shared_ptr<const JobAnswer> answer;
 };
 
-Jobs::Jobs(Options options, Runner runner) : o_(options), runner_(std::move(runner)) {
+LocalJobs::LocalJobs(Options options, Runner runner) : o_(options), runner_(std::move(runner)) {
   for (int i = 0; i < o_.workers; ++i) workers_.emplace_back([this] { work(); });
 }
 
-Jobs::~Jobs() { stop(); }
-
-void Jobs::stop() {
+void LocalJobs::stop() {
   {
     std::lock_guard<std::mutex> lock(mu_);
     stopping_ = true;
@@ -56,12 +95,12 @@ void Jobs::stop() {
   workers_.clear();
 }
 
-void Jobs::changed(Job& job) {
+void LocalJobs::changed(Job& job) {
   ++job.version;
   change_.notify_all();
 }
 
-JobView Jobs::view(const Job& job) const {
+JobView LocalJobs::view(const Job& job) const {
   JobView v;
   v.id = job.id, v.effect = job.effect, v.keyId = job.keyId, v.state = job.state;
   v.fraction = job.fraction, v.cells = job.cells, v.steps = job.steps, v.created = job.created;
@@ -78,7 +117,7 @@ JobView Jobs::view(const Job& job) const {
   return v;
 }
 
-JobView Jobs::submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) {
+JobView LocalJobs::submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) {
   std::lock_guard<std::mutex> lock(mu_);
   expire();
   refusal = Refusal::kNone;
@@ -102,7 +141,7 @@ JobView Jobs::submit(const std::string& effect, std::string body, const std::str
   return view(*job);
 }
 
-std::optional<JobView> Jobs::find(const std::string& id) {
+std::optional<JobView> LocalJobs::find(const std::string& id, bool /*withBody*/) {
   std::lock_guard<std::mutex> lock(mu_);
   expire();
   auto it = jobs_.find(id);
@@ -110,7 +149,7 @@ std::optional<JobView> Jobs::find(const std::string& id) {
   return view(*it->second);
 }
 
-std::optional<JobView> Jobs::waitForChange(const std::string& id, uint64_t version, std::chrono::milliseconds timeout) {
+std::optional<JobView> LocalJobs::waitForChange(const std::string& id, uint64_t version, std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mu_);
   const Clock::time_point until = Clock::now() + timeout;
   for (;;) {
@@ -124,7 +163,7 @@ std::optional<JobView> Jobs::waitForChange(const std::string& id, uint64_t versi
   }
 }
 
-std::optional<JobView> Jobs::cancel(const std::string& id, std::chrono::milliseconds wait) {
+std::optional<JobView> LocalJobs::cancel(const std::string& id, std::chrono::milliseconds wait) {
   std::unique_lock<std::mutex> lock(mu_);
   auto it = jobs_.find(id);
   if (it == jobs_.end()) return std::nullopt;
@@ -147,7 +186,7 @@ std::optional<JobView> Jobs::cancel(const std::string& id, std::chrono::millisec
   return view(*job);
 }
 
-bool Jobs::remove(const std::string& id) {
+bool LocalJobs::remove(const std::string& id) {
   std::lock_guard<std::mutex> lock(mu_);
   auto it = jobs_.find(id);
   if (it == jobs_.end() || !finished(it->second->state)) return false;
@@ -157,7 +196,7 @@ bool Jobs::remove(const std::string& id) {
   return true;
 }
 
-void Jobs::expire() {
+void LocalJobs::expire() {
   const Clock::time_point now = Clock::now();
   for (auto it = jobs_.begin(); it != jobs_.end();) {
     const Job& job = *it->second;
@@ -181,7 +220,7 @@ void Jobs::expire() {
   }
 }
 
-void Jobs::work() {
+void LocalJobs::work() {
   for (;;) {
     std::shared_ptr<Job> job;
     {
@@ -228,7 +267,7 @@ void Jobs::work() {
   }
 }
 
-std::string Jobs::metricsText() const {
+std::string LocalJobs::metricsText() const {
   std::lock_guard<std::mutex> lock(mu_);
   std::map<std::string, size_t> now;
   for (const char* s : {"queued", "running", "done", "failed", "cancelled"}) now[s] = 0;

@@ -3,21 +3,23 @@
 // while. This file knows nothing of HTTP: the service (jobs_api.cpp) hands it a runner that
 // answers a body as the effect's endpoint does, and serves what it keeps.
 //
-// Jobs live in this process: a restart loses the queue, the running work and the answers
-// (docs/serving.md, "Jobs").
+// Two stores behind one interface (docs/serving.md, "Jobs"):
+//   - in this process (Jobs::inProcess, jobs.cpp): a restart loses the queue, the running work
+//     and the answers;
+//   - in Redis (Jobs::inRedis, jobs_redis.cpp, --jobs-redis): every replica that shares it
+//     answers any job's state and result, and idle replicas take queued work; a replica that
+//     stops hands its running jobs back to the queue, and one that dies is found by its lease
+//     running out, its job queued again (failed after kMaxAttempts).
 #pragma once
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace effectd {
@@ -48,8 +50,14 @@ struct JobView {
   double etaS = -1;                  // seconds left, from the fraction's pace; -1: not known yet
   bool cancelRequested = false;
   bool expired = false;              // finished, its answer dropped for room (Options::maxStoreBytes)
+  std::string worker;                // running (or ran) on: "host:pid" (a shared store's replica)
   uint64_t version = 0;              // grows with every change (Server-Sent Events wait on it)
   std::shared_ptr<const JobAnswer> answer;  // done, failed, or cancelled while running
+};
+
+// What the store could not do: Redis unreachable (the service answers 503).
+struct JobStoreError : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 class Jobs {
@@ -59,50 +67,36 @@ class Jobs {
     size_t maxJobs = 256;           // kept at once, in any state
     std::chrono::seconds ttl{3600};  // a finished job is forgotten this long after it finished
     // Queued requests and kept answers at once: past it the oldest answers are dropped, and a
-    // job whose request would not fit is refused.
+    // job whose request would not fit is refused (in this process; Redis keeps what its
+    // maxmemory allows).
     size_t maxStoreBytes = 256u << 20;
     int perKey = 2;                 // an API key's jobs queued or running at once
   };
   // Answers `body` as the endpoint of `effect` does, reporting progress through `progress`.
   using Runner = std::function<JobAnswer(const std::string& effect, const std::string& body, const JobProgress& progress)>;
 
-  Jobs(Options options, Runner runner);
-  ~Jobs();  // stop()
-  Jobs(const Jobs&) = delete;
-  Jobs& operator=(const Jobs&) = delete;
+  static std::unique_ptr<Jobs> inProcess(Options options, Runner runner);
+  // `redisUrl`: redis://host:port. Throws JobStoreError when Redis cannot be reached at start.
+  static std::unique_ptr<Jobs> inRedis(Options options, Runner runner, const std::string& redisUrl);
+  virtual ~Jobs() = default;
 
   enum class Refusal { kNone, kFull, kKeyBusy };
   // Queues a job; on refusal, `refusal` says why and the view is empty.
-  JobView submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal);
-  std::optional<JobView> find(const std::string& id);
+  virtual JobView submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) = 0;
+  // The job (its answer's bytes only with `withBody`: a poll needs its status and headers).
+  virtual std::optional<JobView> find(const std::string& id, bool withBody = false) = 0;
   // Waits until the job changes past `version`, or `timeout`; its view then (nullopt: gone).
-  std::optional<JobView> waitForChange(const std::string& id, uint64_t version, std::chrono::milliseconds timeout);
+  virtual std::optional<JobView> waitForChange(const std::string& id, uint64_t version,
+                                               std::chrono::milliseconds timeout) = 0;
   // Cancels a queued job at once, or asks a running one to stop and waits up to `wait` for it.
-  std::optional<JobView> cancel(const std::string& id, std::chrono::milliseconds wait);
+  virtual std::optional<JobView> cancel(const std::string& id, std::chrono::milliseconds wait) = 0;
   // Forgets a finished job and its answer; false when there is none or it is not finished.
-  bool remove(const std::string& id);
-  // Cancels every job and joins the workers (the process is stopping).
-  void stop();
-
-  std::string metricsText() const;
-
- private:
-  struct Job;
-  void work();
-  void expire();  // mu_ held: drops jobs past their ttl, and answers past maxStoreBytes
-  JobView view(const Job& job) const;  // mu_ held
-  void changed(Job& job);               // mu_ held: bumps the version, wakes waiters
-
-  const Options o_;
-  const Runner runner_;
-  mutable std::mutex mu_;
-  std::condition_variable queued_, change_;
-  std::map<std::string, std::shared_ptr<Job>> jobs_;
-  std::deque<std::shared_ptr<Job>> queue_;
-  size_t answerBytes_ = 0, requestBytes_ = 0;  // kept answers, queued requests
-  bool stopping_ = false;
-  std::map<std::string, uint64_t> outcomes_;  // finished jobs by state, for /metrics
-  std::vector<std::thread> workers_;
+  virtual bool remove(const std::string& id) = 0;
+  // Stops the workers: in this process every job is cancelled; in Redis the running ones go
+  // back to the queue for another replica.
+  virtual void stop() = 0;
+  virtual std::string metricsText() const = 0;
+  virtual bool shared() const = 0;
 };
 
 }  // namespace effectd

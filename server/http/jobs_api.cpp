@@ -52,6 +52,7 @@ json statusJson(const JobView& v) {
               {"runningS", v.runningS},
               {"links", links}};
   if (v.cancelRequested && !finished(v.state)) out["cancelRequested"] = true;
+  if (!v.worker.empty()) out["worker"] = v.worker;
   if (v.expired) out["expired"] = true;
   if (v.state == JobState::kFailed && v.answer) {
     try {
@@ -73,6 +74,10 @@ ApiError notFound(const std::string& id) {
   return {404, "not-found", "Not Found", "no job " + id + " here (finished jobs are kept for --job-ttl)", {}, {}};
 }
 
+ApiError storeDown(const JobStoreError& e) {
+  return {503, "unavailable", "Service Unavailable", std::string(e.what()) + " (--jobs-redis)", {}, {{"Retry-After", "5"}}};
+}
+
 }  // namespace
 
 void Service::installJobs() {
@@ -85,10 +90,11 @@ void Service::installJobs() {
   o.ttl = std::chrono::seconds(config_.jobTtlS);
   o.maxStoreBytes = config_.jobStoreMb << 20;
   o.perKey = config_.keyMaxJobs;
-  jobs_ = std::make_unique<Jobs>(
-      o, [this](const std::string& effect, const std::string& body, const JobProgress& progress) {
-        return runJob(effect, body, progress);
-      });
+  Jobs::Runner runner = [this](const std::string& effect, const std::string& body, const JobProgress& progress) {
+    return runJob(effect, body, progress);
+  };
+  jobs_ = config_.jobsRedis.empty() ? Jobs::inProcess(o, std::move(runner))
+                                    : Jobs::inRedis(o, std::move(runner), config_.jobsRedis);
   metrics_.addSource([this] { return jobs_->metricsText(); });
 
   auto route = [this](const std::string& path, std::vector<std::string> methods) {
@@ -141,7 +147,12 @@ void Service::submitJob(const Route& route, const std::string& bodyText, httplib
                          std::to_string(budget.budgetBytes >> 20) + " MiB memory budget (--memory-budget-mb)",
                      {}, {}};
     Jobs::Refusal refusal;
-    const JobView v = jobs_->submit(route.path.substr(4), bodyText, tl.keyId, refusal);
+    JobView v;
+    try {
+      v = jobs_->submit(route.path.substr(4), bodyText, tl.keyId, refusal);
+    } catch (const JobStoreError& e) {
+      throw storeDown(e);
+    }
     if (refusal == Jobs::Refusal::kFull)
       throw ApiError{503, "overloaded", "Service Unavailable",
                      "the server keeps " + std::to_string(config_.maxJobs) + " jobs and " +
@@ -192,9 +203,15 @@ JobAnswer Service::runJob(const std::string& effect, const std::string& body, co
   }
 }
 
-std::optional<JobView> Service::jobOf(const httplib::Request& req, httplib::Response& res) {
+std::optional<JobView> Service::jobOf(const httplib::Request& req, httplib::Response& res, bool withBody) {
   const std::string id = req.matches[1];
-  std::optional<JobView> v = jobs_->find(id);
+  std::optional<JobView> v;
+  try {
+    v = jobs_->find(id, withBody);
+  } catch (const JobStoreError& e) {
+    writeProblem(res, storeDown(e), tl.requestId);
+    return std::nullopt;
+  }
   if (v && v->keyId != tl.keyId) v.reset();  // another key's job is not there for this one
   if (!v) writeProblem(res, notFound(id), tl.requestId);
   return v;
@@ -215,8 +232,11 @@ void Service::answerJobEvents(const httplib::Request& req, httplib::Response& re
   auto last = std::make_shared<uint64_t>(~uint64_t(0));
   auto quiet = std::make_shared<int>(0);
   res.set_chunked_content_provider("text/event-stream", [this, id, last, quiet](size_t, httplib::DataSink& sink) {
-    std::optional<JobView> v = *last == ~uint64_t(0) ? jobs_->find(id)
-                                                     : jobs_->waitForChange(id, *last, std::chrono::milliseconds(1000));
+    std::optional<JobView> v;
+    try {
+      v = *last == ~uint64_t(0) ? jobs_->find(id) : jobs_->waitForChange(id, *last, std::chrono::milliseconds(1000));
+    } catch (const JobStoreError&) {  // the store went away: the stream ends, the client asks again
+    }
     if (!v || stopping_) {
       sink.done();
       return true;
@@ -239,7 +259,7 @@ void Service::answerJobEvents(const httplib::Request& req, httplib::Response& re
 }
 
 void Service::answerJobResult(const httplib::Request& req, httplib::Response& res) {
-  auto v = jobOf(req, res);
+  auto v = jobOf(req, res, true);
   if (!v) return;
   res.set_header("Cache-Control", "no-store");
   if (v->answer) {
@@ -276,13 +296,17 @@ void Service::answerJobResult(const httplib::Request& req, httplib::Response& re
 void Service::cancelJob(const httplib::Request& req, httplib::Response& res) {
   auto v = jobOf(req, res);
   if (!v) return;
-  if (finished(v->state)) {  // a finished job: forgotten, its answer's memory returned
-    jobs_->remove(v->id);
-    res.status = 204;
-    return;
+  try {
+    if (finished(v->state)) {  // a finished job: forgotten, its answer's memory returned
+      jobs_->remove(v->id);
+      res.status = 204;
+      return;
+    }
+    // The work stops at its next progress report (a bolt reports every 50 ms); waited for here.
+    if (auto after = jobs_->cancel(v->id, std::chrono::milliseconds(2000))) sendStatus(*after, 200, res);
+  } catch (const JobStoreError& e) {
+    writeProblem(res, storeDown(e), tl.requestId);
   }
-  // The work stops at its next progress report (a bolt reports every 50 ms); waited for here.
-  if (auto after = jobs_->cancel(v->id, std::chrono::milliseconds(2000))) sendStatus(*after, 200, res);
 }
 
 }  // namespace effectd

@@ -1,20 +1,12 @@
 #include "http/quota.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <optional>
-#include <vector>
 
-#include <arpa/inet.h>
-#include <netdb.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
+#include "http/redis.h"
 
 namespace effectd {
 
@@ -55,112 +47,31 @@ double quotaUnits(size_t estimatedBytes) {
   return std::max(1.0, std::ceil(double(estimatedBytes) / double(kQuotaUnitBytes)));
 }
 
-// A Redis connection speaking RESP (the protocol's arrays of bulk strings), enough for EVAL.
-// One connection, one charge at a time; every wait bounded by kTimeout.
+// The buckets in Redis (redis.h), one script per charge; every wait bounded by 250 ms.
 class Quota::Redis {
  public:
-  explicit Redis(const std::string& url) {
-    std::string rest = url.substr(std::string("redis://").size());
-    const size_t slash = rest.find('/');
-    if (slash != std::string::npos) rest.resize(slash);
-    const size_t colon = rest.rfind(':');
-    host_ = colon == std::string::npos ? rest : rest.substr(0, colon);
-    port_ = colon == std::string::npos ? "6379" : rest.substr(colon + 1);
-  }
-  ~Redis() { disconnect(); }
+  explicit Redis(const std::string& url) : client_(url, std::chrono::milliseconds(250)) {}
 
   // The script's {allowed, tokens}, or nullopt when Redis did not answer in time.
   std::optional<std::pair<bool, double>> charge(const ApiKey& key, double units, double need) {
-    std::lock_guard lock(mutex_);
-    const auto now = std::chrono::steady_clock::now();
-    if (fd_ < 0 && now < retryAt_) return std::nullopt;
     char rate[32], burst[32], n[32], least[32];
     std::snprintf(rate, sizeof rate, "%.17g", key.perMinute / 60.0);
     std::snprintf(burst, sizeof burst, "%.17g", key.burst);
     std::snprintf(n, sizeof n, "%.17g", units);
     std::snprintf(least, sizeof least, "%.17g", need);
-    const std::vector<std::string> args = {"EVAL", kChargeScript, "1", "effectd:quota:" + key.id, rate, burst, n, least};
-    std::string request = "*" + std::to_string(args.size()) + "\r\n";
-    for (const auto& a : args) request += "$" + std::to_string(a.size()) + "\r\n" + a + "\r\n";
-    if ((fd_ >= 0 || connect()) && send(request)) {
-      // *2 :<allowed> $<len> <tokens>
-      std::string line;
-      if (readLine(line) && line == "*2" && readLine(line) && line.size() > 1 && line[0] == ':') {
-        const bool allowed = line.substr(1) == "1";
-        if (readLine(line) && line.size() > 1 && line[0] == '$' && readLine(line)) {
-          char* end = nullptr;
-          const double tokens = std::strtod(line.c_str(), &end);
-          if (end && *end == '\0') return std::make_pair(allowed, tokens);
-        }
-      }
-    }
-    disconnect();
-    retryAt_ = now + std::chrono::seconds(1);
-    return std::nullopt;
+    const auto r = client_.command({"EVAL", kChargeScript, "1", "effectd:quota:" + key.id, rate, burst, n, least});
+    // {allowed, tokens}: an integer and a string
+    if (!r || r->type != RedisReply::Type::kArray || r->items.size() != 2 ||
+        r->items[0].type != RedisReply::Type::kInteger || !r->items[1].isString())
+      return std::nullopt;
+    char* end = nullptr;
+    const double tokens = std::strtod(r->items[1].text.c_str(), &end);
+    if (!end || *end != '\0') return std::nullopt;
+    return std::make_pair(r->items[0].integer == 1, tokens);
   }
 
  private:
-  static constexpr int kTimeoutMs = 250;
-
-  bool connect() {
-    addrinfo hints{}, *found = nullptr;
-    hints.ai_socktype = SOCK_STREAM;
-    if (getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found) != 0 || !found) return false;
-    fd_ = ::socket(found->ai_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    bool ok = fd_ >= 0;
-    if (ok && ::connect(fd_, found->ai_addr, found->ai_addrlen) != 0) {
-      pollfd p{fd_, POLLOUT, 0};
-      int error = 0;
-      socklen_t length = sizeof error;
-      ok = errno == EINPROGRESS && ::poll(&p, 1, kTimeoutMs) == 1 &&
-           ::getsockopt(fd_, SOL_SOCKET, SO_ERROR, &error, &length) == 0 && error == 0;
-    }
-    freeaddrinfo(found);
-    if (ok) {
-      int one = 1;
-      ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    } else {
-      disconnect();
-    }
-    return ok;
-  }
-  void disconnect() {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-    buffer_.clear();
-  }
-  bool send(const std::string& bytes) {
-    for (size_t done = 0; done < bytes.size();) {
-      pollfd p{fd_, POLLOUT, 0};
-      if (::poll(&p, 1, kTimeoutMs) != 1) return false;
-      const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
-      if (n <= 0) return false;
-      done += size_t(n);
-    }
-    return true;
-  }
-  bool readLine(std::string& line) {
-    for (;;) {
-      const size_t end = buffer_.find("\r\n");
-      if (end != std::string::npos) {
-        line = buffer_.substr(0, end);
-        buffer_.erase(0, end + 2);
-        return line.empty() || line[0] != '-';  // "-ERR ...": an error reply
-      }
-      if (buffer_.size() > 4096) return false;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, kTimeoutMs) != 1) return false;
-      char chunk[512];
-      const ssize_t n = ::recv(fd_, chunk, sizeof chunk, 0);
-      if (n <= 0) return false;
-      buffer_.append(chunk, size_t(n));
-    }
-  }
-
-  std::mutex mutex_;
-  std::string host_, port_, buffer_;
-  int fd_ = -1;
-  std::chrono::steady_clock::time_point retryAt_;
+  RedisClient client_;
 };
 
 Quota::Quota(const std::string& redisUrl) {

@@ -190,9 +190,9 @@ class Service {
   void answerJobEvents(const httplib::Request& req, httplib::Response& res);
   void answerJobResult(const httplib::Request& req, httplib::Response& res);
   void cancelJob(const httplib::Request& req, httplib::Response& res);
-  // The job a request's path names, if it is there and the request's key (if any) owns it;
-  // otherwise the answer is a 404 problem.
-  std::optional<JobView> jobOf(const httplib::Request& req, httplib::Response& res);
+  // The job a request's path names (its answer's bytes with `withBody`), if it is there and the
+  // request's key (if any) owns it; otherwise the answer is a 404 problem (503: the store is away).
+  std::optional<JobView> jobOf(const httplib::Request& req, httplib::Response& res, bool withBody = false);
   const Route* findRoute(const std::string& path) const;
   std::string allowedOrigin(const std::string& origin) const;  // "" when not allowed
 

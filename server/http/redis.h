@@ -1,0 +1,55 @@
+// A Redis connection speaking RESP2: commands as arrays of bulk strings, replies parsed whole
+// (strings, integers, arrays, nil, errors). Shared by the quotas (quota.cpp) and the jobs'
+// shared store (jobs_redis.cpp).
+//
+// One command at a time (a mutex); every wait is bounded by the timeout. A failed exchange
+// drops the connection; the next command connects again, but not within `retry` of a failure,
+// so that an unreachable Redis costs a caller one timeout per `retry`, not one per command.
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace effectd {
+
+struct RedisReply {
+  enum class Type { kNil, kString, kInteger, kArray, kError } type = Type::kNil;
+  std::string text;  // a string's bytes, or an error's message
+  long long integer = 0;
+  std::vector<RedisReply> items;
+  bool isString() const { return type == Type::kString; }
+};
+
+class RedisClient {
+ public:
+  // `url`: redis://host[:port][/...] (the path is ignored).
+  RedisClient(const std::string& url, std::chrono::milliseconds timeout,
+              std::chrono::milliseconds retry = std::chrono::seconds(1));
+  ~RedisClient();
+  RedisClient(const RedisClient&) = delete;
+  RedisClient& operator=(const RedisClient&) = delete;
+
+  // The reply (an error reply included: Type::kError), or nullopt when Redis could not be
+  // reached, did not answer within the timeout, or answered what is not RESP.
+  std::optional<RedisReply> command(const std::vector<std::string>& args);
+
+ private:
+  bool connect();
+  void disconnect();
+  bool send(const std::string& bytes);
+  bool fill();  // reads more bytes into buffer_
+  bool readLine(std::string& line);
+  bool readReply(RedisReply& reply, int depth);
+
+  const std::chrono::milliseconds timeout_, retry_;
+  std::mutex mutex_;
+  std::string host_, port_, buffer_;
+  size_t read_ = 0;  // bytes of buffer_ consumed
+  int fd_ = -1;
+  std::chrono::steady_clock::time_point retryAt_;
+};
+
+}  // namespace effectd
