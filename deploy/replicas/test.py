@@ -353,7 +353,11 @@ def main():
               statuses)
         c.request("GET", job, headers=keyed)
         r = c.getresponse()
-        problem = json.loads(r.read())
+        raw = r.read()
+        try:
+            problem = json.loads(raw)
+        except ValueError:  # nginx's own error page: show it rather than a traceback
+            problem = {"non-JSON answer": raw[:200].decode(errors="replace")}
         check(r.status == 503 and r.getheader("Retry-After") == "5" and "--jobs-redis" in problem.get("detail", ""),
               "D: ... and a job's status is 503 with Retry-After (the job store is away)", (r.status, problem))
     finally:

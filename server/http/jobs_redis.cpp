@@ -263,7 +263,8 @@ class RedisJobs final : public Jobs {
       auto a = std::make_shared<JobAnswer>();
       a->status = int(number(f[13]));
       try {
-        for (const auto& [name, value] : nlohmann::json::parse(f[14].text).items()) a->headers[name] = value.get<std::string>();
+        const nlohmann::json headers = nlohmann::json::parse(f[14].text);  // items() must not outlive it
+        for (const auto& [name, value] : headers.items()) a->headers[name] = value.get<std::string>();
       } catch (const std::exception&) {
       }
       if (r.items[2].isString()) a->body = r.items[2].text;
