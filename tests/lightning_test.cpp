@@ -4,6 +4,7 @@
 #include <limits>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -15,6 +16,8 @@
 #include <effects/lightning.h>
 
 #include "lightning/hooks.h"
+#include "lightning/laplace.h"
+#include "lightning/laplace3.h"
 
 #include "fixtures.h"
 
@@ -489,6 +492,83 @@ TEST(Lightning, SolversAgree) {
   EXPECT_NEAR(at(5, 20), 0.25 * (at(4, 20) + at(6, 20) + at(5, 19) + at(5, 21)), 1e-9);
   EXPECT_EQ(at(16, 31), 1.0);
   EXPECT_EQ(at(16, 1), 0.0);
+}
+
+TEST(Lightning, SolversGiveTheSameNumbersOnAnyThreads) {
+  // From kParallelCells up the fine level's loops split over threads, in fixed blocks with
+  // sums added in block order: the potential is the same bit for bit on one thread and on
+  // three, from scratch and warm after more cells are fixed (a sum over the pool's own
+  // chunks, which depend on timing, fails this).
+  ThreadPool pool(2);
+  const int side = 512;
+  ASSERT_GE(size_t(side) * side, detail::kParallelCells);
+  auto solveOn = [&](Parallel* parallel, std::vector<int>& its) {
+    detail::Laplace lap(side, side, parallel);
+    effects::Rng rng(3);
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x)
+        if (rng.uniform() < 0.01) lap.fix(x, y, 0.0);
+    lap.fix(side / 2, side - 1, 1.0);
+    for (int y = 0; y < side / 3; ++y) lap.fix(side / 2 + y / 7, y, 0.0);
+    its.push_back(lap.solve(Solver::kMgpcg, 1e-10));
+    for (int y = side / 3; y < side / 2; ++y) lap.fix(side / 2 - y / 9, y, 0.0);
+    its.push_back(lap.solve(Solver::kMgpcg, 1e-6));
+    std::vector<double> phi;
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x) phi.push_back(lap.phi(x, y));
+    return phi;
+  };
+  std::vector<int> itsOne, itsThree;
+  const std::vector<double> one = solveOn(nullptr, itsOne), three = solveOn(&pool, itsThree);
+  EXPECT_EQ(itsOne, itsThree);
+  size_t differ = 0;
+  for (size_t i = 0; i < one.size(); ++i) differ += std::memcmp(&one[i], &three[i], sizeof(double)) != 0;
+  EXPECT_EQ(differ, 0u) << "of " << one.size() << " cells";
+  // 3-D from 64^3: the same.
+  auto solve3 = [&](Parallel* parallel, int& its) {
+    const int n = 64;
+    detail::Laplace3 lap(n, n, n, parallel);
+    effects::Rng rng(5);
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          if (rng.uniform() < 0.01) lap.fix({x, y, z}, 0.0);
+    lap.fix({n / 2, n - 1, n / 2}, 1.0);
+    for (int y = 0; y < n / 2; ++y) lap.fix({n / 2 + y / 5, y, n / 2}, 0.0);
+    its = lap.solve(Solver::kMgpcg, 1e-10);
+    std::vector<double> phi;
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) phi.push_back(lap.phi({x, y, z}));
+    return phi;
+  };
+  int its3One = 0, its3Three = 0;
+  const std::vector<double> one3 = solve3(nullptr, its3One), three3 = solve3(&pool, its3Three);
+  EXPECT_EQ(its3One, its3Three);
+  differ = 0;
+  for (size_t i = 0; i < one3.size(); ++i) differ += std::memcmp(&one3[i], &three3[i], sizeof(double)) != 0;
+  EXPECT_EQ(differ, 0u) << "of " << one3.size() << " voxels";
+}
+
+TEST(Lightning, DbmBoltDoesNotDependOnThreads) {
+  // The whole growth on threads (Params::parallel): the same cells in the same order, on a
+  // grid past kParallelCells that grows in a few dozen steps.
+  ThreadPool pool(2);
+  Params p;
+  p.width = 8192, p.height = 32;
+  p.start = {4096, 0};
+  p.targets = {{4096, 31}};
+  p.method = Method::kDbm;
+  p.solver = Solver::kMgpcg;
+  auto alone = grow(p);
+  p.parallel = &pool;
+  auto shared = grow(p);
+  ASSERT_TRUE(alone.ok() && shared.ok());
+  ASSERT_EQ(alone.value().nodes.size(), shared.value().nodes.size());
+  for (size_t i = 0; i < alone.value().nodes.size(); ++i) {
+    EXPECT_EQ(alone.value().nodes[i].cell.x, shared.value().nodes[i].cell.x) << i;
+    EXPECT_EQ(alone.value().nodes[i].cell.y, shared.value().nodes[i].cell.y) << i;
+  }
 }
 
 TEST(Lightning, CapacitanceIsTheExactSolution) {

@@ -17,8 +17,8 @@ std::unique_ptr<DeepField> dbmProblem(const Growth& s, Cell target, Solver solve
   if (s.toRegion)
     for (uint8_t r : s.region) fixedCells += r;
   std::unique_ptr<Potential> lap =
-      potentialFor(p.width, p.height, p.depth, solver, fixedCells, fixedCells);  // room to grow
-  auto field = std::make_unique<DeepField>(std::move(lap), p.width, p.height, p.depth);
+      potentialFor(p.width, p.height, p.depth, solver, fixedCells, fixedCells, p.parallel);  // room to grow
+  auto field = std::make_unique<DeepField>(std::move(lap), p.width, p.height, p.depth, p.parallel);
   for (size_t i = 0; i < s.g.cells(); ++i)
     if (!p.obstacles.empty() && p.obstacles[i]) field->fix(s.g.cellAt(i), 0.0);
   for (const Node& n : s.bolt.nodes) field->fix(n.cell, 0.0);

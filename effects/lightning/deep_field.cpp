@@ -8,9 +8,9 @@
 
 namespace effects::lightning::detail {
 
-DeepField::DeepField(std::unique_ptr<Potential> base, int width, int height, int depth)
+DeepField::DeepField(std::unique_ptr<Potential> base, int width, int height, int depth, Parallel* parallel)
     : w_(width), h_(height), d_(depth), cells_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))),
-      field_(std::move(base)), zero_(cells_, 0) {}
+      parallel_(parallel), field_(std::move(base)), zero_(cells_, 0) {}
 
 DeepField::~DeepField() = default;
 
@@ -37,7 +37,7 @@ void DeepField::fix(Cell c, double value) {
 
 std::unique_ptr<Potential> DeepField::build(int stage) const {
   // A rebuilt stage is solved iteratively (solver_choice.h's rule for any solver but capacitance).
-  std::unique_ptr<Potential> lap = potentialFor(w_, h_, d_, Solver::kMgpcg, 0, 0);
+  std::unique_ptr<Potential> lap = potentialFor(w_, h_, d_, Solver::kMgpcg, 0, 0, parallel_);
   for (size_t i = 0; i < cells_; ++i) {
     if (zero_[i]) {
       lap->fix(cellAt(i), 0.0);

@@ -33,7 +33,8 @@ class DeepField {
   // in it). It may be the direct capacitance solver, which a cut replaces by the iterative one.
   // One solver hierarchy lives at a time (a stage below is built again when the bolt comes
   // back to it); the stages add 11 bytes a cell.
-  DeepField(std::unique_ptr<Potential> base, int width, int height, int depth);
+  // parallel: for the stages it builds (potentialFor); null: this thread.
+  DeepField(std::unique_ptr<Potential> base, int width, int height, int depth, Parallel* parallel = nullptr);
   ~DeepField();
   // Fixes a cell at a value in every stage: 0 (obstacles, bolt cells) or the target's 1.
   void fix(Cell c, double value);
@@ -76,6 +77,7 @@ class DeepField {
 
   int w_, h_, d_;
   size_t cells_;
+  Parallel* parallel_;
   std::unique_ptr<Potential> field_;  // the current stage's solver (null: build it when needed)
   int k_ = 0, deepest_ = 0, stageSolves_ = 0;
   double estimate_ = 1;             // the candidates' largest potential at the last solve (its stage)

@@ -15,7 +15,11 @@ constexpr int kCoarsestSweeps = 12;
 
 }  // namespace
 
-Laplace::Laplace(int width, int height) : w_(width), h_(height), stride_(width + 2) {
+Laplace::Laplace(int width, int height, Parallel* parallel)
+    : w_(width),
+      h_(height),
+      stride_(width + 2),
+      parallel_(size_t(width) * size_t(height) >= kParallelCells ? parallel : nullptr) {
   size_t n = size_t(width + 2) * size_t(height + 2);
   phi_.assign(n, 0.0);
   bvec_.assign(n, 0.0);
@@ -31,14 +35,22 @@ Laplace::Laplace(int width, int height) : w_(width), h_(height), stride_(width +
     l.h = h;
     l.stride = w + 2;
     size_t m = size_t(w + 2) * size_t(h + 2);
-    l.a.assign(m, {});
-    l.invDiag.assign(m, 0.0);
-    l.mask.assign(m, 0.0);
+    l.kind.assign(m, 0);
+    l.rows.assign(2, {});
+    l.invDiag.assign(2, 0.0);
     l.e.assign(m, 0.0);
     l.r.assign(m, 0.0);
     levels_.push_back(std::move(l));
   }
-  dirty_ = {0, 0, w_ - 1, h_ - 1};
+  // Every coarse row, level by level, with nothing fixed yet; each level's regular row first.
+  for (size_t k = 1; k < levels_.size(); ++k) {
+    Level& l = levels_[k];
+    l.rows[1] = galerkinRow(k, l.w / 2, l.h / 2);
+    l.invDiag[1] = l.rows[1][4] > 0 ? 1.0 / l.rows[1][4] : 0.0;
+    for (int y = 0; y < l.h; ++y)
+      for (int x = 0; x < l.w; ++x) setRow(k, x, y, galerkinRow(k, x, y));
+  }
+  dirty_ = {0, 0, -1, -1};
 }
 
 void Laplace::fix(int x, int y, double value) {
@@ -64,8 +76,8 @@ void Laplace::fix(int x, int y, double value) {
 }
 
 // One row of A_c = P^T A P at level k (k >= 1) from the operator of level k - 1.
-void Laplace::galerkinRow(size_t k, int cx, int cy) {
-  Level& c = levels_[k];
+std::array<double, 9> Laplace::galerkinRow(size_t k, int cx, int cy) const {
+  const Level& c = levels_[k];
   const Level* f = k > 1 ? &levels_[k - 1] : nullptr;
   const int fw = f ? f->w : w_, fh = f ? f->h : h_, fs = f ? f->stride : stride_;
   std::array<double, 9> row{};
@@ -77,7 +89,7 @@ void Laplace::galerkinRow(size_t k, int cx, int cy) {
         const int ox = o % 3 - 1, oy = o / 3 - 1;
         double a;
         if (f) {
-          a = f->a[fi][size_t(o)];
+          a = f->row(fi)[size_t(o)];
         } else {  // the fine 5-point operator on unknowns
           if (!unknown_[fi] || (ox != 0 && oy != 0)) continue;
           a = o == 4 ? 4.0 : (unknown_[fi + size_t(ox) + size_t(oy) * size_t(fs)] ? -1.0 : 0.0);
@@ -93,10 +105,23 @@ void Laplace::galerkinRow(size_t k, int cx, int cy) {
             row[size_t((px[a0] - cx + 1) + 3 * (py[a1] - cy + 1))] += wf * a * wx[a0] * wy[a1];
       }
     }
-  const size_t ci = size_t(cy + 1) * size_t(c.stride) + size_t(cx + 1);
-  c.a[ci] = row;
-  c.invDiag[ci] = row[4] > 0 ? 1.0 / row[4] : 0.0;
-  c.mask[ci] = row[4] > 0 ? 1.0 : 0.0;
+  return row;
+}
+
+void Laplace::setRow(size_t k, int cx, int cy, const std::array<double, 9>& row) {
+  Level& c = levels_[k];
+  uint32_t& kind = c.kind[size_t(cy + 1) * size_t(c.stride) + size_t(cx + 1)];
+  if (row == c.rows[0] || row == c.rows[1]) {  // no diagonal means no row at all (A is SPD)
+    kind = row == c.rows[0] ? 0 : 1;
+    return;
+  }
+  if (kind < 2) {  // a row of its own; one that later becomes regular again keeps its slot unused
+    kind = uint32_t(c.rows.size());
+    c.rows.emplace_back();
+    c.invDiag.push_back(0.0);
+  }
+  c.rows[kind] = row;
+  c.invDiag[kind] = row[4] > 0 ? 1.0 / row[4] : 0.0;
 }
 
 void Laplace::updateCoarse() {
@@ -107,33 +132,57 @@ void Laplace::updateCoarse() {
     Box cb{std::max(0, floorDiv(b.x0 - 2, 2)), std::max(0, floorDiv(b.y0 - 2, 2)),
            std::min(c.w - 1, floorDiv(b.x1 + 1, 2)), std::min(c.h - 1, floorDiv(b.y1 + 1, 2))};
     for (int y = cb.y0; y <= cb.y1; ++y)
-      for (int x = cb.x0; x <= cb.x1; ++x) galerkinRow(k, x, y);
+      for (int x = cb.x0; x <= cb.x1; ++x) setRow(k, x, y, galerkinRow(k, x, y));
     b = cb;
   }
   dirty_ = {0, 0, -1, -1};
 }
 
 void Laplace::smoothFine(bool forward, bool fromZero) {
-  // Red-black Gauss-Seidel on 4e - sum e_n = r over the unknowns (e is 0 on fixed cells).
+  // Red-black Gauss-Seidel on 4e - sum e_n = r over the unknowns (e is 0 on fixed cells),
+  // both colours in one pass over the rows: the second colour of row y - 1 needs only the
+  // first colour of rows y - 2 .. y, so it follows the first colour of row y, and the grid
+  // streams once. On threads, in blocks of rows: each block does both colours except the
+  // second colour of its first and last rows, which a second pass does once every block's
+  // first colour is in. Every cell sees the values it would in two whole passes, so the
+  // numbers are the same on any threads.
   // From zero, the first colour's neighbours are all 0; writing every cell of both colours
   // (the pad is never written) then replaces clearing the vector.
-  std::vector<double>& e = z_;
+  double* e = z_.data();
+  const double* r = r_.data();
+  const double* m = mask_.data();
   const size_t s = size_t(stride_);
-  for (int pass = 0; pass < 2; ++pass) {
-    const int colour = forward ? pass : 1 - pass;
-    for (int y = 0; y < h_; ++y) {
-      const size_t row = size_t(y + 1) * s;
-      if (fromZero && pass == 0) {
-        for (int x = (y + colour) & 1; x < w_; x += 2)
-          e[row + size_t(x + 1)] = mask_[row + size_t(x + 1)] * 0.25 * r_[row + size_t(x + 1)];
-        continue;
-      }
-      for (int x = (y + colour) & 1; x < w_; x += 2) {
-        const size_t i = row + size_t(x + 1);
-        e[i] = mask_[i] * 0.25 * (r_[i] + e[i - 1] + e[i + 1] + e[i - s] + e[i + s]);
+  const int first = forward ? 0 : 1;
+  auto sweep = [&](int y, int colour) {
+    const size_t row = size_t(y + 1) * s + 1;
+    if (fromZero && colour == first) {
+      for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x)] = m[row + size_t(x)] * 0.25 * r[row + size_t(x)];
+      return;
+    }
+    for (int x = (y + colour) & 1; x < w_; x += 2) {
+      const size_t i = row + size_t(x);
+      e[i] = m[i] * 0.25 * (r[i] + e[i - 1] + e[i + 1] + e[i - s] + e[i + s]);
+    }
+  };
+  constexpr int kRows = 16;  // rows per block on threads
+  const int rows = parallel_ ? kRows : h_;
+  const size_t blocks = size_t((h_ + rows - 1) / rows);
+  effects::forRange(parallel_, blocks, 1, [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) {
+      const int y0 = int(b) * rows, y1 = std::min(h_, y0 + rows);
+      for (int y = y0; y < y1; ++y) {
+        sweep(y, first);
+        if (y - 1 > y0) sweep(y - 1, 1 - first);
       }
     }
-  }
+  });
+  effects::forRange(parallel_, blocks, 1, [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) {
+      const int y0 = int(b) * rows, y1 = std::min(h_, y0 + rows);
+      sweep(y0, 1 - first);
+      if (y1 - 1 > y0) sweep(y1 - 1, 1 - first);
+    }
+  });
 }
 
 void Laplace::smoothCoarse(Level& l, bool forward) {
@@ -144,15 +193,17 @@ void Laplace::smoothCoarse(Level& l, bool forward) {
   const size_t s = size_t(l.stride);
   double* e = l.e.data();
   auto update = [&](size_t i, size_t prevOffset) {
-    const auto& a = l.a[i];  // all zero on inactive and pad cells, where invDiag is 0 too
+    const uint32_t kind = l.kind[i];
+    const auto& a = l.rows[kind];  // all zero on inactive and pad cells, where invDiag is 0 too
+    const double invDiag = l.invDiag[kind];
     const double* u = e + i - s;
     const double* d = e + i + s;
     double rest = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
     // forward: e[i-1] was just updated, e[i+1] is old; backward the other way round.
     if (prevOffset == 1)
-      rest -= a[5] * e[i + 1], e[i] = (rest - a[3] * e[i - 1]) * l.invDiag[i];
+      rest -= a[5] * e[i + 1], e[i] = (rest - a[3] * e[i - 1]) * invDiag;
     else
-      rest -= a[3] * e[i - 1], e[i] = (rest - a[5] * e[i + 1]) * l.invDiag[i];
+      rest -= a[3] * e[i - 1], e[i] = (rest - a[5] * e[i + 1]) * invDiag;
   };
   if (forward) {
     for (int y = 0; y < l.h; ++y)
@@ -185,13 +236,15 @@ void Laplace::vcycle(size_t k) {
     std::vector<double>& res = e0_;
     const size_t first = fs + 1, last = size_t(fh + 1) * fs - 1;  // the pad columns come out 0
     if (fine) {
-      for (size_t i = first; i < last; ++i)
-        res[i] = mask_[i] * (r_[i] - (4 * z_[i] - z_[i - 1] - z_[i + 1] - z_[i - fs] - z_[i + fs]));
+      blockFor(parallel_, first, last, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i)
+          res[i] = mask_[i] * (r_[i] - (4 * z_[i] - z_[i - 1] - z_[i + 1] - z_[i - fs] - z_[i + fs]));
+      });
     } else {
       const Level& l = levels_[k];
       const double* e = l.e.data();
       for (size_t i = first; i < last; ++i) {
-        const auto& a = l.a[i];
+        const auto& a = l.row(i);
         const double* u = e + i - fs;
         const double* d = e + i + fs;
         res[i] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) -
@@ -200,33 +253,39 @@ void Laplace::vcycle(size_t k) {
     }
     Level& c = levels_[k + 1];
     const size_t cs = size_t(c.stride);
-    for (int cy = 0; cy < c.h; ++cy)
-      for (int cx = 0; cx < c.w; ++cx) {
-        // fine cell (2cx+1, 2cy+1) is at padded index (2cx+2, 2cy+2)
-        size_t i = size_t(2 * cy + 2) * fs + size_t(2 * cx + 2);
-        double v = res[i] + 0.5 * (res[i - 1] + res[i + 1] + res[i - fs] + res[i + fs]) +
-                   0.25 * (res[i - fs - 1] + res[i - fs + 1] + res[i + fs - 1] + res[i + fs + 1]);
-        c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = v;
-      }
+    Parallel* parallel = fine ? parallel_ : nullptr;
+    effects::forRange(parallel, size_t(c.h), 8, [&](size_t y0, size_t y1) {
+      for (int cy = int(y0); cy < int(y1); ++cy)
+        for (int cx = 0; cx < c.w; ++cx) {
+          // fine cell (2cx+1, 2cy+1) is at padded index (2cx+2, 2cy+2)
+          size_t i = size_t(2 * cy + 2) * fs + size_t(2 * cx + 2);
+          double v = res[i] + 0.5 * (res[i - 1] + res[i + 1] + res[i - fs] + res[i + fs]) +
+                     0.25 * (res[i - fs - 1] + res[i - fs + 1] + res[i + fs - 1] + res[i + fs + 1]);
+          c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = v;
+        }
+    });
     vcycle(k + 1);
     // Prolongation (bilinear), masked to this level's active cells, gathered per fine row:
     // odd fine rows/columns sit on a coarse one, even ones halfway between two (the pad of
     // the coarse grid is 0, so the borders need no special case).
     std::vector<double>& e = fine ? z_ : levels_[k].e;
-    const std::vector<double>& m = fine ? mask_ : levels_[k].mask;
-    rowTmp_.resize(cs);
-    for (int y = 0; y < fh; ++y) {
-      const double* c0 = &c.e[size_t((y + 1) / 2) * cs];  // coarse row (y-1)/2 or y/2-1, padded
-      const double* c1 = &c.e[size_t(y / 2 + 1) * cs];
-      const bool odd = y & 1;
-      for (size_t j = 0; j < cs; ++j) rowTmp_[j] = odd ? c1[j] : 0.5 * (c0[j] + c1[j]);
-      const size_t row = size_t(y + 1) * fs + 1;
-      for (int x = 0; x < fw; ++x) {
-        const double v =
-            (x & 1) ? rowTmp_[size_t(x / 2 + 1)] : 0.5 * (rowTmp_[size_t(x / 2)] + rowTmp_[size_t(x / 2 + 1)]);
-        e[row + size_t(x)] += m[row + size_t(x)] * v;
+    const double* fineMask = fine ? mask_.data() : nullptr;  // else a coarse cell is active when its row is not 0
+    const uint32_t* kind = fine ? nullptr : levels_[k].kind.data();
+    effects::forRange(parallel, size_t(fh), 16, [&](size_t y0, size_t y1) {
+      std::vector<double> line(cs);
+      for (int y = int(y0); y < int(y1); ++y) {
+        const double* c0 = &c.e[size_t((y + 1) / 2) * cs];  // coarse row (y-1)/2 or y/2-1, padded
+        const double* c1 = &c.e[size_t(y / 2 + 1) * cs];
+        const bool odd = y & 1;
+        for (size_t j = 0; j < cs; ++j) line[j] = odd ? c1[j] : 0.5 * (c0[j] + c1[j]);
+        const size_t row = size_t(y + 1) * fs + 1;
+        for (int x = 0; x < fw; ++x) {
+          const double v = (x & 1) ? line[size_t(x / 2 + 1)] : 0.5 * (line[size_t(x / 2)] + line[size_t(x / 2 + 1)]);
+          const size_t i = row + size_t(x);
+          e[i] += (fineMask ? fineMask[i] : (kind[i] != 0 ? 1.0 : 0.0)) * v;
+        }
       }
-    }
+    });
   }
   for (int i = 0; i < kPreSmooth; ++i) fine ? smoothFine(false, false) : smoothCoarse(levels_[k], false);
 }
@@ -240,17 +299,20 @@ int Laplace::solve(Solver solver, double tolerance) {
   const size_t n = phi_.size();
   const size_t s = size_t(stride_);
   // r = b - A phi = (sum of 4 neighbours) - 4 phi on unknowns (fixed neighbours carry b).
-  double rr = 0.0;
-  for (size_t i = s; i + s < n; ++i) {
-    r_[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i]);
-    rr += r_[i] * r_[i];
-  }
+  double rr = blockSum(parallel_, s, n - s, [&](size_t b, size_t e) {
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) {
+      r_[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i]);
+      sum += r_[i] * r_[i];
+    }
+    return sum;
+  });
   const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
   const bool mg = solver != Solver::kCg;
   const int maxIt = 20 * (w_ + h_) + 1000;  // CG converges in O(sqrt(cond)) ~ O(n) iterations
   const int it = conjugateGradients(
-      phi_, r_, z_, p_, ap_, goal, maxIt, rr,
+      phi_, r_, z_, p_, ap_, goal, maxIt, rr, parallel_,
       [&] {
         if (mg)
           precondition();
@@ -258,12 +320,14 @@ int Laplace::solve(Solver solver, double tolerance) {
           z_ = r_;
       },
       [&] {
-        double pap = 0;
-        for (size_t i = s; i + s < n; ++i) {
-          ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
-          pap += p_[i] * ap_[i];
-        }
-        return pap;
+        return blockSum(parallel_, s, n - s, [&](size_t b, size_t e) {
+          double pap = 0;
+          for (size_t i = b; i < e; ++i) {
+            ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
+            pap += p_[i] * ap_[i];
+          }
+          return pap;
+        });
       });
   residual_ = std::sqrt(rr) / bnorm;
   return it;

@@ -10,13 +10,46 @@
 // coarse rows are rebuilt in a small box per level instead of from scratch every step.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
 #include "effects/lightning.h"
+#include "effects/parallel.h"
 
 namespace effects::lightning::detail {
+
+// Threads help the fine level's loops from this many cells up (below, a V-cycle is too short
+// to pay for handing out work): 512^2 in 2-D, 64^3 in 3-D. docs/lightning-hero.md measures it.
+inline constexpr size_t kParallelCells = size_t(512) * 512;
+
+// The same numbers on any number of threads: loops over a range split into fixed blocks of
+// kBlock indices (never the pool's own chunks), and sums add the blocks' partial sums in
+// block order. One block (ranges up to kBlock) is the plain loop, bit for bit.
+inline constexpr size_t kBlock = 16384;
+template <class Fn>
+void blockFor(Parallel* parallel, size_t first, size_t last, Fn fn) {
+  if (last <= first) return;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
+  auto run = [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) fn(first + b * kBlock, std::min(last, first + (b + 1) * kBlock));
+  };
+  if (!parallel || blocks == 1) return run(0, blocks);
+  effects::forRange(parallel, blocks, 1, run);
+}
+// sum over blocks of fn(begin, end), a block's own sum, in block order.
+template <class Fn>
+double blockSum(Parallel* parallel, size_t first, size_t last, Fn fn) {
+  if (last <= first) return 0;
+  const size_t blocks = (last - first + kBlock - 1) / kBlock;
+  if (blocks == 1) return fn(first, last);
+  std::vector<double> part(blocks);
+  blockFor(parallel, first, last, [&](size_t b, size_t e) { part[(b - first) / kBlock] = fn(b, e); });
+  double sum = 0;
+  for (double v : part) sum += v;
+  return sum;
+}
 
 // Vertex-centred coarsening, per axis (2-D and 3-D alike): coarse cell J sits on fine cell 2J+1.
 inline int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
@@ -37,36 +70,45 @@ inline int coarseParents(int g, int n, int* p, double* w) {
 
 // Conjugate gradients from phi with residual r (r = b - A phi, rr = its squared norm) until
 // ||r|| <= goal or maxIt iterations; precondition() sets z from r, applyAndDot() sets
-// ap = A p and returns p . ap. The vectors share one padded layout (pads stay 0). Returns the
-// iterations; rr ends as the final residual's squared norm.
+// ap = A p and returns p . ap. The vectors share one padded layout (pads stay 0). The vector
+// loops run on `parallel` (null: this thread) in fixed blocks. Returns the iterations; rr ends
+// as the final residual's squared norm.
 template <class Precondition, class ApplyAndDot>
 int conjugateGradients(std::vector<double>& phi, std::vector<double>& r, std::vector<double>& z,
                        std::vector<double>& p, const std::vector<double>& ap, double goal, int maxIt, double& rr,
-                       Precondition precondition, ApplyAndDot applyAndDot) {
+                       Parallel* parallel, Precondition precondition, ApplyAndDot applyAndDot) {
   const size_t n = phi.size();
+  auto dotRz = [&](size_t b, size_t e) {
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) sum += r[i] * z[i];
+    return sum;
+  };
   int it = 0;
   if (!(std::sqrt(rr) > goal)) return 0;
   precondition();
-  p = z;
-  double rz = 0;
-  for (size_t i = 0; i < n; ++i) rz += r[i] * z[i];
+  blockFor(parallel, 0, n, [&](size_t b, size_t e) { std::copy(z.begin() + ptrdiff_t(b), z.begin() + ptrdiff_t(e), p.begin() + ptrdiff_t(b)); });
+  double rz = blockSum(parallel, 0, n, dotRz);
   for (; it < maxIt; ++it) {
     const double pap = applyAndDot();
     if (!(pap > 0)) break;
     const double alpha = rz / pap;
-    rr = 0;
-    for (size_t i = 0; i < n; ++i) {
-      phi[i] += alpha * p[i];
-      r[i] -= alpha * ap[i];
-      rr += r[i] * r[i];
-    }
+    rr = blockSum(parallel, 0, n, [&](size_t b, size_t e) {
+      double sum = 0;
+      for (size_t i = b; i < e; ++i) {
+        phi[i] += alpha * p[i];
+        r[i] -= alpha * ap[i];
+        sum += r[i] * r[i];
+      }
+      return sum;
+    });
     if (std::sqrt(rr) <= goal) return it + 1;
     precondition();
-    double rzNew = 0;
-    for (size_t i = 0; i < n; ++i) rzNew += r[i] * z[i];
+    const double rzNew = blockSum(parallel, 0, n, dotRz);
     const double beta = rzNew / rz;
     rz = rzNew;
-    for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];  // z is 0 on fixed cells
+    blockFor(parallel, 0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) p[i] = z[i] + beta * p[i];  // z is 0 on fixed cells
+    });
   }
   return it;
 }
@@ -88,7 +130,8 @@ class Potential {
 
 class Laplace final : public Potential {
  public:
-  Laplace(int width, int height);
+  // parallel: where the fine level's loops may split (from kParallelCells up); null: this thread.
+  Laplace(int width, int height, Parallel* parallel = nullptr);
   void fix(int x, int y, double value);
   void fix(Cell c, double value) override { fix(c.x, c.y, value); }
   int solve(Solver solver, double tolerance) override;
@@ -98,30 +141,39 @@ class Laplace final : public Potential {
 
  private:
   size_t at(int x, int y) const { return size_t(y + 1) * stride_ + size_t(x + 1); }
-  // A coarse level: padded (w+2) x (h+2) arrays; a[i][k] is the stencil weight from cell i to
-  // its neighbour at offset k = (dx+1) + 3 (dy+1). A cell with a zero diagonal is inactive.
+  // A coarse level: padded (w+2) x (h+2) arrays. Cell i's stencil is rows[kind[i]], where
+  // row[k] is the weight from the cell to its neighbour at offset k = (dx+1) + 3 (dy+1).
+  // Most cells share one row: rows[0] is all zero (inactive and pad cells), rows[1] the
+  // level's regular row (its centre's before anything was fixed; rows equal to it bit for bit
+  // point at it), and only cells near a border or a fixed cell have rows of their own. A cell
+  // then streams 4 bytes of stencil per sweep instead of 72 (+8 of diagonal).
   struct Level {
     int w = 0, h = 0, stride = 0;
-    std::vector<std::array<double, 9>> a;
-    std::vector<double> invDiag, mask, e, r;  // mask: 1 on active cells
+    std::vector<uint32_t> kind;
+    std::vector<std::array<double, 9>> rows;
+    std::vector<double> invDiag;  // per row: 1 / its diagonal, 0 for rows[0]
+    std::vector<double> e, r;
+    const std::array<double, 9>& row(size_t i) const { return rows[kind[i]]; }
   };
   struct Box {
     int x0, y0, x1, y1;  // inclusive; empty when x0 > x1
     bool empty() const { return x0 > x1 || y0 > y1; }
   };
   void updateCoarse();
-  void galerkinRow(size_t k, int cx, int cy);
+  std::array<double, 9> galerkinRow(size_t k, int cx, int cy) const;
+  void setRow(size_t k, int cx, int cy, const std::array<double, 9>& row);
   void vcycle(size_t k);
   void smoothFine(bool forward, bool fromZero);
   void smoothCoarse(Level& l, bool forward);
   void precondition();
 
   int w_, h_, stride_;
+  Parallel* parallel_;  // null below kParallelCells
   std::vector<double> phi_, bvec_, mask_;  // mask_: 1 on unknowns, 0 on fixed and pad cells
   std::vector<uint8_t> unknown_;           // padded; the pad is fixed at 0
   double bb_ = 0;                          // ||b||^2, kept up to date by fix()
   double residual_ = 0;                    // ||r|| / ||b|| after the last solve
-  std::vector<double> r_, z_, p_, ap_, e0_, rowTmp_;
+  std::vector<double> r_, z_, p_, ap_, e0_;
   std::vector<Level> levels_;  // levels_[0] is unused: the fine level lives in the members
   Box dirty_;                  // fine cells fixed since the coarse operators were built
 };

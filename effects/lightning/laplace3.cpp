@@ -28,8 +28,13 @@ inline double stencilDot(const std::array<double, 27>& a, const double* centre, 
 
 }  // namespace
 
-Laplace3::Laplace3(int width, int height, int depth)
-    : w_(width), h_(height), d_(depth), sx_(size_t(width) + 2), sy_(size_t(height) + 2) {
+Laplace3::Laplace3(int width, int height, int depth, Parallel* parallel)
+    : w_(width),
+      h_(height),
+      d_(depth),
+      sx_(size_t(width) + 2),
+      sy_(size_t(height) + 2),
+      parallel_(size_t(width) * size_t(height) * size_t(depth) >= kParallelCells ? parallel : nullptr) {
   const size_t n = sx_ * sy_ * (size_t(depth) + 2);
   phi_.assign(n, 0.0);
   bvec_.assign(n, 0.0);
@@ -157,13 +162,16 @@ void Laplace3::updateCoarse() {
 
 void Laplace3::smoothFine(bool forward, bool fromZero) {
   // Red-black Gauss-Seidel on 6e - sum e_n = r over the unknowns (e is 0 on fixed voxels).
+  // A colour's voxels depend only on the other colour's, so its pass splits over slabs on
+  // threads with the same numbers.
   // From zero, the first colour's neighbours are all 0; writing every voxel of both colours
   // (the pad is never written) then replaces clearing the vector.
   const size_t slab = sx_ * sy_;
   double* e = z_.data();
   for (int pass = 0; pass < 2; ++pass) {
     const int colour = forward ? pass : 1 - pass;
-    for (int z = 0; z < d_; ++z)
+    effects::forRange(parallel_, size_t(d_), 1, [&](size_t z0, size_t z1) {
+    for (int z = int(z0); z < int(z1); ++z)
       for (int y = 0; y < h_; ++y) {
         const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
         if (fromZero && pass == 0) {
@@ -178,6 +186,7 @@ void Laplace3::smoothFine(bool forward, bool fromZero) {
                  ((r_[i] + (e[i - 1] + e[i + 1])) + ((e[i - sx_] + e[i + sx_]) + (e[i - slab] + e[i + slab])));
         }
       }
+    });
   }
 }
 
@@ -203,17 +212,16 @@ void Laplace3::smoothCoarse(Level& l, bool forward) {
 }
 
 double Laplace3::apply(const std::vector<double>& v, std::vector<double>& out) const {
+  // Over every index between the pad slabs (pad voxels have mask 0: out stays 0 there).
   const size_t slab = sx_ * sy_;
-  double dot = 0;
-  for (int z = 0; z < d_; ++z)
-    for (int y = 0; y < h_; ++y) {
-      const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-      for (size_t i = row; i < row + size_t(w_); ++i) {
-        out[i] = mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] - v[i - slab] - v[i + slab]);
-        dot += v[i] * out[i];
-      }
+  return blockSum(parallel_, slab, v.size() - slab, [&](size_t b, size_t end) {
+    double dot = 0;
+    for (size_t i = b; i < end; ++i) {
+      out[i] = mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] - v[i - slab] - v[i + slab]);
+      dot += v[i] * out[i];
     }
-  return dot;
+    return dot;
+  });
 }
 
 // e_k approximately solves A_k e_k = r_k; k = 0 is the fine level (r_ -> z_).
@@ -239,13 +247,11 @@ void Laplace3::vcycle(size_t k) {
     if (fine) {
       const size_t slab = sx_ * sy_;
       const double* v = z_.data();
-      for (int z = 0; z < d_; ++z)
-        for (int y = 0; y < h_; ++y) {
-          const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-          for (size_t i = row; i < row + size_t(w_); ++i)
-            res[i] = mask_[i] * (r_[i] - mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] -
-                                                     v[i - slab] - v[i + slab]));
-        }
+      blockFor(parallel_, slab, res.size() - slab, [&](size_t b, size_t end) {
+        for (size_t i = b; i < end; ++i)
+          res[i] = mask_[i] * (r_[i] - mask_[i] * (6 * v[i] - v[i - 1] - v[i + 1] - v[i - sx_] - v[i + sx_] -
+                                                   v[i - slab] - v[i + slab]));
+      });
     } else {
       const Level& l = levels_[k];
       const auto off = offsets(l.sx, l.sy);
@@ -260,7 +266,9 @@ void Laplace3::vcycle(size_t k) {
     // (along x, then y, then z, each [1/2, 1, 1/2]).
     Level& c = levels_[k + 1];
     const size_t fslab = fsx * fsy;
-    for (int cz = 0; cz < c.d; ++cz)
+    Parallel* parallel = fine ? parallel_ : nullptr;
+    effects::forRange(parallel, size_t(c.d), 1, [&](size_t z0, size_t z1) {
+    for (int cz = int(z0); cz < int(z1); ++cz)
       for (int cy = 0; cy < c.h; ++cy)
         for (int cx = 0; cx < c.w; ++cx) {
           const size_t i = (size_t(2 * cz + 2) * fsy + size_t(2 * cy + 2)) * fsx + size_t(2 * cx + 2);
@@ -269,6 +277,7 @@ void Laplace3::vcycle(size_t k) {
           c.r[(size_t(cz + 1) * c.sy + size_t(cy + 1)) * c.sx + size_t(cx + 1)] =
               0.5 * plane(i - fslab) + plane(i) + 0.5 * plane(i + fslab);
         }
+    });
     vcycle(k + 1);
     // Prolongation (trilinear), masked to this level's active voxels, one fine row at a time:
     // the coarse rows around it blended in y and z (the coarse padding is 0, so borders need
@@ -276,8 +285,9 @@ void Laplace3::vcycle(size_t k) {
     // x/2-1 and x/2 (padded indices x/2 + 1 and x/2).
     std::vector<double>& e = fine ? z_ : levels_[k].e;
     const std::vector<double>& active = fine ? mask_ : levels_[k].invDiag;
+    effects::forRange(parallel, size_t(fd), 1, [&](size_t z0, size_t z1) {
     std::vector<double> line(c.sx);
-    for (int z = 0; z < fd; ++z) {
+    for (int z = int(z0); z < int(z1); ++z) {
       int pz[2];
       double wz[2];
       const int nz = coarseParents(z, c.d, pz, wz);
@@ -300,27 +310,27 @@ void Laplace3::vcycle(size_t k) {
         }
       }
     }
+    });
   }
   fine ? smoothFine(false, false) : smoothCoarse(levels_[k], false);
 }
 
-void Laplace3::residualFine(std::vector<double>& out) const {
+double Laplace3::residualFine(std::vector<double>& out) const {
   const size_t slab = sx_ * sy_;
-  for (int z = 0; z < d_; ++z)
-    for (int y = 0; y < h_; ++y) {
-      const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-      for (size_t i = row; i < row + size_t(w_); ++i)
-        out[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - sx_] + phi_[i + sx_] + phi_[i - slab] +
-                             phi_[i + slab] - 6 * phi_[i]);
+  return blockSum(parallel_, slab, out.size() - slab, [&](size_t b, size_t end) {
+    double sum = 0;
+    for (size_t i = b; i < end; ++i) {
+      out[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - sx_] + phi_[i + sx_] + phi_[i - slab] +
+                           phi_[i + slab] - 6 * phi_[i]);
+      sum += out[i] * out[i];
     }
+    return sum;
+  });
 }
 
 int Laplace3::solve(Solver solver, double tolerance) {
   // r = b - A phi = (sum of 6 neighbours) - 6 phi on unknowns (fixed neighbours carry b).
-  residualFine(r_);
-  const size_t n = phi_.size();
-  double rr = 0;
-  for (size_t i = 0; i < n; ++i) rr += r_[i] * r_[i];
+  double rr = residualFine(r_);
   const double bnorm = bb_ > 0 ? std::sqrt(bb_) : 1.0;
   const double goal = tolerance * bnorm;
   const bool mg = solver != Solver::kCg && levels_.size() > 1;
@@ -333,7 +343,7 @@ int Laplace3::solve(Solver solver, double tolerance) {
       z_ = r_;
     }
   };
-  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, precondition, [&] { return apply(p_, ap_); });
+  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, parallel_, precondition, [&] { return apply(p_, ap_); });
   residual_ = std::sqrt(rr) / bnorm;
   return it;
 }

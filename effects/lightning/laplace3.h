@@ -16,7 +16,8 @@ namespace effects::lightning::detail {
 
 class Laplace3 final : public Potential {
  public:
-  Laplace3(int width, int height, int depth);
+  // parallel: where the fine level's loops may split (from kParallelCells up); null: this thread.
+  Laplace3(int width, int height, int depth, Parallel* parallel = nullptr);
   Laplace3(const Laplace3&) = delete;  // levels point into themselves
   Laplace3& operator=(const Laplace3&) = delete;
   void fix(Cell c, double value) override;
@@ -48,12 +49,14 @@ class Laplace3 final : public Potential {
   void vcycle(size_t k);
   void smoothFine(bool forward, bool fromZero);
   void smoothCoarse(Level& l, bool forward);
-  void residualFine(std::vector<double>& out) const;
+  // out = b - A phi over the unknowns; returns its squared norm.
+  double residualFine(std::vector<double>& out) const;
   // The fine operator: out = A v over the unknowns; returns v . out.
   double apply(const std::vector<double>& v, std::vector<double>& out) const;
 
   int w_, h_, d_;
   size_t sx_, sy_;
+  Parallel* parallel_;  // null below kParallelCells
   std::vector<double> phi_, bvec_, mask_, r_, z_, p_, ap_, res_;
   double bb_ = 0;  // ||b||^2, kept up to date by fix()
   double residual_ = 0;  // ||r|| / ||b|| after the last solve

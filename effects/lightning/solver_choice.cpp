@@ -10,12 +10,12 @@
 namespace effects::lightning::detail {
 
 std::unique_ptr<Potential> potentialFor(int width, int height, int depth, Solver solver, size_t fixedCells,
-                                        size_t cellsToCome) {
+                                        size_t cellsToCome, Parallel* parallel) {
   if (solver == Solver::kCapacitance && Capacitance::fits(width, height, depth) &&
       fixedCells + cellsToCome <= Capacitance::maxFixed(width, height, depth))
     return std::make_unique<Capacitance>(width, height, depth);
-  if (depth > 0) return std::make_unique<Laplace3>(width, height, depth);
-  return std::make_unique<Laplace>(width, height);
+  if (depth > 0) return std::make_unique<Laplace3>(width, height, depth, parallel);
+  return std::make_unique<Laplace>(width, height, parallel);
 }
 
 }  // namespace effects::lightning::detail

@@ -13,7 +13,8 @@
 
 namespace effects::lightning::detail {
 
+// parallel: where the iterative solver's fine level may split its loops (null: this thread).
 std::unique_ptr<Potential> potentialFor(int width, int height, int depth, Solver solver, size_t fixedCells,
-                                        size_t cellsToCome);
+                                        size_t cellsToCome, Parallel* parallel = nullptr);
 
 }  // namespace effects::lightning::detail

@@ -238,6 +238,7 @@ JsonReply runLightning(const LightningRequest& request, const json& /*body*/, co
   const bool glbFormat = request.glb;  // include: only timeline applies
   lt::Params p = boltParams(request, ctx.at);
   p.measureError = include.has("error") && !glbFormat;
+  p.parallel = ctx.parallel;  // the same bolt on any threads
   const lt::Bolt bolt = growBolt(p, ctx.at, ctx.progress);
   JsonReply reply;
   reply.method = bolt.stats.method;

@@ -53,6 +53,7 @@
 #include "effects/common.h"
 
 #include "effects/export.h"
+#include "effects/parallel.h"
 
 EFFECTS_API_BEGIN
 namespace effects::lightning {
@@ -125,6 +126,8 @@ struct Params {
   size_t maxSteps = kDefaultMaxGrowthSteps;  // growth budget (cells added)
   bool measureError = false;    // per-step TV distance to the converged Laplace distribution
   ProgressCallback progress;    // optional: progress reports and cancellation (Progress)
+  Parallel* parallel = nullptr;  // kDbm from 512^2 (64^3) cells: where the iterative solver may split
+                                 // its fine level's loops (the same bolt on any threads); null: this thread
 };
 
 [[nodiscard]] std::optional<Error> validate(const Params& p);
