@@ -24,10 +24,9 @@ Laplace::Laplace(int width, int height, Parallel* parallel)
   phi_.assign(n, 0.0);
   bvec_.assign(n, 0.0);
   unknown_.assign(n, 0);
-  mask_.assign(n, 0.0);
   for (int y = 0; y < h_; ++y)
-    for (int x = 0; x < w_; ++x) unknown_[at(x, y)] = 1, mask_[at(x, y)] = 1.0;
-  for (auto* v : {&r_, &z_, &p_, &ap_, &e0_}) v->assign(n, 0.0);
+    for (int x = 0; x < w_; ++x) unknown_[at(x, y)] = 1;
+  for (auto* v : {&r_, &z_, &p_, &ap_}) v->assign(n, 0.0);
   levels_.resize(1);
   for (int w = w_ / 2, h = h_ / 2; w >= 2 && h >= 2; w /= 2, h /= 2) {
     Level l;
@@ -61,7 +60,6 @@ void Laplace::fix(int x, int y, double value) {
     bb_ -= bvec_[i] * bvec_[i];
     bvec_[i] = 0;
     unknown_[i] = 0;
-    mask_[i] = 0.0;
     dirty_ = dirty_.empty()
                  ? Box{x, y, x, y}
                  : Box{std::min(dirty_.x0, x), std::min(dirty_.y0, y), std::max(dirty_.x1, x), std::max(dirty_.y1, y)};
@@ -150,18 +148,18 @@ void Laplace::smoothFine(bool forward, bool fromZero) {
   // (the pad is never written) then replaces clearing the vector.
   double* e = z_.data();
   const double* r = r_.data();
-  const double* m = mask_.data();
+  const uint8_t* m = unknown_.data();
   const size_t s = size_t(stride_);
   const int first = forward ? 0 : 1;
   auto sweep = [&](int y, int colour) {
     const size_t row = size_t(y + 1) * s + 1;
     if (fromZero && colour == first) {
-      for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x)] = m[row + size_t(x)] * 0.25 * r[row + size_t(x)];
+      for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x)] = m[row + size_t(x)] ? 0.25 * r[row + size_t(x)] : 0.0;
       return;
     }
     for (int x = (y + colour) & 1; x < w_; x += 2) {
       const size_t i = row + size_t(x);
-      e[i] = m[i] * 0.25 * (r[i] + e[i - 1] + e[i + 1] + e[i - s] + e[i + s]);
+      e[i] = m[i] ? 0.25 * (r[i] + e[i - 1] + e[i + 1] + e[i - s] + e[i + s]) : 0.0;
     }
   };
   constexpr int kRows = 16;  // rows per block on threads
@@ -230,46 +228,61 @@ void Laplace::vcycle(size_t k) {
   }
   for (int i = 0; i < kPreSmooth; ++i) fine ? smoothFine(true, i == 0) : smoothCoarse(levels_[k], true);
   if (!coarsest) {
-    // Residual of this level, restricted with P^T (full weighting over the 3x3 fine support).
+    // Residual of this level, restricted with P^T (full weighting over the 3x3 fine support),
+    // row by row: coarse row J takes padded fine rows 2J+1 .. 2J+3, each residual row made once
+    // into a ring of three (the last, row fh + 1, is the pad: 0) instead of a whole residual
+    // written and read back.
     const int fw = fine ? w_ : levels_[k].w, fh = fine ? h_ : levels_[k].h;
     const size_t fs = size_t(fine ? stride_ : levels_[k].stride);
-    std::vector<double>& res = e0_;
-    const size_t first = fs + 1, last = size_t(fh + 1) * fs - 1;  // the pad columns come out 0
-    if (fine) {
-      blockFor(parallel_, first, last, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i)
-          res[i] = mask_[i] * (r_[i] - (4 * z_[i] - z_[i - 1] - z_[i + 1] - z_[i - fs] - z_[i + fs]));
-      });
-    } else {
-      const Level& l = levels_[k];
-      const double* e = l.e.data();
-      for (size_t i = first; i < last; ++i) {
-        const auto& a = l.row(i);
-        const double* u = e + i - fs;
-        const double* d = e + i + fs;
-        res[i] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) -
-                 (a[3] * e[i - 1] + a[4] * e[i] + a[5] * e[i + 1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
+    auto residualRow = [&](int py, double* out) {  // padded row py of r - A e; 0 on the pads
+      std::fill(out, out + fs, 0.0);
+      if (py > fh) return;
+      const size_t row = size_t(py) * fs;
+      if (fine) {
+        for (size_t x = 1; x <= size_t(fw); ++x) {
+          const size_t i = row + x;
+          out[x] = unknown_[i] ? r_[i] - (4 * z_[i] - z_[i - 1] - z_[i + 1] - z_[i - fs] - z_[i + fs]) : 0.0;
+        }
+      } else {
+        const Level& l = levels_[k];
+        const double* e = l.e.data();
+        for (size_t x = 1; x <= size_t(fw); ++x) {
+          const size_t i = row + x;
+          const auto& a = l.row(i);
+          const double* u = e + i - fs;
+          const double* d = e + i + fs;
+          out[x] = l.r[i] - (a[0] * u[-1] + a[1] * u[0] + a[2] * u[1]) -
+                   (a[3] * e[i - 1] + a[4] * e[i] + a[5] * e[i + 1]) - (a[6] * d[-1] + a[7] * d[0] + a[8] * d[1]);
+        }
       }
-    }
+    };
     Level& c = levels_[k + 1];
     const size_t cs = size_t(c.stride);
     Parallel* parallel = fine ? parallel_ : nullptr;
     effects::forRange(parallel, size_t(c.h), 8, [&](size_t y0, size_t y1) {
-      for (int cy = int(y0); cy < int(y1); ++cy)
+      std::vector<double> ring(3 * fs);
+      double* above = ring.data();
+      double* mid = above + fs;
+      double* below = mid + fs;
+      residualRow(int(2 * y0 + 1), above);
+      for (int cy = int(y0); cy < int(y1); ++cy) {
+        residualRow(2 * cy + 2, mid);
+        residualRow(2 * cy + 3, below);
         for (int cx = 0; cx < c.w; ++cx) {
-          // fine cell (2cx+1, 2cy+1) is at padded index (2cx+2, 2cy+2)
-          size_t i = size_t(2 * cy + 2) * fs + size_t(2 * cx + 2);
-          double v = res[i] + 0.5 * (res[i - 1] + res[i + 1] + res[i - fs] + res[i + fs]) +
-                     0.25 * (res[i - fs - 1] + res[i - fs + 1] + res[i + fs - 1] + res[i + fs + 1]);
-          c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = v;
+          const size_t x = size_t(2 * cx + 2);  // fine cell (2cx+1, 2cy+1): padded column 2cx+2, row 2cy+2
+          c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = mid[x] + 0.5 * (mid[x - 1] + mid[x + 1] + above[x] + below[x]) +
+                                                      0.25 * (above[x - 1] + above[x + 1] + below[x - 1] + below[x + 1]);
         }
+        std::swap(above, below);  // row 2cy+3 is the next coarse row's first
+      }
     });
     vcycle(k + 1);
     // Prolongation (bilinear), masked to this level's active cells, gathered per fine row:
     // odd fine rows/columns sit on a coarse one, even ones halfway between two (the pad of
     // the coarse grid is 0, so the borders need no special case).
     std::vector<double>& e = fine ? z_ : levels_[k].e;
-    const double* fineMask = fine ? mask_.data() : nullptr;  // else a coarse cell is active when its row is not 0
+    // Active: an unknown fine cell, or a coarse cell whose row is not 0.
+    const uint8_t* unknown = fine ? unknown_.data() : nullptr;
     const uint32_t* kind = fine ? nullptr : levels_[k].kind.data();
     effects::forRange(parallel, size_t(fh), 16, [&](size_t y0, size_t y1) {
       std::vector<double> line(cs);
@@ -282,7 +295,7 @@ void Laplace::vcycle(size_t k) {
         for (int x = 0; x < fw; ++x) {
           const double v = (x & 1) ? line[size_t(x / 2 + 1)] : 0.5 * (line[size_t(x / 2)] + line[size_t(x / 2 + 1)]);
           const size_t i = row + size_t(x);
-          e[i] += (fineMask ? fineMask[i] : (kind[i] != 0 ? 1.0 : 0.0)) * v;
+          if (unknown ? unknown[i] != 0 : kind[i] != 0) e[i] += v;
         }
       }
     });
@@ -295,6 +308,16 @@ void Laplace::precondition() {
   vcycle(0);
 }
 
+std::vector<double> Laplace::preconditioned(const std::vector<double>& r) {
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < w_; ++x) r_[at(x, y)] = unknown_[at(x, y)] ? r[size_t(y) * size_t(w_) + size_t(x)] : 0.0;
+  precondition();
+  std::vector<double> z(r.size());
+  for (int y = 0; y < h_; ++y)
+    for (int x = 0; x < w_; ++x) z[size_t(y) * size_t(w_) + size_t(x)] = z_[at(x, y)];
+  return z;
+}
+
 int Laplace::solve(Solver solver, double tolerance) {
   const size_t n = phi_.size();
   const size_t s = size_t(stride_);
@@ -302,7 +325,7 @@ int Laplace::solve(Solver solver, double tolerance) {
   double rr = blockSum(parallel_, s, n - s, [&](size_t b, size_t e) {
     double sum = 0;
     for (size_t i = b; i < e; ++i) {
-      r_[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i]);
+      r_[i] = unknown_[i] ? phi_[i - 1] + phi_[i + 1] + phi_[i - s] + phi_[i + s] - 4 * phi_[i] : 0.0;
       sum += r_[i] * r_[i];
     }
     return sum;
@@ -323,7 +346,7 @@ int Laplace::solve(Solver solver, double tolerance) {
         return blockSum(parallel_, s, n - s, [&](size_t b, size_t e) {
           double pap = 0;
           for (size_t i = b; i < e; ++i) {
-            ap_[i] = mask_[i] * (4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s]);  // p is 0 on fixed cells
+            ap_[i] = unknown_[i] ? 4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s] : 0.0;  // p is 0 on fixed cells
             pap += p_[i] * ap_[i];
           }
           return pap;

@@ -138,6 +138,9 @@ class Laplace final : public Potential {
   double phi(int x, int y) const { return phi_[at(x, y)]; }
   double phi(Cell c) const override { return phi(c.x, c.y); }
   double residual() const override { return residual_; }
+  // One V-cycle, z = M r, over unpadded w x h vectors (r's entries on fixed cells are ignored,
+  // z is 0 there), for tests: CG needs M symmetric. Uses the solver's scratch vectors.
+  std::vector<double> preconditioned(const std::vector<double>& r);
 
  private:
   size_t at(int x, int y) const { return size_t(y + 1) * stride_ + size_t(x + 1); }
@@ -169,11 +172,12 @@ class Laplace final : public Potential {
 
   int w_, h_, stride_;
   Parallel* parallel_;  // null below kParallelCells
-  std::vector<double> phi_, bvec_, mask_;  // mask_: 1 on unknowns, 0 on fixed and pad cells
-  std::vector<uint8_t> unknown_;           // padded; the pad is fixed at 0
+  std::vector<double> phi_, bvec_;
+  std::vector<uint8_t> unknown_;  // padded: 1 on unknowns, 0 on fixed and pad cells (a byte, not
+                                  // a double mask: the fine loops are bound by memory traffic)
   double bb_ = 0;                          // ||b||^2, kept up to date by fix()
   double residual_ = 0;                    // ||r|| / ||b|| after the last solve
-  std::vector<double> r_, z_, p_, ap_, e0_;
+  std::vector<double> r_, z_, p_, ap_;
   std::vector<Level> levels_;  // levels_[0] is unused: the fine level lives in the members
   Box dirty_;                  // fine cells fixed since the coarse operators were built
 };
