@@ -154,7 +154,8 @@ void Laplace::smoothFine(bool forward, bool fromZero) {
   auto sweep = [&](int y, int colour) {
     const size_t row = size_t(y + 1) * s + 1;
     if (fromZero && colour == first) {
-      for (int x = (y + colour) & 1; x < w_; x += 2) e[row + size_t(x)] = m[row + size_t(x)] ? 0.25 * r[row + size_t(x)] : 0.0;
+      for (int x = (y + colour) & 1; x < w_; x += 2)
+        e[row + size_t(x)] = m[row + size_t(x)] ? 0.25 * r[row + size_t(x)] : 0.0;
       return;
     }
     for (int x = (y + colour) & 1; x < w_; x += 2) {
@@ -270,8 +271,9 @@ void Laplace::vcycle(size_t k) {
         residualRow(2 * cy + 3, below);
         for (int cx = 0; cx < c.w; ++cx) {
           const size_t x = size_t(2 * cx + 2);  // fine cell (2cx+1, 2cy+1): padded column 2cx+2, row 2cy+2
-          c.r[size_t(cy + 1) * cs + size_t(cx + 1)] = mid[x] + 0.5 * (mid[x - 1] + mid[x + 1] + above[x] + below[x]) +
-                                                      0.25 * (above[x - 1] + above[x + 1] + below[x - 1] + below[x + 1]);
+          c.r[size_t(cy + 1) * cs + size_t(cx + 1)] =
+              mid[x] + 0.5 * (mid[x - 1] + mid[x + 1] + above[x] + below[x]) +
+              0.25 * (above[x - 1] + above[x + 1] + below[x - 1] + below[x + 1]);
         }
         std::swap(above, below);  // row 2cy+3 is the next coarse row's first
       }
@@ -346,7 +348,8 @@ int Laplace::solve(Solver solver, double tolerance) {
         return blockSum(parallel_, s, n - s, [&](size_t b, size_t e) {
           double pap = 0;
           for (size_t i = b; i < e; ++i) {
-            ap_[i] = unknown_[i] ? 4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s] : 0.0;  // p is 0 on fixed cells
+            ap_[i] =
+                unknown_[i] ? 4 * p_[i] - p_[i - 1] - p_[i + 1] - p_[i - s] - p_[i + s] : 0.0;  // p is 0 on fixed cells
             pap += p_[i] * ap_[i];
           }
           return pap;

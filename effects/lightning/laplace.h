@@ -21,7 +21,8 @@
 namespace effects::lightning::detail {
 
 // Threads help the fine level's loops from this many cells up (below, a V-cycle is too short
-// to pay for handing out work): 512^2 in 2-D, 64^3 in 3-D. docs/lightning-hero.md measures it.
+// to pay for handing out work): 512^2 in 2-D, 64^3 in 3-D. Set by that reasoning, not tuned
+// (docs/lightning-hero.md has what two threads gain at 512^2 and 1024^2).
 inline constexpr size_t kParallelCells = size_t(512) * 512;
 
 // The same numbers on any number of threads: loops over a range split into fixed blocks of
@@ -74,9 +75,9 @@ inline int coarseParents(int g, int n, int* p, double* w) {
 // loops run on `parallel` (null: this thread) in fixed blocks. Returns the iterations; rr ends
 // as the final residual's squared norm.
 template <class Precondition, class ApplyAndDot>
-int conjugateGradients(std::vector<double>& phi, std::vector<double>& r, std::vector<double>& z,
-                       std::vector<double>& p, const std::vector<double>& ap, double goal, int maxIt, double& rr,
-                       Parallel* parallel, Precondition precondition, ApplyAndDot applyAndDot) {
+int conjugateGradients(std::vector<double>& phi, std::vector<double>& r, std::vector<double>& z, std::vector<double>& p,
+                       const std::vector<double>& ap, double goal, int maxIt, double& rr, Parallel* parallel,
+                       Precondition precondition, ApplyAndDot applyAndDot) {
   const size_t n = phi.size();
   auto dotRz = [&](size_t b, size_t e) {
     double sum = 0;
@@ -86,7 +87,9 @@ int conjugateGradients(std::vector<double>& phi, std::vector<double>& r, std::ve
   int it = 0;
   if (!(std::sqrt(rr) > goal)) return 0;
   precondition();
-  blockFor(parallel, 0, n, [&](size_t b, size_t e) { std::copy(z.begin() + ptrdiff_t(b), z.begin() + ptrdiff_t(e), p.begin() + ptrdiff_t(b)); });
+  blockFor(parallel, 0, n, [&](size_t b, size_t e) {
+    std::copy(z.begin() + ptrdiff_t(b), z.begin() + ptrdiff_t(e), p.begin() + ptrdiff_t(b));
+  });
   double rz = blockSum(parallel, 0, n, dotRz);
   for (; it < maxIt; ++it) {
     const double pap = applyAndDot();
@@ -175,8 +178,8 @@ class Laplace final : public Potential {
   std::vector<double> phi_, bvec_;
   std::vector<uint8_t> unknown_;  // padded: 1 on unknowns, 0 on fixed and pad cells (a byte, not
                                   // a double mask: the fine loops are bound by memory traffic)
-  double bb_ = 0;                          // ||b||^2, kept up to date by fix()
-  double residual_ = 0;                    // ||r|| / ||b|| after the last solve
+  double bb_ = 0;                 // ||b||^2, kept up to date by fix()
+  double residual_ = 0;           // ||r|| / ||b|| after the last solve
   std::vector<double> r_, z_, p_, ap_;
   std::vector<Level> levels_;  // levels_[0] is unused: the fine level lives in the members
   Box dirty_;                  // fine cells fixed since the coarse operators were built

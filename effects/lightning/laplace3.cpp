@@ -13,7 +13,8 @@ constexpr int kCoarsestSweeps = 12;
 std::array<ptrdiff_t, 27> offsets(size_t sx, size_t sy) {
   std::array<ptrdiff_t, 27> o{};
   for (int k = 0; k < 27; ++k)
-    o[size_t(k)] = ptrdiff_t(k % 3 - 1) + ptrdiff_t(k / 3 % 3 - 1) * ptrdiff_t(sx) + ptrdiff_t(k / 9 - 1) * ptrdiff_t(sx * sy);
+    o[size_t(k)] =
+        ptrdiff_t(k % 3 - 1) + ptrdiff_t(k / 3 % 3 - 1) * ptrdiff_t(sx) + ptrdiff_t(k / 9 - 1) * ptrdiff_t(sx * sy);
   return o;
 }
 
@@ -22,7 +23,8 @@ std::array<ptrdiff_t, 27> offsets(size_t sx, size_t sy) {
 inline double stencilDot(const std::array<double, 27>& a, const double* centre, const std::array<ptrdiff_t, 27>& off) {
   double row[9];
   for (size_t j = 0; j < 9; ++j)
-    row[j] = a[3 * j] * centre[off[3 * j]] + a[3 * j + 1] * centre[off[3 * j + 1]] + a[3 * j + 2] * centre[off[3 * j + 2]];
+    row[j] =
+        a[3 * j] * centre[off[3 * j]] + a[3 * j + 1] * centre[off[3 * j + 1]] + a[3 * j + 2] * centre[off[3 * j + 2]];
   return (((row[0] + row[1]) + (row[2] + row[3])) + ((row[4] + row[5]) + (row[6] + row[7]))) + row[8];
 }
 
@@ -171,21 +173,21 @@ void Laplace3::smoothFine(bool forward, bool fromZero) {
   for (int pass = 0; pass < 2; ++pass) {
     const int colour = forward ? pass : 1 - pass;
     effects::forRange(parallel_, size_t(d_), 1, [&](size_t z0, size_t z1) {
-    for (int z = int(z0); z < int(z1); ++z)
-      for (int y = 0; y < h_; ++y) {
-        const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
-        if (fromZero && pass == 0) {
-          for (int x = (y + z + colour) & 1; x < w_; x += 2)
-            e[row + size_t(x)] = mask_[row + size_t(x)] * (1.0 / 6.0) * r_[row + size_t(x)];
-          continue;
+      for (int z = int(z0); z < int(z1); ++z)
+        for (int y = 0; y < h_; ++y) {
+          const size_t row = (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + 1;
+          if (fromZero && pass == 0) {
+            for (int x = (y + z + colour) & 1; x < w_; x += 2)
+              e[row + size_t(x)] = mask_[row + size_t(x)] * (1.0 / 6.0) * r_[row + size_t(x)];
+            continue;
+          }
+          for (int x = (y + z + colour) & 1; x < w_; x += 2) {
+            const size_t i = row + size_t(x);
+            // Added pairwise, not as one chain of six dependent additions.
+            e[i] = mask_[i] * (1.0 / 6.0) *
+                   ((r_[i] + (e[i - 1] + e[i + 1])) + ((e[i - sx_] + e[i + sx_]) + (e[i - slab] + e[i + slab])));
+          }
         }
-        for (int x = (y + z + colour) & 1; x < w_; x += 2) {
-          const size_t i = row + size_t(x);
-          // Added pairwise, not as one chain of six dependent additions.
-          e[i] = mask_[i] * (1.0 / 6.0) *
-                 ((r_[i] + (e[i - 1] + e[i + 1])) + ((e[i - sx_] + e[i + sx_]) + (e[i - slab] + e[i + slab])));
-        }
-      }
     });
   }
 }
@@ -268,15 +270,15 @@ void Laplace3::vcycle(size_t k) {
     const size_t fslab = fsx * fsy;
     Parallel* parallel = fine ? parallel_ : nullptr;
     effects::forRange(parallel, size_t(c.d), 1, [&](size_t z0, size_t z1) {
-    for (int cz = int(z0); cz < int(z1); ++cz)
-      for (int cy = 0; cy < c.h; ++cy)
-        for (int cx = 0; cx < c.w; ++cx) {
-          const size_t i = (size_t(2 * cz + 2) * fsy + size_t(2 * cy + 2)) * fsx + size_t(2 * cx + 2);
-          auto row = [&](size_t j) { return 0.5 * res[j - 1] + res[j] + 0.5 * res[j + 1]; };
-          auto plane = [&](size_t j) { return 0.5 * row(j - fsx) + row(j) + 0.5 * row(j + fsx); };
-          c.r[(size_t(cz + 1) * c.sy + size_t(cy + 1)) * c.sx + size_t(cx + 1)] =
-              0.5 * plane(i - fslab) + plane(i) + 0.5 * plane(i + fslab);
-        }
+      for (int cz = int(z0); cz < int(z1); ++cz)
+        for (int cy = 0; cy < c.h; ++cy)
+          for (int cx = 0; cx < c.w; ++cx) {
+            const size_t i = (size_t(2 * cz + 2) * fsy + size_t(2 * cy + 2)) * fsx + size_t(2 * cx + 2);
+            auto row = [&](size_t j) { return 0.5 * res[j - 1] + res[j] + 0.5 * res[j + 1]; };
+            auto plane = [&](size_t j) { return 0.5 * row(j - fsx) + row(j) + 0.5 * row(j + fsx); };
+            c.r[(size_t(cz + 1) * c.sy + size_t(cy + 1)) * c.sx + size_t(cx + 1)] =
+                0.5 * plane(i - fslab) + plane(i) + 0.5 * plane(i + fslab);
+          }
     });
     vcycle(k + 1);
     // Prolongation (trilinear), masked to this level's active voxels, one fine row at a time:
@@ -286,30 +288,30 @@ void Laplace3::vcycle(size_t k) {
     std::vector<double>& e = fine ? z_ : levels_[k].e;
     const std::vector<double>& active = fine ? mask_ : levels_[k].invDiag;
     effects::forRange(parallel, size_t(fd), 1, [&](size_t z0, size_t z1) {
-    std::vector<double> line(c.sx);
-    for (int z = int(z0); z < int(z1); ++z) {
-      int pz[2];
-      double wz[2];
-      const int nz = coarseParents(z, c.d, pz, wz);
-      for (int y = 0; y < fh; ++y) {
-        int py[2];
-        double wy[2];
-        const int ny = coarseParents(y, c.h, py, wy);
-        std::fill(line.begin(), line.end(), 0.0);
-        for (int a2 = 0; a2 < nz; ++a2)
-          for (int a1 = 0; a1 < ny; ++a1) {
-            const double wgt = wz[a2] * wy[a1];
-            const double* src = &c.e[(size_t(pz[a2] + 1) * c.sy + size_t(py[a1] + 1)) * c.sx];
-            for (size_t j = 0; j < c.sx; ++j) line[j] += wgt * src[j];
+      std::vector<double> line(c.sx);
+      for (int z = int(z0); z < int(z1); ++z) {
+        int pz[2];
+        double wz[2];
+        const int nz = coarseParents(z, c.d, pz, wz);
+        for (int y = 0; y < fh; ++y) {
+          int py[2];
+          double wy[2];
+          const int ny = coarseParents(y, c.h, py, wy);
+          std::fill(line.begin(), line.end(), 0.0);
+          for (int a2 = 0; a2 < nz; ++a2)
+            for (int a1 = 0; a1 < ny; ++a1) {
+              const double wgt = wz[a2] * wy[a1];
+              const double* src = &c.e[(size_t(pz[a2] + 1) * c.sy + size_t(py[a1] + 1)) * c.sx];
+              for (size_t j = 0; j < c.sx; ++j) line[j] += wgt * src[j];
+            }
+          const size_t row = (size_t(z + 1) * fsy + size_t(y + 1)) * fsx + 1;
+          for (int x = 0; x < fw; ++x) {
+            const size_t i = row + size_t(x);
+            if (active[i] == 0.0) continue;
+            e[i] += (x & 1) ? line[size_t(x / 2 + 1)] : 0.5 * (line[size_t(x / 2)] + line[size_t(x / 2 + 1)]);
           }
-        const size_t row = (size_t(z + 1) * fsy + size_t(y + 1)) * fsx + 1;
-        for (int x = 0; x < fw; ++x) {
-          const size_t i = row + size_t(x);
-          if (active[i] == 0.0) continue;
-          e[i] += (x & 1) ? line[size_t(x / 2 + 1)] : 0.5 * (line[size_t(x / 2)] + line[size_t(x / 2 + 1)]);
         }
       }
-    }
     });
   }
   fine ? smoothFine(false, false) : smoothCoarse(levels_[k], false);
@@ -320,8 +322,8 @@ double Laplace3::residualFine(std::vector<double>& out) const {
   return blockSum(parallel_, slab, out.size() - slab, [&](size_t b, size_t end) {
     double sum = 0;
     for (size_t i = b; i < end; ++i) {
-      out[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - sx_] + phi_[i + sx_] + phi_[i - slab] +
-                           phi_[i + slab] - 6 * phi_[i]);
+      out[i] = mask_[i] * (phi_[i - 1] + phi_[i + 1] + phi_[i - sx_] + phi_[i + sx_] + phi_[i - slab] + phi_[i + slab] -
+                           6 * phi_[i]);
       sum += out[i] * out[i];
     }
     return sum;
@@ -343,7 +345,8 @@ int Laplace3::solve(Solver solver, double tolerance) {
       z_ = r_;
     }
   };
-  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, parallel_, precondition, [&] { return apply(p_, ap_); });
+  const int it = conjugateGradients(phi_, r_, z_, p_, ap_, goal, maxIt, rr, parallel_, precondition,
+                                    [&] { return apply(p_, ap_); });
   residual_ = std::sqrt(rr) / bnorm;
   return it;
 }

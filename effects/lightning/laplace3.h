@@ -30,7 +30,7 @@ class Laplace3 final : public Potential {
   size_t at(int x, int y, int z) const { return (size_t(z + 1) * sy_ + size_t(y + 1)) * sx_ + size_t(x + 1); }
   struct Level {
     int w = 0, h = 0, d = 0;
-    size_t sx = 0, sy = 0;                // padded row length and rows per slab
+    size_t sx = 0, sy = 0;                  // padded row length and rows per slab
     std::vector<std::array<double, 27>> a;  // a[i][(dx+1) + 3 (dy+1) + 9 (dz+1)]; all 0 when inactive
     // The stencil of each voxel: &interior where its row equals the row of a voxel far from
     // every fixed voxel and border (most of the grid: one row in cache instead of 27 doubles
@@ -58,7 +58,7 @@ class Laplace3 final : public Potential {
   size_t sx_, sy_;
   Parallel* parallel_;  // null below kParallelCells
   std::vector<double> phi_, bvec_, mask_, r_, z_, p_, ap_, res_;
-  double bb_ = 0;  // ||b||^2, kept up to date by fix()
+  double bb_ = 0;        // ||b||^2, kept up to date by fix()
   double residual_ = 0;  // ||r|| / ||b|| after the last solve
   std::vector<uint8_t> unknown_;
   std::vector<Level> levels_;  // levels_[0] unused: the fine level lives in the members
