@@ -1,16 +1,15 @@
-// dbm_hero: exact DBM hero bolts at large grids (docs/lightning-hero.md), in one run:
-//   1. a bolt per grid side (top centre to bottom centre, eta 2, 8 neighbours, MGPCG at the
-//      default tolerance 1e-6, seed 1): seconds, cells, steps, V-cycles, and a hash of the
-//      cells in growth order (the same hash means the same bolt, cell for cell);
-//   2. the same bolt on two threads (Params::parallel), whose hash must equal the first's; at
-//      sizes up to 256^2 also the capacitance direct solver's (no multigrid in it), the peer
-//      measured in the same run;
-//   3. exactness at sampled steps (1/4, 1/2, 3/4 of the bolt): the step solved as growth
-//      solves it (the bolt up to the step's cell solved to the tolerance, the cell fixed, a
-//      warm solve to the tolerance) against the same bolt solved from scratch to 1e-12: the
-//      candidates' largest error relative to their largest potential P, and the total
-//      variation distance between the two candidate distributions Phi^eta / sum.
-// Usage: dbm_hero [side ...]   (default 256 512 1024). Exit 1 when two solvers' bolts differ.
+// dbm_hero: exact DBM hero bolts at large grids (docs/lightning-hero.md), in one run per grid
+// side (top centre to bottom centre, eta 2, 8 neighbours, seed 1):
+//   1. the bolt by the direct solver (capacitance, the default) on one thread and on two
+//      (Params::parallel), and by MGPCG at the default tolerance 1e-6 on two threads, the
+//      solver these sizes had before: seconds, cells, steps (how many direct), and a hash of
+//      the cells in growth order. The same hash means the same bolt, cell for cell; the program
+//      exits 1 when one differs.
+//   2. exactness at sampled steps (1/4, 1/2, 3/4 of the bolt): the step solved by each solver
+//      as growth solves it against MGPCG from scratch to 1e-12: the candidates' largest error
+//      relative to their largest potential P, and the total variation distance between the
+//      two candidate distributions Phi^eta / sum.
+// Usage: dbm_hero [side ...]   (default 256 512 1024).
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -91,36 +90,60 @@ std::vector<lt::Cell> candidates(const lt::Bolt& b, size_t n, int side) {
   return out;
 }
 
-std::unique_ptr<ld::DeepField> problem(const lt::Bolt& b, size_t n, int side) {
-  auto f = std::make_unique<ld::DeepField>(ld::potentialFor(side, side, 0, lt::Solver::kMgpcg, n + 1, n + 1), side, side, 0);
+std::unique_ptr<ld::DeepField> problem(const lt::Bolt& b, size_t n, int side, lt::Solver solver) {
+  auto f = std::make_unique<ld::DeepField>(ld::potentialFor(side, side, 0, solver, n + 1, 0), side, side, 0);
   for (size_t i = 0; i < n; ++i) f->fix(b.nodes[i].cell, 0.0);
   f->fix({side / 2, side - 1}, 1.0);
   return f;
 }
 
-// Step n (its bolt: the first n cells) as growth solves it, against a converged solve.
-void sampledStep(const lt::Bolt& b, size_t n, int side) {
-  const std::vector<lt::Cell> probes = candidates(b, n, side);
-  std::vector<double> logPhi, refLogPhi;
-  auto warm = problem(b, n - 1, side);
-  warm->solve(lt::Solver::kMgpcg, kTolerance, candidates(b, n - 1, side), logPhi);
-  warm->fix(b.nodes[n - 1].cell, 0.0);
-  const auto t0 = std::chrono::steady_clock::now();
-  const int its = warm->solve(lt::Solver::kMgpcg, kTolerance, probes, logPhi);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  problem(b, n, side)->solve(lt::Solver::kMgpcg, 1e-12, probes, refLogPhi);
-  double P = 0, err = 0, sum = 0, refSum = 0;
-  for (size_t i = 0; i < probes.size(); ++i) P = std::max(P, std::exp(refLogPhi[i]));
-  for (size_t i = 0; i < probes.size(); ++i) {
-    err = std::max(err, std::fabs(std::exp(logPhi[i]) - std::exp(refLogPhi[i])) / P);
+// The candidates' largest error relative to their largest potential P, and the total variation
+// distance between the two distributions Phi^eta / sum.
+struct Against {
+  double P = 0, error = 0, tv = 0;
+};
+Against compare(const std::vector<double>& logPhi, const std::vector<double>& refLogPhi) {
+  Against a;
+  double sum = 0, refSum = 0;
+  for (size_t i = 0; i < refLogPhi.size(); ++i) a.P = std::max(a.P, std::exp(refLogPhi[i]));
+  for (size_t i = 0; i < refLogPhi.size(); ++i) {
+    a.error = std::max(a.error, std::fabs(std::exp(logPhi[i]) - std::exp(refLogPhi[i])) / a.P);
     sum += std::exp(kEta * logPhi[i]);
     refSum += std::exp(kEta * refLogPhi[i]);
   }
-  double tv = 0;
-  for (size_t i = 0; i < probes.size(); ++i)
-    tv += std::fabs(std::exp(kEta * logPhi[i]) / sum - std::exp(kEta * refLogPhi[i]) / refSum);
-  std::printf("  step %6zu: %5zu candidates, P %.3e, warm solve %3d V-cycles %7.1f ms, error/P %.2e, TV %.2e\n", n,
-              probes.size(), P, its, ms, err, 0.5 * tv);
+  for (size_t i = 0; i < refLogPhi.size(); ++i)
+    a.tv += 0.5 * std::fabs(std::exp(kEta * logPhi[i]) / sum - std::exp(kEta * refLogPhi[i]) / refSum);
+  return a;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Step n (its bolt: the first n cells) as growth solves it, by each solver, against MGPCG from
+// scratch to 1e-12 (the reference neither shares code with the direct solver nor stops where
+// growth's MGPCG stops).
+void sampledStep(const lt::Bolt& b, size_t n, int side) {
+  const std::vector<lt::Cell> probes = candidates(b, n, side);
+  std::vector<double> direct, warm, ref;
+  // The direct solver: the cells fixed one by one as growth fixes them, then one solve.
+  auto cap = problem(b, n, side, lt::Solver::kCapacitance);
+  auto t0 = std::chrono::steady_clock::now();
+  cap->solve(lt::Solver::kCapacitance, kTolerance, probes, direct);
+  const double capMs = msSince(t0);
+  // MGPCG: the bolt up to cell n - 1 solved to the tolerance, cell n fixed, a warm solve.
+  auto mg = problem(b, n - 1, side, lt::Solver::kMgpcg);
+  mg->solve(lt::Solver::kMgpcg, kTolerance, candidates(b, n - 1, side), warm);
+  mg->fix(b.nodes[n - 1].cell, 0.0);
+  t0 = std::chrono::steady_clock::now();
+  const int its = mg->solve(lt::Solver::kMgpcg, kTolerance, probes, warm);
+  const double mgMs = msSince(t0);
+  problem(b, n, side, lt::Solver::kMgpcg)->solve(lt::Solver::kMgpcg, 1e-12, probes, ref);
+  const Against d = compare(direct, ref), m = compare(warm, ref);
+  std::printf(
+      "  step %6zu: %5zu candidates, P %.3e | direct %s(from scratch) %6.1f ms, error/P %.2e, TV %.2e "
+      "| MGPCG %d V-cycles %6.1f ms, error/P %.2e, TV %.2e\n",
+      n, probes.size(), d.P, cap->direct() ? "" : "(HANDED OVER)", capMs, d.error, d.tv, its, mgMs, m.error, m.tv);
 }
 
 }  // namespace
@@ -131,36 +154,40 @@ int main(int argc, char** argv) {
   if (sides.empty()) sides = {256, 512, 1024};
   int status = 0;
   effects::ThreadPool pool(1);  // the caller and one worker: this machine's two cores
-  std::printf("exact DBM, top centre to bottom centre, eta %.0f, 8 neighbours, MGPCG at %.0e, seed 1\n", kEta, kTolerance);
+  std::printf(
+      "exact DBM, top centre to bottom centre, eta %.0f, 8 neighbours, seed 1; the direct (capacitance) "
+      "solver against MGPCG at %.0e\n",
+      kEta, kTolerance);
   for (int side : sides) {
-    const Run mg = grow(side, lt::Solver::kMgpcg);
-    const effects::Stats& s = mg.bolt.stats;
-    std::printf("%4d^2: %8.2f s  %6zu cells  %6.0f steps  %7.0f V-cycles (%.2f a step)  D %.3f  hash %016" PRIx64 "\n",
-                side, mg.seconds, mg.bolt.nodes.size(), s.counters.at("steps"), s.counters.at("solverIterations"),
-                s.counters.at("solverIterations") / s.counters.at("steps"),
-                lt::fractalDimension([&] {
-                  std::vector<lt::Cell> c;
-                  for (const lt::Node& n : mg.bolt.nodes) c.push_back(n.cell);
-                  return c;
-                }(), side, side),
-                hashOf(mg.bolt));
-    {
-      const Run two = grow(side, lt::Solver::kMgpcg, &pool);
-      const bool same = hashOf(two.bolt) == hashOf(mg.bolt);
-      std::printf("        on 2 threads:         %8.2f s, hash %016" PRIx64 " (%s), 1 thread / 2 threads %.2fx%s\n",
-                  two.seconds, hashOf(two.bolt), same ? "the same bolt" : "A DIFFERENT BOLT", mg.seconds / two.seconds,
-                  size_t(side) * size_t(side) < ld::kParallelCells ? " (one thread below 512^2)" : "");
-      if (!same) status = 1;
+    const Run one = grow(side, lt::Solver::kCapacitance);
+    const Run two = grow(side, lt::Solver::kCapacitance, &pool);
+    const Run mg = grow(side, lt::Solver::kMgpcg, &pool);
+    const effects::Stats& s = two.bolt.stats;
+    const double steps = s.counters.at("steps");
+    std::printf("%4d^2: %6zu cells  %6.0f steps (%.0f direct)  D %.3f  hash %016" PRIx64 "\n", side,
+                two.bolt.nodes.size(), steps, s.counters.at("directSteps"),
+                lt::fractalDimension(
+                    [&] {
+                      std::vector<lt::Cell> c;
+                      for (const lt::Node& n : two.bolt.nodes) c.push_back(n.cell);
+                      return c;
+                    }(),
+                    side, side),
+                hashOf(two.bolt));
+    std::printf("        direct, 1 thread:  %8.2f s\n", one.seconds);
+    std::printf("        direct, 2 threads: %8.2f s  (1 thread / 2 threads %.2fx)\n", two.seconds,
+                one.seconds / two.seconds);
+    std::printf("        MGPCG, 2 threads:  %8.2f s  (%.2f V-cycles a step; MGPCG / direct on 2 threads %.1fx)\n",
+                mg.seconds, mg.bolt.stats.counters.at("solverIterations") / mg.bolt.stats.counters.at("steps"),
+                mg.seconds / two.seconds);
+    for (const Run* r : {&one, &mg}) {
+      if (hashOf(r->bolt) == hashOf(two.bolt)) continue;
+      std::printf("        A DIFFERENT BOLT: %s, hash %016" PRIx64 "\n", r == &one ? "direct on 1 thread" : "MGPCG",
+                  hashOf(r->bolt));
+      status = 1;
     }
-    if (side <= 256) {
-      const Run cap = grow(side, lt::Solver::kCapacitance);
-      const bool same = hashOf(cap.bolt) == hashOf(mg.bolt);
-      std::printf("        capacitance (direct): %8.2f s, hash %016" PRIx64 " (%s), MGPCG / direct %.2fx\n", cap.seconds,
-                  hashOf(cap.bolt), same ? "the same bolt" : "A DIFFERENT BOLT", mg.seconds / cap.seconds);
-      if (!same) status = 1;
-    }
-    const size_t n = mg.bolt.nodes.size();
-    for (size_t q = 1; q <= 3; ++q) sampledStep(mg.bolt, std::max<size_t>(2, n * q / 4), side);
+    const size_t n = two.bolt.nodes.size();
+    for (size_t q = 1; q <= 3; ++q) sampledStep(two.bolt, std::max<size_t>(2, n * q / 4), side);
     std::fflush(stdout);
   }
   return status;

@@ -15,6 +15,7 @@
 
 #include <effects/lightning.h>
 
+#include "lightning/capacitance.h"
 #include "lightning/hooks.h"
 #include "lightning/laplace.h"
 #include "lightning/laplace3.h"
@@ -568,6 +569,53 @@ TEST(Lightning, SolversGiveTheSameNumbersOnAnyThreads) {
   differ = 0;
   for (size_t i = 0; i < one3.size(); ++i) differ += std::memcmp(&one3[i], &three3[i], sizeof(double)) != 0;
   EXPECT_EQ(differ, 0u) << "of " << one3.size() << " voxels";
+}
+
+TEST(Lightning, DirectSolverGivesTheSameNumbersOnAnyThreads) {
+  // The capacitance solver past 4 kSolveBlock fixed cells, where its triangular solves and the
+  // candidates' products split over threads: the same potentials bit for bit on one thread and
+  // on three, and MGPCG's from scratch to 1e-12 (an independent solver) to 1e-7 of the largest.
+  ThreadPool pool(2);
+  const int side = 512;
+  std::vector<Cell> bolt;  // a bent line and side branches: about 1500 cells
+  for (int y = 0; y < 400; ++y) bolt.push_back({side / 2 + y / 5, y});
+  for (int b = 0; b < 8; ++b)
+    for (int i = 1; i < 140; ++i) bolt.push_back({side / 2 + (40 * b) / 5 + (b % 2 ? i : -i), 40 * b + i / 2});
+  auto byRow = [](Cell a, Cell b) { return a.y != b.y ? a.y < b.y : a.x < b.x; };
+  std::sort(bolt.begin(), bolt.end(), byRow);
+  bolt.erase(std::unique(bolt.begin(), bolt.end()), bolt.end());
+  const Cell target{side / 2, side - 1};
+  ASSERT_GT(bolt.size(), 4 * detail::Capacitance::kSolveBlock);
+  ASSERT_LE(bolt.size() + 1, detail::Capacitance::maxFixed(side, side));
+  std::vector<Cell> probes;  // every free cell of a band across the bolt
+  for (int y = 100; y < 120; ++y)
+    for (int x = 0; x < side; ++x)
+      if (!std::binary_search(bolt.begin(), bolt.end(), Cell{x, y}, byRow)) probes.push_back({x, y});
+  auto solveOn = [&](Parallel* parallel) {
+    detail::Capacitance cap(side, side, 0, parallel);
+    cap.fix(target, 1.0);
+    for (const Cell& c : bolt) cap.fix(c, 0.0);
+    cap.solve(Solver::kCapacitance, 1e-6);
+    EXPECT_TRUE(cap.direct());
+    std::vector<double> phi;
+    cap.phiAt(probes, phi);
+    return phi;
+  };
+  const std::vector<double> one = solveOn(nullptr), three = solveOn(&pool);
+  size_t differ = 0;
+  for (size_t i = 0; i < one.size(); ++i) differ += std::memcmp(&one[i], &three[i], sizeof(double)) != 0;
+  EXPECT_EQ(differ, 0u) << "of " << one.size() << " cells";
+  detail::Laplace lap(side, side);
+  lap.fix(target, 1.0);
+  for (const Cell& c : bolt) lap.fix(c, 0.0);
+  lap.solve(Solver::kMgpcg, 1e-12);
+  double largest = 0, error = 0;
+  for (size_t i = 0; i < probes.size(); ++i) {
+    largest = std::max(largest, lap.phi(probes[i]));
+    error = std::max(error, std::fabs(one[i] - lap.phi(probes[i])));
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LT(error, 1e-7 * largest);  // 1e-12 of the target's residual resolves ~1e-8 of these
 }
 
 TEST(Lightning, DbmBoltDoesNotDependOnThreads) {

@@ -34,11 +34,11 @@ double halfSquared(int k, int n) {
   return 2 * half * half;
 }
 // h(d), d = 0 .. 2m, of the closed-form axis (m cells, M = m + 1) for cosh mu = 1 + delta.
-void closedForm(double delta, int m, std::vector<double>& h) {
+void closedForm(double delta, int m, double* h) {
   const int M = m + 1;
   const double mu = std::log1p(delta + std::sqrt(delta * (delta + 2)));
   const double scale = 1.0 / (2 * std::sinh(mu) * -std::expm1(-2 * mu * M));
-  for (int d = 0; d <= 2 * m; ++d) h[size_t(d)] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
+  for (int d = 0; d <= 2 * m; ++d) h[d] = (std::exp(-mu * d) + std::exp(-mu * (2 * M - d))) * scale;
 }
 // Mode k of a series over n cells: row r of `out` (r = 0 .. 2n, `stride` entries each) gains
 // cos(theta_k r) / divisor times `in`.
@@ -52,18 +52,34 @@ void addMode(const std::vector<double>& cosine, int k, int n, double divisor, co
 }
 }  // namespace
 
-BoxGreen::BoxGreen(int width, int height, int depth) : volume_(depth > 0) {
+BoxGreen::BoxGreen(int width, int height, int depth, Parallel* parallel) : volume_(depth > 0) {
   if (!volume_) {
     order_[0] = height < width ? 1 : 0, order_[1] = -1, order_[2] = height < width ? 0 : 1;
     const int n = std::min(width, height), m = std::max(width, height);
     stride2_ = 1, stride_ = size_t(2 * m + 1);
     const std::vector<double> cosine = cosines(n);
-    std::vector<double> h(stride_);
-    k_.assign(size_t(2 * n + 1) * stride_, 0.0);
-    for (int k = 1; k <= n; ++k) {  // cosh mu = 2 - cos theta_k
-      closedForm(halfSquared(k, n), m, h);
-      addMode(cosine, k, n, n + 1, h.data(), stride_, k_.data());
-    }
+    // Every mode's closed form (cosh mu = 2 - cos theta_k), then K by blocks of rows that stay
+    // in cache while the modes add to them in order: the same sums as mode by mode over the
+    // whole table, which streamed all of it from memory once a mode. The blocks split over the
+    // threads (a 1024^2 table: 1.8 s before, 1.35 s on one thread, 0.8 s on two).
+    std::vector<double> h(size_t(n) * stride_);
+    forRange(parallel, size_t(n), 16, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) closedForm(halfSquared(int(k) + 1, n), m, &h[k * stride_]);
+    });
+    const size_t rows = size_t(2 * n + 1), period = size_t(2 * (n + 1));
+    constexpr size_t kRowsPerBlock = 16;
+    k_.assign(rows * stride_, 0.0);
+    forRange(parallel, (rows + kRowsPerBlock - 1) / kRowsPerBlock, 1, [&](size_t b, size_t e) {
+      for (size_t r0 = b * kRowsPerBlock; r0 < std::min(rows, e * kRowsPerBlock); r0 += kRowsPerBlock)
+        for (size_t k = 1; k <= size_t(n); ++k) {
+          const double* in = &h[(k - 1) * stride_];
+          for (size_t r = r0; r < std::min(rows, r0 + kRowsPerBlock); ++r) {
+            const double c = cosine[(k * r) % period] / (n + 1);
+            double* row = &k_[r * stride_];
+            for (size_t i = 0; i < stride_; ++i) row[i] += c * in[i];
+          }
+        }
+    });
     return;
   }
   // 3-D: the series over the two shorter axes (n1, n2 cells), the closed form along the
@@ -83,7 +99,7 @@ BoxGreen::BoxGreen(int width, int height, int depth) : volume_(depth > 0) {
   for (int k = 1; k <= n1; ++k) {
     std::fill(b.begin(), b.end(), 0.0);
     for (int l = 1; l <= n2; ++l) {
-      closedForm(halfSquared(k, n1) + halfSquared(l, n2), m, h);
+      closedForm(halfSquared(k, n1) + halfSquared(l, n2), m, h.data());
       addMode(cos2, l, n2, 1.0, h.data(), stride_, b.data());
     }
     addMode(cos1, k, n1, double(n1 + 1) * double(n2 + 1), b.data(), plane, k_.data());
@@ -114,10 +130,11 @@ double BoxGreen::operator()(Cell a, Cell b) const {
   return axes(dt) - axes(st);
 }
 
-std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth) {
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth, Parallel* parallel) {
   // Keyed as a map of depth -1 - depth with no obstacles: a table depends on the grid size only.
   return std::static_pointer_cast<const BoxGreen>(cachedMap(
-      width, height, -1 - depth, {}, nullptr, [&] { return std::make_shared<const BoxGreen>(width, height, depth); },
+      width, height, -1 - depth, {}, nullptr,
+      [&] { return std::make_shared<const BoxGreen>(width, height, depth, parallel); },
       [](const void* t) { return static_cast<const BoxGreen*>(t)->bytes(); }));
 }
 
@@ -144,7 +161,14 @@ size_t rowStart(size_t i) { return i * (i + 1) / 2; }
 
 size_t Capacitance::maxFixed(int width, int height, int depth) {
   if (depth > 0) return 1024;
-  return std::clamp<size_t>(size_t(4.5 * std::sqrt(double(width) * double(height))), 64, 1024);
+  const double cells = double(width) * double(height);
+  // Up to 256^2 (the service's synchronous limit) MGPCG's grid stays in cache, and the two
+  // measured even at about 4.5 sqrt(cells) (64^2-256^2), at most 1024. Past it both stream from
+  // memory, a step of this one the rows and L (O(m^2)), MGPCG's the grid's levels several times
+  // over: at 512^2 and 1024^2 a direct step at 6 sqrt(cells) fixed cells costs about what an
+  // MGPCG step does (docs/lightning-hero.md). At most 8192 (maxBytes: 3 GiB).
+  if (cells <= 65536.0) return std::clamp<size_t>(size_t(4.5 * std::sqrt(cells)), 64, 1024);
+  return std::min<size_t>(size_t(6 * std::sqrt(cells)), 8192);
 }
 
 size_t Capacitance::maxBytes(int width, int height, int depth) {
@@ -157,17 +181,18 @@ bool Capacitance::fits(int width, int height, int depth) {
   return depth <= 0 || BoxGreen::tableEntries(width, height, depth) * sizeof(double) <= (size_t(32) << 20);
 }
 
-Capacitance::Capacitance(int width, int height, int depth)
+Capacitance::Capacitance(int width, int height, int depth, Parallel* parallel)
     : w_(width),
       h_(height),
       d_(depth),
+      parallel_(parallel),
       maxFixed_(maxFixed(width, height, depth)),
       maxBytes_(maxBytes(width, height, depth)),
-      green_(cachedBoxGreen(width, height, depth)),
+      green_(cachedBoxGreen(width, height, depth, parallel)),
       fixedIndex_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))),
       rowOf_(size_t(width) * size_t(height) * size_t(std::max(depth, 1))) {}
 
-Capacitance::Row& Capacitance::row(Cell c) const {
+Capacitance::Row& Capacitance::reserve(Cell c) const {
   const size_t i = at(c);
   int slot = rowOf_.get(i);
   if (slot < 0) {
@@ -176,14 +201,16 @@ Capacitance::Row& Capacitance::row(Cell c) const {
     rows_.emplace_back();
   }
   Row& r = rows_[size_t(slot)];
-  for (; r.size < fixed_.size(); ++r.size) {
-    if (r.size % kBlock == 0) {
-      if (blocks_ % kBlocksPerPage == 0) pages_.emplace_back(new double[kBlocksPerPage * kBlock]);
-      r.blocks.push_back(blocks_++);
-    }
-    block(r.blocks.back())[r.size % kBlock] = (*green_)(c, fixed_[r.size]);
+  while (r.blocks.size() * kBlock < fixed_.size()) {
+    if (blocks_ % kBlocksPerPage == 0) pages_.emplace_back(new double[kBlocksPerPage * kBlock]);
+    r.blocks.push_back(blocks_++);
   }
   return r;
+}
+
+void Capacitance::fill(Row& r, Cell c) const {
+  for (; r.size < fixed_.size(); ++r.size)
+    block(r.blocks[r.size / kBlock])[r.size % kBlock] = (*green_)(c, fixed_[r.size]);
 }
 
 double Capacitance::dotQ(const Row& r, size_t n) const {
@@ -192,11 +219,46 @@ double Capacitance::dotQ(const Row& r, size_t n) const {
   return s;
 }
 
+void Capacitance::forward(double* x, size_t n) const {
+  double partial[kSolveBlock];
+  for (size_t b0 = 0; b0 < n; b0 += kSolveBlock) {
+    const size_t b1 = std::min(n, b0 + kSolveBlock);
+    // Threads only where a block's products are worth handing out (tens of microseconds).
+    forRange(b0 >= 4 * kSolveBlock ? parallel_ : nullptr, b1 - b0, 16, [&](size_t s, size_t e) {
+      for (size_t i = s; i < e; ++i) partial[i] = dot(&lower_[rowStart(b0 + i)], x, b0);
+    });
+    for (size_t i = b0; i < b1; ++i) {
+      const double* row = &lower_[rowStart(i)];
+      x[i] = (x[i] - partial[i - b0] - dot(row + b0, x + b0, i - b0)) / row[i];
+    }
+  }
+}
+
+void Capacitance::backward(double* x, size_t n) const {
+  // By rows p of L from the last: x_p, then x_i -= L_pi x_p for i < p.
+  for (size_t b1 = n; b1 > 0;) {
+    const size_t b0 = b1 > kSolveBlock ? b1 - kSolveBlock : 0;
+    for (size_t p = b1; p-- > b0;) {
+      const double* l = &lower_[rowStart(p)];
+      const double xp = x[p] /= l[p];
+      for (size_t i = b0; i < p; ++i) x[i] -= l[i] * xp;
+    }
+    forRange(b0 >= 4 * kSolveBlock ? parallel_ : nullptr, b0, 512, [&](size_t s, size_t e) {
+      for (size_t p = b1; p-- > b0;) {
+        const double* l = &lower_[rowStart(p)];
+        const double xp = x[p];
+        for (size_t i = s; i < e; ++i) x[i] -= l[i] * xp;
+      }
+    });
+    b1 = b0;
+  }
+}
+
 void Capacitance::handOver() {
   if (d_ > 0)
-    fallback_ = std::make_unique<Laplace3>(w_, h_, d_);
+    fallback_ = std::make_unique<Laplace3>(w_, h_, d_, parallel_);
   else
-    fallback_ = std::make_unique<Laplace>(w_, h_);
+    fallback_ = std::make_unique<Laplace>(w_, h_, parallel_);
   for (size_t j = 0; j < fixed_.size(); ++j) fallback_->fix(fixed_[j], value_[j]);
   // What only the direct solve needed goes.
   for (auto* v : {&lower_, &y_, &q_}) std::vector<double>().swap(*v);
@@ -210,8 +272,8 @@ void Capacitance::fix(Cell c, double value) {
   const size_t cell = at(c);
   if (const int j = fixedIndex_.get(cell); j >= 0) {  // a new value: y again from v
     value_[size_t(j)] = value;
-    for (size_t i = 0; i < fixed_.size(); ++i)
-      y_[i] = (value_[i] - dot(&lower_[rowStart(i)], y_.data(), i)) / lower_[rowStart(i) + i];
+    y_ = value_;
+    forward(y_.data(), y_.size());
     return;
   }
   if (fixed_.size() >= maxFixed_ || (size_t(blocks_) * kBlock + lower_.capacity()) * sizeof(double) > maxBytes_) {
@@ -225,8 +287,8 @@ void Capacitance::fix(Cell c, double value) {
   if (lower_.empty()) lower_.reserve(rowStart(maxFixed_ + 1));  // no copies as it grows
   lower_.resize(rowStart(m + 1));
   double* l = &lower_[rowStart(m)];
-  for (size_t i = 0; i < m; ++i)
-    l[i] = (entry(g, i) - dot(&lower_[rowStart(i)], l, i)) / lower_[rowStart(i) + i];
+  for (size_t i = 0; i < m; ++i) l[i] = entry(g, i);
+  forward(l, m);
   const double d = (*green_)(c, c) - dot(l, l, m);
   // C is positive definite (G is the inverse of a positive definite operator); d is G of c
   // with the other fixed cells grounded, positive for any cell not yet fixed.
@@ -244,14 +306,8 @@ void Capacitance::fix(Cell c, double value) {
 
 int Capacitance::solve(Solver solver, double tolerance) {
   if (fallback_) return fallback_->solve(solver, tolerance);
-  // L^T q = y by columns of L^T, i.e. rows of L: q_p, then y_i -= L_pi q_p for i < p.
-  const size_t m = fixed_.size();
   q_ = y_;
-  for (size_t p = m; p-- > 0;) {
-    const double* l = &lower_[rowStart(p)];
-    const double qp = q_[p] /= l[p];
-    for (size_t i = 0; i < p; ++i) q_[i] -= l[i] * qp;
-  }
+  backward(q_.data(), q_.size());
   return 0;
 }
 
@@ -259,6 +315,31 @@ double Capacitance::phi(Cell c) const {
   if (fallback_) return fallback_->phi(c);
   if (const int j = fixedIndex_.get(at(c)); j >= 0) return value_[size_t(j)];
   return dotQ(row(c), q_.size());
+}
+
+void Capacitance::phiAt(const std::vector<Cell>& cells, std::vector<double>& out) {
+  if (fallback_) return fallback_->phiAt(cells, out);
+  out.resize(cells.size());
+  // The rows and their blocks first, on this thread (rows_ and the pool grow), as slots: the
+  // entries and the dot products then split over the threads, a row to a thread.
+  std::vector<int> slot(cells.size(), -1);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const size_t cell = at(cells[i]);
+    if (const int j = fixedIndex_.get(cell); j >= 0) {
+      out[i] = value_[size_t(j)];
+    } else {
+      reserve(cells[i]);
+      slot[i] = rowOf_.get(cell);
+    }
+  }
+  forRange(parallel_, cells.size(), 64, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (slot[i] < 0) continue;
+      Row& r = rows_[size_t(slot[i])];
+      fill(r, cells[i]);
+      out[i] = dotQ(r, q_.size());
+    }
+  });
 }
 
 // ||C q - v|| / ||v|| over the fixed cells: the grid equations elsewhere hold by

@@ -25,7 +25,8 @@ namespace effects::lightning::detail {
 // (2 n1 + 1) (x (2 n2 + 1)) x (2 m + 1) entries, so that G is four lookups (eight in 3-D).
 class BoxGreen {
  public:
-  BoxGreen(int width, int height, int depth = 0);  // depth 0: a 2-D grid
+  // depth 0: a 2-D grid. parallel: where a 2-D table's rows split as it is built.
+  BoxGreen(int width, int height, int depth = 0, Parallel* parallel = nullptr);
   double operator()(Cell a, Cell b) const;
   size_t bytes() const { return k_.size() * sizeof(double); }
   static size_t tableEntries(int width, int height, int depth = 0);
@@ -42,14 +43,15 @@ class BoxGreen {
 };
 
 // The table of a grid size, kept beside the boundary maps (map_cache.h).
-std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth = 0);
+std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth = 0, Parallel* parallel = nullptr);
 
 class Capacitance final : public Potential {
  public:
   // A step costs O(m^2) here (phi at ~3 m candidates, each a dot product over the m fixed
   // cells) and O(cells) in MGPCG: past maxFixed() fixed cells the problem goes to Laplace
-  // (MGPCG at the request's tolerance). About 4.5 sqrt(cells), where the two measured even
-  // (bolts at 64^2-256^2 handed over at several limits), and at most 1024.
+  // (MGPCG at the request's tolerance). Up to 256^2 about 4.5 sqrt(cells), where the two
+  // measured even (bolts at 64^2-256^2 handed over at several limits), at most 1024; past it
+  // 6 sqrt(cells), at most 8192 (about even at 512^2 and 1024^2: docs/lightning-hero.md).
   // In 3-D: at most 1024, where a step still costs a few milliseconds against MGPCG's tens.
   static size_t maxFixed(int width, int height, int depth = 0);
   // Working memory at most: the Cholesky factor (maxFixed^2 / 2 entries) and the rows (about
@@ -61,10 +63,14 @@ class Capacitance final : public Potential {
   // limit; 3-D up to about 80^3, 32 MB).
   static bool fits(int width, int height, int depth);
 
-  Capacitance(int width, int height, int depth = 0);
+  // parallel: where phiAt's cells split (and the solver it hands over to); null: this thread.
+  Capacitance(int width, int height, int depth = 0, Parallel* parallel = nullptr);
+  // Rows of the triangular solves' blocks (forward, backward); from 4 blocks they use threads.
+  static constexpr size_t kSolveBlock = 256;
   void fix(Cell c, double value) override;
   int solve(Solver solver, double tolerance) override;
   double phi(Cell c) const override;
+  void phiAt(const std::vector<Cell>& cells, std::vector<double>& out) override;
   double residual() const override;
   bool direct() const override { return !fallback_; }
 
@@ -77,16 +83,32 @@ class Capacitance final : public Potential {
     std::vector<uint32_t> blocks;  // pool blocks holding entries kBlock b .. kBlock (b + 1) - 1
     size_t size = 0;
   };
-  Row& row(Cell c) const;
+  // A cell's row, made if new, with pool blocks for an entry per fixed cell (serial: the pool
+  // grows); fill() computes the entries it lacks (a row at a time, so rows fill in parallel).
+  Row& reserve(Cell c) const;
+  void fill(Row& r, Cell c) const;
+  Row& row(Cell c) const {
+    Row& r = reserve(c);
+    fill(r, c);
+    return r;
+  }
   double* block(uint32_t b) const { return pages_[b / kBlocksPerPage].get() + (b % kBlocksPerPage) * kBlock; }
   double entry(const Row& r, size_t j) const { return block(r.blocks[j / kBlock])[j % kBlock]; }
   size_t at(Cell c) const { return (size_t(c.z) * size_t(h_) + size_t(c.y)) * size_t(w_) + size_t(c.x); }
   // Row . q over the first n fixed cells.
   double dotQ(const Row& r, size_t n) const;
   void handOver();
+  // L x = b and L^T x = b over the first n fixed cells, in place (x holds b), in blocks of
+  // kSolveBlock rows whose products with the entries outside the block split over the threads.
+  // No value depends on the threads: forward's dot products split at the block's first row
+  // whatever runs them, and backward takes each entry's terms in the order a whole-matrix
+  // sweep does.
+  void forward(double* x, size_t n) const;
+  void backward(double* x, size_t n) const;
   static constexpr size_t kBlocksPerPage = 64;
 
   int w_, h_, d_;  // d_ 0: 2-D
+  Parallel* parallel_;
   size_t maxFixed_, maxBytes_;
   std::shared_ptr<const BoxGreen> green_;
   std::vector<Cell> fixed_;

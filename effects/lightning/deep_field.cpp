@@ -92,14 +92,12 @@ Potential& DeepField::current() {
 double DeepField::largest(const std::vector<Cell>& probes, bool& inRegion) {
   double top = 0;
   inRegion = false;
-  const Potential& cur = current();
-  phi_.resize(probes.size());
+  current().phiAt(probes, phi_);
   for (size_t i = 0; i < probes.size(); ++i) {
     if (k_ > 0) {
       const uint16_t s = cutStage_[index(probes[i])];
       if (s != 0 && s <= k_) inRegion = true;
     }
-    phi_[i] = cur.phi(probes[i]);
     top = std::max(top, phi_[i]);
   }
   return top;

@@ -125,6 +125,12 @@ class Potential {
   // Solves to ||r|| <= tolerance * ||b|| from the current potential; returns iterations.
   virtual int solve(Solver solver, double tolerance) = 0;
   virtual double phi(Cell c) const = 0;
+  // Phi at many cells (a step's candidates): out[i] = phi(cells[i]). The direct solver computes
+  // them on its threads; a cell's value does not depend on how they are split.
+  virtual void phiAt(const std::vector<Cell>& cells, std::vector<double>& out) {
+    out.resize(cells.size());
+    for (size_t i = 0; i < cells.size(); ++i) out[i] = phi(cells[i]);
+  }
   // The relative residual the last solve reached.
   virtual double residual() const = 0;
   // Whether the last solve was direct (capacitance.h) rather than iterative.

@@ -13,7 +13,7 @@ std::unique_ptr<Potential> potentialFor(int width, int height, int depth, Solver
                                         size_t cellsToCome, Parallel* parallel) {
   if (solver == Solver::kCapacitance && Capacitance::fits(width, height, depth) &&
       fixedCells + cellsToCome <= Capacitance::maxFixed(width, height, depth))
-    return std::make_unique<Capacitance>(width, height, depth);
+    return std::make_unique<Capacitance>(width, height, depth, parallel);
   if (depth > 0) return std::make_unique<Laplace3>(width, height, depth, parallel);
   return std::make_unique<Laplace>(width, height, parallel);
 }
