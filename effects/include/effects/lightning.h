@@ -22,8 +22,8 @@
 //   kDbm     converged Laplace solve every step (bolt, obstacles and border Phi = 0, target
 //            Phi = 1). Solver kCapacitance (the default): the exact solution by the
 //            capacitance-matrix method, one Cholesky row per step, while the fixed cells are
-//            few (2-D: about 4.5 sqrt(cells), at most 1024; 3-D: 1024, on grids up to about
-//            80^3); past that, MGPCG.
+//            few (2-D: about 4.5 sqrt(cells) up to 256^2, at most 1024, and 6 sqrt(cells)
+//            past it, at most 8192; 3-D: 1024, on grids up to about 80^3); past that, MGPCG.
 //            kMgpcg: multigrid-preconditioned CG warm-started to `tolerance`; kCg: plain CG
 //            (the baseline of Kim & Lin 2004 and of seed 002's comparison).
 //   kCharges Kim et al. 2007: incremental point-charge potential, no linear solve.
