@@ -16,6 +16,7 @@
 #include <effects/lightning.h>
 
 #include "lightning/capacitance.h"
+#include "lightning/draw.h"
 #include "lightning/hooks.h"
 #include "lightning/laplace.h"
 #include "lightning/laplace3.h"
@@ -864,6 +865,122 @@ TEST(Fast, OvershootTurnsBackInATallGrid) {
     ASSERT_TRUE(r.ok()) << "seed " << seed << ": " << r.error().message;
     for (const Node& n : r.value().nodes) EXPECT_LT(n.cell.y, 400) << "seed " << seed;
   }
+}
+
+}  // namespace
+}  // namespace effects::lightning
+
+namespace effects::lightning {
+namespace {
+
+// The bounded draw (docs/effects.md section 1.3): decidedDraw's pick, where it makes one, is
+// the one sampleAt makes from the exact weights, and it never picks a slot it does not know.
+TEST(Lightning, BoundedDrawPicksWhatTheExactDrawPicks) {
+  using effects::lightning::detail::decidedDraw;
+  using effects::lightning::detail::kUndecided;
+  using effects::lightning::detail::sampleAt;
+  effects::Rng rng(7);
+  int decided = 0, trials = 0;
+  for (int t = 0; t < 4000; ++t) {
+    const size_t n = 1 + size_t(rng.uniform() * 60);
+    std::vector<double> logPhi(n), w(n), lo(n), hi(n), scratch;
+    for (size_t i = 0; i < n; ++i) logPhi[i] = -8 * rng.uniform();
+    const double eta = 0.5 + 2 * rng.uniform();
+    effects::lightning::detail::candidateWeights(logPhi, eta, w);
+    for (size_t i = 0; i < n; ++i) {
+      const bool open = rng.uniform() < 0.5;
+      // An open slot: the weight is somewhere in [0, hi], hi at most 2e-2 above it.
+      lo[i] = open ? 0 : w[i];
+      hi[i] = open ? w[i] + 2e-2 * rng.uniform() : w[i];
+    }
+    const double u = rng.uniform();
+    const size_t pick = decidedDraw(lo, hi, u);
+    ++trials;
+    if (pick == kUndecided) continue;
+    ++decided;
+    EXPECT_EQ(pick, sampleAt(logPhi, eta, u, scratch)) << "trial " << t;
+    EXPECT_EQ(lo[pick], hi[pick]) << "trial " << t;
+  }
+  EXPECT_GT(decided, trials / 8);  // the bounds do decide, often
+  // Exact weights decide every draw but one on a boundary.
+  std::vector<double> one{1.0, 2.0, 1.0};
+  EXPECT_EQ(decidedDraw(one, one, 0.5), 1u);
+  EXPECT_EQ(decidedDraw(one, one, 0.25), kUndecided);  // u W = 1 = S_1: within the margin
+}
+
+// DBM's direct steps draw from bounds on Phi, computing it where the bounds leave the pick open:
+// the bolt is the one that computing Phi at every candidate grows, cell for cell, on open grids,
+// obstacles, a deep channel (where the field falls below the direct solver's reach and MGPCG
+// takes over), past the direct solver's limit of fixed cells (64^2 at eta 0.5), chained
+// targets (the second growing back beside the first), a target region, at several eta.
+TEST(Lightning, BoundedDrawGrowsTheSameBolt) {
+  struct Case {
+    const char* name;
+    Params p;
+  };
+  std::vector<Case> cases;
+  auto base = [](int w, int h, double eta, int nbhd, uint64_t seed) {
+    Params p;
+    p.width = w, p.height = h;
+    p.start = {w / 2, 0};
+    p.targets = {{w / 2, h - 1}};
+    p.method = Method::kDbm;
+    p.eta = eta;
+    p.neighbourhood = nbhd;
+    p.seed = seed;
+    return p;
+  };
+  for (uint64_t seed : {1, 2, 3})
+    for (double eta : {0.5, 1.0, 2.0, 4.0}) cases.push_back({"open 64^2", base(64, 64, eta, 8, seed)});
+  cases.push_back({"open 128^2, 4 neighbours", base(128, 128, 2.0, 4, 5)});
+  {
+    Params p = base(96, 48, 2.0, 8, 9);
+    p.obstacles.assign(96 * 48, 0);
+    for (int x = 10; x < 80; ++x) p.obstacles[size_t(24) * 96 + size_t(x)] = 1;  // a wall to go round
+    cases.push_back({"wall", p});
+  }
+  {
+    Params p = base(9, 200, 2.0, 4, 4);  // a channel 3 wide: the field falls below 1e-8
+    p.obstacles.assign(9 * 200, 0);
+    for (int y = 20; y < 200; ++y)
+      for (int x = 0; x < 9; ++x)
+        if (x < 3 || x > 5) p.obstacles[size_t(y) * 9 + size_t(x)] = 1;
+    p.targets = {{4, 199}};
+    p.start = {4, 0};
+    cases.push_back({"deep channel", p});
+  }
+  {
+    Params p = base(64, 64, 2.0, 8, 6);  // chain lightning: each segment its own field, the
+    p.targets = {{32, 60}, {34, 30}};     // second growing back beside the first
+    cases.push_back({"two targets", p});
+  }
+  {
+    Params p = base(64, 64, 1.0, 8, 8);  // the whole bottom row at 1
+    p.targets.clear();
+    p.targetRegion.assign(64 * 64, 0);
+    for (int x = 0; x < 64; ++x) p.targetRegion[size_t(63) * 64 + size_t(x)] = 1;
+    cases.push_back({"target region", p});
+  }
+  for (const Case& c : cases) {
+    effects::lightning::setBoundedDraw(false);
+    auto every = grow(c.p);
+    effects::lightning::setBoundedDraw(true);
+    auto bounded = grow(c.p);
+    ASSERT_TRUE(every.ok() && bounded.ok()) << c.name;
+    const auto &a = every.value().nodes, &b = bounded.value().nodes;
+    ASSERT_EQ(a.size(), b.size()) << c.name << " eta " << c.p.eta << " seed " << c.p.seed;
+    size_t differ = 0;
+    for (size_t i = 0; i < a.size(); ++i) differ += !(a[i].cell == b[i].cell);
+    EXPECT_EQ(differ, 0u) << c.name << " eta " << c.p.eta << " seed " << c.p.seed;
+    EXPECT_EQ(every.value().stats.method, bounded.value().stats.method) << c.name;
+    EXPECT_EQ(every.value().stats.counters.at("directSteps"), bounded.value().stats.counters.at("directSteps"))
+        << c.name;
+  }
+  // And it saves: a 128^2 bolt at eta 2 computes Phi at under half of the candidates offered.
+  auto r = grow(base(128, 128, 2.0, 8, 1));
+  ASSERT_TRUE(r.ok());
+  const auto& counters = r.value().stats.counters;
+  EXPECT_LT(counters.at("candidatesWeighed"), 0.5 * counters.at("candidatesOffered"));
 }
 
 }  // namespace

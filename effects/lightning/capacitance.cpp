@@ -159,8 +159,21 @@ __attribute__((target_clones("avx2", "default"))) double dot(const double* a, co
 size_t rowStart(size_t i) { return i * (i + 1) / 2; }
 }  // namespace
 
+namespace {
+constexpr double kSynchronousVolume = 64.0 * 64.0 * 64.0;  // the service's synchronous 3-D solver limit
+}
+
 size_t Capacitance::maxFixed(int width, int height, int depth) {
-  if (depth > 0) return 1024;
+  if (depth > 0) {
+    // Up to 64^3, 1024, where a step cost a few milliseconds against MGPCG's tens. Past it (jobs)
+    // a fixed cell has about ten candidates, nearly all of which the bounded draw computes in
+    // 3-D, so a step streams about 11 m^2 numbers against MGPCG's hundreds of bytes a cell
+    // (4096 fixed cells: 0.1 s against MGPCG's 0.29 s a step at 128^3): cells^(2/3) / 4,
+    // continuous at 64^3, at most 4096 (maxBytes: 800 MB).
+    const double cells = double(width) * double(height) * double(depth);
+    if (cells <= kSynchronousVolume) return 1024;
+    return std::min<size_t>(size_t(0.25 * std::cbrt(cells) * std::cbrt(cells)), 4096);
+  }
   const double cells = double(width) * double(height);
   // Up to 256^2 (the service's synchronous limit) MGPCG's grid stays in cache, and the two
   // measured even at about 4.5 sqrt(cells) (64^2-256^2), at most 1024. Past it both stream from
@@ -172,13 +185,16 @@ size_t Capacitance::maxFixed(int width, int height, int depth) {
 }
 
 size_t Capacitance::maxBytes(int width, int height, int depth) {
-  if (depth > 0) return size_t(64) << 20;
-  const size_t m = maxFixed(width, height);
+  const size_t m = maxFixed(width, height, depth);
+  if (depth > 0) return std::max(size_t(64) << 20, 6 * m * m * sizeof(double));
   return 6 * m * m * sizeof(double);
 }
 
 bool Capacitance::fits(int width, int height, int depth) {
-  return depth <= 0 || BoxGreen::tableEntries(width, height, depth) * sizeof(double) <= (size_t(32) << 20);
+  if (depth <= 0) return true;
+  const double cells = double(width) * double(height) * double(depth);
+  const size_t cap = cells <= kSynchronousVolume ? size_t(32) << 20 : size_t(256) << 20;
+  return BoxGreen::tableEntries(width, height, depth) * sizeof(double) <= cap;
 }
 
 Capacitance::Capacitance(int width, int height, int depth, Parallel* parallel)
@@ -317,25 +333,26 @@ double Capacitance::phi(Cell c) const {
   return dotQ(row(c), q_.size());
 }
 
-void Capacitance::phiAt(const std::vector<Cell>& cells, std::vector<double>& out) {
-  if (fallback_) return fallback_->phiAt(cells, out);
+void Capacitance::phiAt(const std::vector<Cell>& cells, std::vector<double>& out, const uint8_t* which) {
+  if (fallback_) return fallback_->phiAt(cells, out, which);
   out.resize(cells.size());
-  // The rows and their blocks first, on this thread (rows_ and the pool grow), as slots: the
-  // entries and the dot products then split over the threads, a row to a thread.
-  std::vector<int> slot(cells.size(), -1);
+  // The rows and their blocks first, on this thread (rows_ and the pool grow), listed with the
+  // cells that want a value: the entries and the dot products then split over the threads, a
+  // row to a thread.
+  todo_.clear();
   for (size_t i = 0; i < cells.size(); ++i) {
     const size_t cell = at(cells[i]);
     if (const int j = fixedIndex_.get(cell); j >= 0) {
       out[i] = value_[size_t(j)];
     } else {
       reserve(cells[i]);
-      slot[i] = rowOf_.get(cell);
+      if (!which || which[i]) todo_.emplace_back(i, size_t(rowOf_.get(cell)));
     }
   }
-  forRange(parallel_, cells.size(), 64, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (slot[i] < 0) continue;
-      Row& r = rows_[size_t(slot[i])];
+  forRange(parallel_, todo_.size(), 64, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const auto [i, slot] = todo_[k];
+      Row& r = rows_[slot];
       fill(r, cells[i]);
       out[i] = dotQ(r, q_.size());
     }

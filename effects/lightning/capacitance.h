@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "grid.h"
@@ -47,20 +48,22 @@ std::shared_ptr<const BoxGreen> cachedBoxGreen(int width, int height, int depth 
 
 class Capacitance final : public Potential {
  public:
-  // A step costs O(m^2) here (phi at ~3 m candidates, each a dot product over the m fixed
-  // cells) and O(cells) in MGPCG: past maxFixed() fixed cells the problem goes to Laplace
-  // (MGPCG at the request's tolerance). Up to 256^2 about 4.5 sqrt(cells), where the two
-  // measured even (bolts at 64^2-256^2 handed over at several limits), at most 1024; past it
-  // 6 sqrt(cells), at most 8192 (about even at 512^2 and 1024^2: docs/lightning-hero.md).
-  // In 3-D: at most 1024, where a step still costs a few milliseconds against MGPCG's tens.
+  // A step costs O(m^2) here (the two triangular solves, and phi at the candidates the bounded
+  // draw asks for, each a dot product over the m fixed cells) and O(cells) in MGPCG: past
+  // maxFixed() fixed cells the problem goes to Laplace (MGPCG at the request's tolerance). Up
+  // to 256^2 about 4.5 sqrt(cells), where the two measured even (bolts at 64^2-256^2 handed
+  // over at several limits, every candidate computed), at most 1024; past it 6 sqrt(cells), at
+  // most 8192 (about even at 512^2 and 1024^2, every candidate computed:
+  // docs/lightning-hero.md). In 3-D up to 64^3: 1024, where a step still costs a few
+  // milliseconds against MGPCG's tens; past it cells^(2/3) / 4, at most 4096.
   static size_t maxFixed(int width, int height, int depth = 0);
   // Working memory at most: the Cholesky factor (maxFixed^2 / 2 entries) and the rows (about
   // 4 maxFixed^2 at the limit: ~3 candidates and the cell itself per fixed cell), 6 maxFixed^2
   // entries in all; rows beyond that hand over too. In 3-D (~10 candidates per bolt voxel
-  // with 26 neighbours) 64 MB.
+  // with 26 neighbours) 64 MB up to 64^3, 6 maxFixed^2 entries past it.
   static size_t maxBytes(int width, int height, int depth = 0);
   // Whether a grid's table is small enough to build (every 2-D grid up to the solver's cell
-  // limit; 3-D up to about 80^3, 32 MB).
+  // limit; 3-D up to 64^3 a table of at most 32 MB, past it (jobs) 256 MB: 128^3's is 136 MB).
   static bool fits(int width, int height, int depth);
 
   // parallel: where phiAt's cells split (and the solver it hands over to); null: this thread.
@@ -70,7 +73,9 @@ class Capacitance final : public Potential {
   void fix(Cell c, double value) override;
   int solve(Solver solver, double tolerance) override;
   double phi(Cell c) const override;
-  void phiAt(const std::vector<Cell>& cells, std::vector<double>& out) override;
+  // Every cell's row is kept (made if new, with room for an entry per fixed cell) whether or
+  // not which asks for it, so that the memory that hands a bolt over does not depend on it.
+  void phiAt(const std::vector<Cell>& cells, std::vector<double>& out, const uint8_t* which = nullptr) override;
   double residual() const override;
   bool direct() const override { return !fallback_; }
 
@@ -121,6 +126,7 @@ class Capacitance final : public Potential {
   mutable std::vector<Row> rows_;
   mutable std::vector<std::unique_ptr<double[]>> pages_;
   mutable uint32_t blocks_ = 0;  // pool blocks handed out
+  std::vector<std::pair<size_t, size_t>> todo_;  // phiAt's cells to compute: (index, row slot)
   std::unique_ptr<Potential> fallback_;
 };
 

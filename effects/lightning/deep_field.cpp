@@ -141,6 +141,12 @@ void DeepField::pop() {
   estimate_ *= kCut;  // the candidates' potential in the scale of the stage below
 }
 
+bool DeepField::solveDirect(Solver solver, double tolerance) {
+  if (k_ != 0 || !field_ || !field_->direct()) return false;
+  field_->solve(solver, std::max(kStageTolerance, tolerance * estimate_));
+  return true;
+}
+
 int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi) {
   // The residual goal (relative to ||b||) is the tolerance times the candidates' largest
   // potential, so that their potentials come out right to about `tolerance` relative wherever

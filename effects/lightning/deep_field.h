@@ -45,6 +45,17 @@ class DeepField {
   // normal double of that stage, so that eta near 0 still weighs it (Phi^eta -> 1). Returns the
   // solver iterations, every stage's included.
   int solve(Solver solver, double tolerance, const std::vector<Cell>& probes, std::vector<double>& logPhi);
+  // A step of the direct solver without every probe (dbm.cpp's bounded draw). Where stage 0 is
+  // on the direct solver, solveDirect solves it as solve() would and returns true; phiDirect
+  // then gives Phi at the probes that `which` marks (the others' rows are kept as solve()
+  // keeps them, so the solver's limits fall where they would), and the caller, having found
+  // the largest potential at the probes to be at least kDeepen, hands it to setLargest, which
+  // solve() would have found. False: nothing was solved, solve() this step.
+  bool solveDirect(Solver solver, double tolerance);
+  void phiDirect(const std::vector<Cell>& probes, const std::vector<uint8_t>& which, std::vector<double>& phi) {
+    field_->phiAt(probes, phi, which.data());
+  }
+  void setLargest(double top) { estimate_ = top; }
   double residual() { return current().residual(); }
   bool direct() { return k_ == 0 && current().direct(); }
   // The deepest stage reached so far (0: never cut).

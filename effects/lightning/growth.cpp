@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <utility>
 
 #include "astar.h"
+#include "draw.h"
 #include "growth.h"
 
 namespace effects::lightning {
@@ -46,8 +46,8 @@ std::optional<Error> validate(const Params& p) {
 namespace {
 
 using detail::Candidate;
-
-constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+using detail::candidateWeights;
+using detail::sample;
 
 std::unique_ptr<detail::PhiMethod> methodFor(detail::Growth& growth, int radius) {
   switch (growth.p.method) {
@@ -205,32 +205,6 @@ void Grower::addCandidatesAround(int node) {
 void Grower::dropOlderThan(int age) {
   for (size_t i = s_.cands.size(); i-- > 0;)
     if (step_ - s_.cands[i].born > age) removeCandidate(i);
-}
-
-// Unnormalised p_i = Phi_i^eta (seed 002 eqn 2) from log Phi, scaled by the largest so that
-// nothing overflows; eta = 0 or all Phi = 0 gives uniform weights (0^0 = 1). Returns the sum.
-double candidateWeights(const std::vector<double>& logPhi, double eta, std::vector<double>& w) {
-  w.resize(logPhi.size());
-  double top = kNegInf;
-  for (double l : logPhi) top = std::max(top, l);
-  double sum = 0;
-  for (size_t i = 0; i < logPhi.size(); ++i) {
-    w[i] = (eta == 0.0 || top == kNegInf) ? 1.0 : std::exp(eta * (logPhi[i] - top));
-    sum += w[i];
-  }
-  return sum;
-}
-
-// Samples index i with probability Phi_i^eta / sum Phi^eta.
-size_t sample(const std::vector<double>& logPhi, double eta, Rng& rng, std::vector<double>& w) {
-  double u = rng.uniform() * candidateWeights(logPhi, eta, w);
-  for (size_t i = 0; i < w.size(); ++i) {
-    u -= w[i];
-    if (u < 0) return i;
-  }
-  size_t last = w.size() - 1;
-  while (last > 0 && w[last] == 0) --last;
-  return last;
 }
 
 double Grower::stepError(const std::vector<double>& logPhi) {

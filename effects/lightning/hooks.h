@@ -39,4 +39,9 @@ std::vector<Cell> astar(int width, int height, const std::vector<uint8_t>& obsta
 std::vector<Cell> astarToRegion(int width, int height, const std::vector<uint8_t>& obstacles, Cell from,
                                 const std::vector<uint8_t>& goals, int neighbourhood = 8, int depth = 0);
 
+// Whether DBM's direct steps draw from bounds on Phi (on: the default) or compute Phi at every
+// candidate, as before the bounded draw: the same bolt either way (docs/effects.md section 1.3),
+// for the tests and the lab that show it. Process-wide; set it before growing.
+void setBoundedDraw(bool on);
+
 }  // namespace effects::lightning

@@ -125,11 +125,14 @@ class Potential {
   // Solves to ||r|| <= tolerance * ||b|| from the current potential; returns iterations.
   virtual int solve(Solver solver, double tolerance) = 0;
   virtual double phi(Cell c) const = 0;
-  // Phi at many cells (a step's candidates): out[i] = phi(cells[i]). The direct solver computes
-  // them on its threads; a cell's value does not depend on how they are split.
-  virtual void phiAt(const std::vector<Cell>& cells, std::vector<double>& out) {
+  // Phi at many cells (a step's candidates): out[i] = phi(cells[i]), where which is null or
+  // which[i] is set (out[i] is left as it was elsewhere). The direct solver computes them on
+  // its threads; a cell's value does not depend on how they are split, nor on which others
+  // are asked for.
+  virtual void phiAt(const std::vector<Cell>& cells, std::vector<double>& out, const uint8_t* which = nullptr) {
     out.resize(cells.size());
-    for (size_t i = 0; i < cells.size(); ++i) out[i] = phi(cells[i]);
+    for (size_t i = 0; i < cells.size(); ++i)
+      if (!which || which[i]) out[i] = phi(cells[i]);
   }
   // The relative residual the last solve reached.
   virtual double residual() const = 0;
