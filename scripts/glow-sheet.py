@@ -12,11 +12,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests"))
 from effectd_process import start  # noqa: E402
 
-with open(os.path.join(ROOT, "scripts", "stability-report.py")) as f:  # its PNG decoder alone
-    source = f.read()
-namespace = {"struct": struct, "zlib": zlib}
-exec(source[source.index("def png_decode"):source.index("\n\n\n", source.index("def png_decode"))], namespace)
-png_decode = namespace["png_decode"]
+from stability.pngio import png_decode  # noqa: E402  (the stability checks' PNG decoder)
 
 TILE = 192
 DISTANCES = (0.75, 1.5, 3.0)

@@ -1,7 +1,7 @@
 // Exact DBM on stiff geometries, checked by invariances and a high-precision reference, not by
 // snapshots: channels whose field ahead of the bolt decays like exp(-pi L / (w + 1)) far below
 // double's range (DeepField, docs/effects.md section 1.3), pockets behind obstacles, eta at its
-// limits, 3-D tubes. The larger sizes run in the stability report (scripts/stability-report.py).
+// limits, 3-D tubes. The larger sizes run in the stability report (tests/stability/lightning.py).
 #include <algorithm>
 #include <cfloat>
 #include <cmath>

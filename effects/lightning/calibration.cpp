@@ -240,6 +240,13 @@ void calibrate(Params& p) {
   p.lifetime = s.lifetime;
 }
 
+void usePaperConstants(Params& p) {
+  p.lifetime = kPaperLifetime;
+  p.axisGrowth = kPaperAxisGrowth;
+  p.chargesEta = p.eta;
+  p.screeningRadius = 1;
+}
+
 int screeningRadius(const Params& p) {
   if (p.method != Method::kFast || p.depth) return 1;
   return p.screeningRadius > 0 ? p.screeningRadius : calibratedScreeningRadius(p);

@@ -165,8 +165,8 @@ size_t Dbm::draw(Rng& rng) {
   ++directSteps_;
   offered_ += n;
   // Weights as candidateWeights makes them (relative to the largest), exact or bounded.
-  const double logTop = std::log(std::max(top, DBL_MIN));
-  auto weight = [&](double phi) { return std::exp(p_.eta * (std::log(std::max(phi, DBL_MIN)) - logTop)); };
+  const double logTop = logPotential(top);
+  auto weight = [&](double phi) { return relativeWeight(logPotential(phi), p_.eta, logTop); };
   lo_.resize(n);
   hi_.resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -197,7 +197,7 @@ size_t Dbm::draw(Rng& rng) {
   }
   // Every weight exact and the pick still within the margin: sampleAt's own sums decide it.
   logPhi_.resize(n);
-  for (size_t i = 0; i < n; ++i) logPhi_[i] = std::log(std::max(phi_[i], DBL_MIN));
+  for (size_t i = 0; i < n; ++i) logPhi_[i] = logPotential(phi_[i]);
   return sampleAt(logPhi_, p_.eta, u, scratch_);
 }
 

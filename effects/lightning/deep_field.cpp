@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 
+#include "draw.h"
 #include "solver_choice.h"
 
 namespace effects::lightning::detail {
@@ -207,7 +208,7 @@ int DeepField::solve(Solver solver, double tolerance, const std::vector<Cell>& p
   estimate_ = top > 0 ? top : 1.0;
   logPhi.resize(probes.size());
   const double scale = k_ * std::log(kCut);
-  for (size_t i = 0; i < probes.size(); ++i) logPhi[i] = std::log(std::max(phi_[i], DBL_MIN)) + scale;
+  for (size_t i = 0; i < probes.size(); ++i) logPhi[i] = logPotential(phi_[i]) + scale;
   return it;
 }
 

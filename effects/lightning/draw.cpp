@@ -14,7 +14,7 @@ double candidateWeights(const std::vector<double>& logPhi, double eta, std::vect
   for (double l : logPhi) top = std::max(top, l);
   double sum = 0;
   for (size_t i = 0; i < logPhi.size(); ++i) {
-    w[i] = (eta == 0.0 || top == kNegInf) ? 1.0 : std::exp(eta * (logPhi[i] - top));
+    w[i] = (eta == 0.0 || top == kNegInf) ? 1.0 : relativeWeight(logPhi[i], eta, top);
     sum += w[i];
   }
   return sum;

@@ -5,12 +5,20 @@
 // draw).
 #pragma once
 
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
 #include "effects/common.h"
 
 namespace effects::lightning::detail {
+
+// log Phi of a potential, Phi below DBL_MIN (0 included) read as DBL_MIN.
+inline double logPotential(double phi) { return std::log(std::max(phi, DBL_MIN)); }
+// Phi^eta relative to the largest Phi, from their logs: what every draw weighs a candidate by.
+inline double relativeWeight(double logPhi, double eta, double logTop) { return std::exp(eta * (logPhi - logTop)); }
 
 // Unnormalised p_i = Phi_i^eta from log Phi, scaled by the largest so that nothing
 // overflows; eta = 0 or all Phi = 0 gives uniform weights (0^0 = 1). Returns the sum.

@@ -97,6 +97,16 @@ std::vector<float> boltGeometry3d(const Lightning& l, const View& view, int widt
   return v;
 }
 
+// The normalised taps of a Gaussian of `sigma` texels, centre first (radius <= kMaxBlurRadius).
+std::vector<float> gaussianTaps(double sigma) {
+  const int radius = std::min(kMaxBlurRadius, std::max(1, int(std::ceil(3 * sigma))));
+  std::vector<float> w(size_t(radius) + 1);
+  double sum = 0;
+  for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * sigma * sigma))));
+  for (float& x : w) x = float(x / sum);
+  return w;
+}
+
 // Separable Gaussian of the core at half resolution (sigma in half-resolution pixels) into
 // `glow`, through `blurred`.
 std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l) {
@@ -105,12 +115,8 @@ std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l) {
   if (!program.ok()) return program.error();
   Program& p = *program.value();
   glUseProgram(p.id);
-  const double sigma = l.glowSigma / 2;
-  const int radius = std::min(kMaxBlurRadius, int(std::ceil(3 * sigma)));
-  std::vector<float> w(size_t(radius) + 1);
-  double sum = 0;
-  for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * sigma * sigma))));
-  for (float& x : w) x = float(x / sum);
+  const std::vector<float> w = gaussianTaps(l.glowSigma / 2);  // glowSigma > 0: a radius of at least 1
+  const int radius = int(w.size()) - 1;
   glUniform1fv(p.at("uWeights[0]"), GLsizei(w.size()), w.data());
   p.set("uRadius", radius);
   p.set("uSource", 0);
@@ -130,16 +136,6 @@ std::optional<Error> glowBlur(Gpu& gpu, FrameState& f, const Lightning& l) {
   glDrawArrays(GL_TRIANGLES, 0, 3);
   f.frame.passes.push_back("blurVertical");
   return std::nullopt;
-}
-
-// The normalised taps of a Gaussian of `sigma` texels, centre first (radius <= kMaxBlurRadius).
-std::vector<float> gaussianTaps(double sigma) {
-  const int radius = std::min(kMaxBlurRadius, std::max(1, int(std::ceil(3 * sigma))));
-  std::vector<float> w(size_t(radius) + 1);
-  double sum = 0;
-  for (int i = 0; i <= radius; ++i) sum += (i ? 2 : 1) * (w[size_t(i)] = float(std::exp(-i * i / (2 * sigma * sigma))));
-  for (float& x : w) x = float(x / sum);
-  return w;
 }
 
 // The fitted APSF kernel for this medium (kept per render thread: an animation's frames share it).

@@ -291,6 +291,7 @@ void addShaderParts(const BubbleRequest& request, double t, json& out, JsonReply
   if (include.has("uniforms") || include.has("shader")) {
     const ErrorEstimate e = shadingErrorEstimate(features);
     out["shadingError"] = {{"meanDeltaE", e.value},
+                           {"limit", e.limit},
                            {"kind", "estimate"},
                            {"variant", e.row},
                            {"reference", "the variant's frame against CPU ray tracing (400 wavelengths) on the error "

@@ -192,12 +192,7 @@ lt::Params boltParams(const LightningRequest& r, const std::string& at) {
       throw fieldError(400, at + "/targetRegion", "holds no cell of the grid");
   }
   lt::calibrate(p);            // from one look at the obstacles
-  if (r.variant == "paper") {  // eqn 8's constants; Kim et al.'s power = eta
-    p.lifetime = lt::kPaperLifetime;
-    p.axisGrowth = lt::kPaperAxisGrowth;
-    p.chargesEta = p.eta;
-    p.screeningRadius = 1;  // eqn 6's N: the adjacent cells
-  }
+  if (r.variant == "paper") lt::usePaperConstants(p);
   p.lifetime = r.lifetime.value_or(p.lifetime);
   p.axisGrowth = r.axisGrowth.value_or(p.axisGrowth);
   return p;
@@ -217,16 +212,16 @@ namespace {
 // X-Effect-Error: the bolt's mean TV distance per step from DBM's converged distribution,
 // measured (include "error") or the error report's figure for the method.
 std::string errorHeader(const lt::Params& p, const lt::Bolt& bolt) {
-  char out[256];
+  char out[320];
+  const ErrorEstimate e = lightningErrorEstimate(p);  // its limit of use applies to a measured figure too
   if (p.measureError) {
-    std::snprintf(out, sizeof out, "meanTotalVariation=%.4g; kind=measured; reference=\"%s\"",
-                  bolt.stats.error.value_or(0.0), bolt.stats.reference.c_str());
+    std::snprintf(out, sizeof out, "meanTotalVariation=%.4g; limit=%g; kind=measured; reference=\"%s\"",
+                  bolt.stats.error.value_or(0.0), e.limit, bolt.stats.reference.c_str());
   } else {
-    const ErrorEstimate e = lightningErrorEstimate(p);
     std::snprintf(out, sizeof out,
-                  "meanTotalVariation=%.3g; kind=estimate; row=\"%s, %s\"; reference=\"DBM's converged per-step "
-                  "distribution, in the error report; include error measures this bolt\"",
-                  e.value, e.row.c_str(), e.setting.c_str());
+                  "meanTotalVariation=%.3g; limit=%g; kind=estimate; row=\"%s, %s\"; reference=\"DBM's converged "
+                  "per-step distribution, in the error report; include error measures this bolt\"",
+                  e.value, e.limit, e.row.c_str(), e.setting.c_str());
   }
   return out;
 }

@@ -99,9 +99,10 @@ std::string frameError(const rd::Image& frame, const rd::Reference& ref) {
   for (double d : de) sum += d, worst = std::max(worst, d);
   char out[256];
   std::snprintf(out, sizeof out,
-                "pass=bubble; meanDeltaE=%.4g; maxDeltaE=%.4g; pixels=%zu; kind=measured; "
+                "pass=bubble; meanDeltaE=%.4g; maxDeltaE=%.4g; pixels=%zu; limit=%g; kind=measured; "
                 "reference=\"CPU ray tracing, %d wavelengths\"",
-                de.empty() ? 0.0 : sum / double(de.size()), worst, de.size(), rd::kReferenceWavelengths);
+                de.empty() ? 0.0 : sum / double(de.size()), worst, de.size(),
+                reported("render-bubble", "", "", "meanDeltaE").limit, rd::kReferenceWavelengths);
   return out;
 }
 
@@ -115,17 +116,28 @@ std::vector<std::string> passEstimates(const rd::Scene& scene, bool bubbleMeasur
     for (const rd::Bubble& b : scene.bubbles) {
       const ErrorEstimate s = shadingErrorEstimate(b.features);
       std::snprintf(e, sizeof e,
-                    "pass=bubble; meanDeltaE=%.3g; kind=estimate; variant=\"%s\"; "
+                    "pass=bubble; meanDeltaE=%.3g; limit=%g; kind=estimate; variant=\"%s\"; "
                     "reference=\"CPU ray tracing, %d wavelengths, on the error report's scene\"",
-                    s.value, s.row.c_str(), rd::kReferenceWavelengths);
+                    s.value, s.limit, s.row.c_str(), rd::kReferenceWavelengths);
       out.push_back(e);
     }
-  if (scene.fog)
-    out.push_back("pass=fog; maxSteps8bit=2; kind=estimate; reference=\"the fog's closed form in double "
-                  "(fog::sampleAt), within 2 steps of 8-bit colour in the error report\"");
-  if (scene.lightning)
-    out.push_back("pass=lightning; maxOffsetPx=1.75; kind=bound; reference=\"the answer's own polyline: the main "
-                  "channel's pixels lie within lightningStyle.coreWidth + 1.75 px of it (the glow spreads by design)\"");
+  if (scene.fog) {
+    const ErrorEstimate f = fogPassErrorEstimate();
+    std::snprintf(e, sizeof e,
+                  "pass=fog; maxSteps8bit=%.3g; limit=%g; kind=estimate; reference=\"the fog's closed form in double "
+                  "(fog::sampleAt), the worst of the error report's fogs\"",
+                  f.value, f.limit);
+    out.push_back(e);
+  }
+  if (scene.lightning) {
+    const ErrorEstimate l = lightningPassErrorEstimate();
+    std::snprintf(e, sizeof e,
+                  "pass=lightning; maxOffsetPx=%g; limit=%g; kind=bound; reference=\"the answer's own polyline: the "
+                  "main channel's pixels lie within lightningStyle.coreWidth + %g px of it (the glow spreads by "
+                  "design)\"",
+                  l.limit, l.limit, l.limit);
+    out.push_back(e);
+  }
   return out;
 }
 

@@ -79,14 +79,15 @@ JsonReply runTangents(const TangentsRequest& request, const json& body, const Re
     const ErrorEstimate e = tangentsErrorEstimate(opt.mode);
     char h[256];
     if (out.stats.error)
-      std::snprintf(h, sizeof h, "meanAngleDeg=%.4g; kind=measured; reference=\"MikkTSpace\"", *out.stats.error);
+      std::snprintf(h, sizeof h, "meanAngleDeg=%.4g; limit=%g; kind=measured; reference=\"MikkTSpace\"", *out.stats.error,
+                    e.limit);
     else if (opt.mode == tg::Mode::kMikkTSpace)
       std::snprintf(h, sizeof h, "meanAngleDeg=0; kind=exact; reference=\"MikkTSpace (this is it)\"");
     else
       std::snprintf(h, sizeof h,
-                    "meanAngleDeg=%.3g; kind=estimate; row=\"%s\"; reference=\"MikkTSpace on the error report's "
-                    "meshes (the worse of two); include error measures this mesh\"",
-                    e.value, e.row.c_str());
+                    "meanAngleDeg=%.3g; limit=%g; kind=estimate; row=\"%s\"; reference=\"MikkTSpace on the error "
+                    "report's meshes (the worse of two); include error measures this mesh\"",
+                    e.value, e.limit, e.row.c_str());
     reply.headers["X-Effect-Error"] = h;
   }
   json res = {{"method", reply.method}, {"vertexCount", out.remap.size()}};

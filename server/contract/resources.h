@@ -13,4 +13,7 @@ const std::map<std::string, std::string_view>& resources();
 // paths relative to the repository: "server/playground/index.html", "proto/examples/fog/...json",
 // "examples/01-lightning.json".
 const std::map<std::string, std::string_view>& playgroundResources();
+// The error report's data the server states figures from (docs/error-vs-time/<section>.json);
+// keys are paths relative to the repository.
+const std::map<std::string, std::string_view>& reportResources();
 }  // namespace effectd

@@ -44,6 +44,8 @@ class LocalJobs final : public Jobs {
   void expire();  // mu_ held: drops jobs past their ttl, and answers past maxStoreBytes
   JobView view(const Job& job) const;  // mu_ held
   void changed(Job& job);               // mu_ held: bumps the version, wakes waiters
+  void dropRequest(Job& job);           // mu_ held: its body and the bytes it held, once it runs no more
+  void forgetAnswer(const Job& job);    // mu_ held: the bytes its answer held, as the job goes
 
   const Options o_;
   const Runner runner_;
@@ -173,9 +175,7 @@ std::optional<JobView> LocalJobs::cancel(const std::string& id, std::chrono::mil
     job->state = JobState::kCancelled;
     job->cancel = true;
     job->finishedAt = Clock::now();
-    requestBytes_ -= job->body.size();
-    job->body.clear();
-    job->body.shrink_to_fit();
+    dropRequest(*job);
     ++outcomes_["cancelled"];
     changed(*job);
   } else if (job->state == JobState::kRunning) {
@@ -186,11 +186,21 @@ std::optional<JobView> LocalJobs::cancel(const std::string& id, std::chrono::mil
   return view(*job);
 }
 
+void LocalJobs::dropRequest(Job& job) {
+  requestBytes_ -= job.body.size();
+  job.body.clear();
+  job.body.shrink_to_fit();
+}
+
+void LocalJobs::forgetAnswer(const Job& job) {
+  if (job.answer) answerBytes_ -= job.answer->body.size();
+}
+
 bool LocalJobs::remove(const std::string& id) {
   std::lock_guard<std::mutex> lock(mu_);
   auto it = jobs_.find(id);
   if (it == jobs_.end() || !finished(it->second->state)) return false;
-  if (it->second->answer) answerBytes_ -= it->second->answer->body.size();
+  forgetAnswer(*it->second);
   jobs_.erase(it);
   change_.notify_all();
   return true;
@@ -201,7 +211,7 @@ void LocalJobs::expire() {
   for (auto it = jobs_.begin(); it != jobs_.end();) {
     const Job& job = *it->second;
     if (finished(job.state) && now - job.finishedAt > o_.ttl) {
-      if (job.answer) answerBytes_ -= job.answer->body.size();
+      forgetAnswer(job);
       it = jobs_.erase(it);
       change_.notify_all();
     } else {
@@ -213,7 +223,7 @@ void LocalJobs::expire() {
     for (auto& [id, job] : jobs_)
       if (finished(job->state) && job->answer && (!oldest || job->finishedAt < oldest->finishedAt)) oldest = job.get();
     if (!oldest) break;
-    answerBytes_ -= oldest->answer->body.size();
+    forgetAnswer(*oldest);
     oldest->answer.reset();
     oldest->expired = true;
     changed(*oldest);
@@ -254,9 +264,7 @@ void LocalJobs::work() {
     job->state = job->cancel ? JobState::kCancelled : answer.status < 400 ? JobState::kDone : JobState::kFailed;
     if (job->state == JobState::kDone) job->fraction = 1;
     job->finishedAt = Clock::now();
-    requestBytes_ -= job->body.size();
-    job->body.clear();
-    job->body.shrink_to_fit();
+    dropRequest(*job);
     if (job->state != JobState::kCancelled) {
       answerBytes_ += answer.body.size();
       job->answer = std::make_shared<const JobAnswer>(std::move(answer));

@@ -553,6 +553,20 @@ void Service::answer(const Route& route, const std::string& bodyText, const std:
   }
 }
 
+namespace {
+
+// Whether the server's listen loop runs within `timeout` (polled every millisecond).
+bool untilRunning(const httplib::Server& server, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!server.is_running()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+}  // namespace
+
 int Service::bind() {
   const int port = config_.port == 0 ? http_->bind_to_any_port(config_.host)
                                      : (http_->bind_to_port(config_.host, config_.port) ? config_.port : -1);
@@ -575,7 +589,7 @@ bool Service::run() {
   if (admin_) adminThread_ = std::thread([this] { admin_->listen_after_bind(); });
   const bool ok = http_->listen_after_bind();
   if (adminThread_.joinable()) {
-    for (int i = 0; i < 2000 && !admin_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    untilRunning(*admin_, std::chrono::milliseconds(2000));  // stop() before its loop runs would be lost
     admin_->stop();
     adminThread_.join();
   }
@@ -590,13 +604,6 @@ void Service::stop() {
   http_->stop();
 }
 
-bool Service::waitUntilRunning(std::chrono::milliseconds timeout) const {
-  auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!http_->is_running()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return true;
-}
+bool Service::waitUntilRunning(std::chrono::milliseconds timeout) const { return untilRunning(*http_, timeout); }
 
 }  // namespace effectd

@@ -160,6 +160,10 @@ int calibratedLifetime(const Params& p);
 // Sets the calibrated defaults the server uses, from one look at the obstacles: axisGrowth and
 // lifetime (the radius follows from screeningRadius 0 when the bolt grows).
 void calibrate(Params& p);
+// `variant: "paper"`: the source papers' constants over whatever calibrate() set: eqn 8's base
+// (kPaperAxisGrowth) and lifetime (kPaperLifetime), eqn 6's N over the adjacent cells, and
+// Kim et al.'s power at DBM's eta.
+void usePaperConstants(Params& p);
 // The radius grow() counts N within: Params::screeningRadius when set, else the calibrated
 // one; 1 for every method but 2-D fast.
 int screeningRadius(const Params& p);
