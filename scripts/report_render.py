@@ -94,7 +94,7 @@ def failing(c):
     return [m for m in c["metrics"] if m["limit"] is not None and m["value"] > m["limit"]]
 
 
-def cell(c, sections_by_id=None):
+def cell(c):
     metrics = " · ".join(f"{m['label']} {fmt(m['value'], 2)}" for m in c["metrics"])
     link = anchor(c["rows"][0][0])
     text = f"`{compact(c['request'])}` {metrics} · {fmt(c['ms'], 2)} ms"

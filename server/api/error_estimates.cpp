@@ -44,7 +44,8 @@ ErrorEstimate reported(const std::string& id, const std::string& series, const s
   for (const json& m : s.value("metrics", json::array()))
     if (m.value("id", "") == metric && m["limit"].is_number()) e.limit = m["limit"].get<double>();
   for (const json& r : s.value("rows", json::array())) {
-    if (r.value("series", "") != series || r.value("setting", "").rfind(settingPrefix, 0) != 0) continue;
+    if ((!series.empty() && r.value("series", "") != series) || r.value("setting", "").rfind(settingPrefix, 0) != 0)
+      continue;
     const json v = r["errors"].value(metric, json());
     if (!v.is_number()) continue;
     if (!(e.value >= v.get<double>())) e.value = v.get<double>(), e.setting = r["setting"].get<std::string>();
@@ -83,14 +84,7 @@ ErrorEstimate shadingErrorEstimate(const effects::bubble::Features& f) {
   return reported("render-bubble", row, "", "meanDeltaE");
 }
 
-ErrorEstimate fogPassErrorEstimate() {
-  ErrorEstimate worst;
-  for (const json& r : section("render-fog").value("rows", json::array())) {
-    const ErrorEstimate e = reported("render-fog", r.value("series", ""), "", "maxSteps");
-    if (!(worst.value >= e.value)) worst = e;
-  }
-  return worst;
-}
+ErrorEstimate fogPassErrorEstimate() { return reported("render-fog", "", "", "maxSteps"); }
 
 ErrorEstimate lightningPassErrorEstimate() { return reported("render-lightning", "128 grid, core 1.5", "", "maxOffsetPx"); }
 

@@ -22,8 +22,8 @@ struct ErrorEstimate {
   std::string setting;      // and its setting ("default", "tol 0.01", ...)
 };
 
-// The largest figure of `metric` among the section's rows of `series` whose setting starts with
-// `settingPrefix`; NaN value when the data holds none (tests/report_test.cpp asks for every
+// The largest figure of `metric` among the section's rows of `series` (empty: of every series)
+// whose setting starts with `settingPrefix`; NaN value when the data holds none (tests/report_test.cpp asks for every
 // figure the server can state).
 ErrorEstimate reported(const std::string& section, const std::string& series, const std::string& settingPrefix,
                        const std::string& metric);
