@@ -1,7 +1,8 @@
 // Run times for the error report, from several processes interleaved in time.
 //
 // A section measures its errors at once and registers what it times: a job that returns run
-// times in ms (one per repeat, or one per seed for bolts) and gets a ticket. Once every section
+// times in ms (one per repeat, or one per seed for bolts) and gets a ticket. A job is told which
+// process runs it (0, 1, ...), so that slow bolts can spread their seeds over the processes. Once every section
 // has registered, run(processes) forks the processes one after another; each runs every job in
 // registration order and sends its times back through a pipe. A ticket's spread is over the
 // times of all processes, so that it holds what changes between runs (memory layout, the
@@ -25,7 +26,7 @@ namespace bench {
 
 class Timings {
  public:
-  using Job = std::function<std::vector<double>()>;
+  using Job = std::function<std::vector<double>(int process)>;
   static constexpr size_t kNone = size_t(-1);
 
   // A job that returns its own times (bolts: each seed's elapsed time).
@@ -35,7 +36,7 @@ class Timings {
   }
   // `repeats` calls of f, each timed.
   size_t repeat(std::string name, int repeats, std::function<void()> f) {
-    return add(std::move(name), [repeats, f = std::move(f)] {
+    return add(std::move(name), [repeats, f = std::move(f)](int) {
       std::vector<double> t;
       for (int i = 0; i < repeats; ++i) {
         effects::Stopwatch w;
@@ -61,7 +62,7 @@ class Timings {
       if (pid == 0) {  // the child: every job in turn, each job's count and times down the pipe
         close(fd[0]);
         for (const auto& [name, job] : jobs_) {
-          const std::vector<double> t = job();
+          const std::vector<double> t = job(run);
           const double n = double(t.size());
           if (!writeAll(fd[1], &n, sizeof n) || !writeAll(fd[1], t.data(), t.size() * sizeof(double))) _exit(3);
         }

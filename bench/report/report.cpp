@@ -3,7 +3,10 @@
 #include "report.h"
 
 #include <algorithm>
+#include <atomic>
 #include <sstream>
+
+#include <effects/parallel.h>
 
 namespace report {
 
@@ -16,7 +19,7 @@ size_t Run::repeat(std::string name, int repeats, std::function<void()> f) {
 }
 
 size_t timeFrames(Run& run, const std::string& name, std::function<effects::render::Scene()> scene, int frames) {
-  return run.time(name, [scene = std::move(scene), frames] {
+  return run.time(name, [scene = std::move(scene), frames](int) {
     static auto renderer = effects::render::Renderer::create();
     std::vector<double> ms;
     if (!renderer.ok()) return ms;
@@ -24,6 +27,14 @@ size_t timeFrames(Run& run, const std::string& name, std::function<effects::rend
     for (int i = 0; i <= frames; ++i)
       if (auto f = renderer.value()->render(built); f.ok() && i > 0) ms.push_back(f.value().ms);
     return ms;
+  });
+}
+
+void onEveryCore(size_t n, const std::function<void(size_t)>& f) {
+  effects::ThreadPool pool(effects::ThreadPool::besideCaller());
+  std::atomic<size_t> next{0};  // each thread takes the next call when it is free: calls differ by 1000x
+  pool.forRange(pool.threads() + 1, 1, [&](size_t, size_t) {
+    for (size_t i; (i = next.fetch_add(1)) < n;) f(i);
   });
 }
 

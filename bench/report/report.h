@@ -102,6 +102,10 @@ std::vector<Section> allSections();
 std::string fmt(double v, int digits = 3);
 // The value at fraction f of v's order statistics (linear between them).
 double quantile(std::vector<double> v, double f);
+// Calls f(i) for every i in [0, n), on every core of the machine: for what a section measures
+// untimed, each call writing only its own slot, so the result is the same on any number of
+// cores. Its threads end before it returns: none is alive when the timing processes fork.
+void onEveryCore(size_t n, const std::function<void(size_t)>& f);
 // Mean and sample standard deviation.
 std::pair<double, double> meanSd(const std::vector<double>& v);
 // A row's error for metric `id` (NaN when not measured), and the largest over the rows.

@@ -1,6 +1,7 @@
 // The lightning sections' shared parts (lightning_common.h).
 #include "lightning_common.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "fixtures.h"
@@ -45,13 +46,17 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
     settings.push_back({"fast axisGrowth", "axisGrowth " + fmt(growth, 3),
                         {{"method", "fast"}, {"axisGrowth", growth}, {"lifetime", 0}}, p});
   }
-  if (!volume && (n <= 128 || hood == 8)) {  // charges is O(cells x candidates): ~10 s a bolt at 256^2
+  if (!volume) {
     lt::Params c = layout();
     c.method = lt::Method::kCharges;
     settings.push_back({"charges calibrated", "default: power " + fmt(lt::calibratedChargesEta(c), 3),
                         {{"method", "charges"}}, c});
-    lt::usePaperConstants(c);  // Kim et al.'s parameter at DBM's eta: space-filling
-    settings.push_back({"charges paper", "variant paper: power " + fmt(c.eta, 3), {{"method", "charges"}, {"variant", "paper"}}, c});
+    // Kim et al.'s parameter at DBM's eta fills space (D 1.7 at 64^2, 1.8 at 128^2, 1.9 at 256^2
+    // when last measured) and costs 20x, 40x and 140x the calibrated power (40 ms, 0.67 s and
+    // 12.8 s a bolt): shown where it is cheap.
+    lt::usePaperConstants(c);
+    if (n <= 64)
+      settings.push_back({"charges paper", "variant paper: power " + fmt(c.eta, 3), {{"method", "charges"}, {"variant", "paper"}}, c});
   }
   std::vector<double> tolerances;
   if (quick)
@@ -86,11 +91,12 @@ double dimensionOf(const lt::Bolt& b, int n) {
   return b.depth ? lt::fractalDimension(cells, n, n, n) : lt::fractalDimension(cells, n, n);
 }
 
-size_t timeBolts(Run& run, const std::string& name, lt::Params p, int seeds) {
-  return run.time(name, [p, seeds]() mutable {
+size_t timeBolts(Run& run, const std::string& name, lt::Params p, int seeds, double boltMs) {
+  const int k = boltMs > 0 ? std::clamp(int(std::min(kBoltTimingMs / boltMs, 1e6)), 1, seeds) : seeds;
+  return run.time(name, [p, seeds, k](int process) mutable {
     std::vector<double> t;
-    for (int seed = 1; seed <= seeds; ++seed) {
-      p.seed = uint64_t(seed);
+    for (int i = 0; i < k; ++i) {
+      p.seed = uint64_t((k == seeds ? i : process * k + i) % seeds + 1);
       if (auto b = lt::grow(p); b.ok()) t.push_back(b.value().stats.elapsedMs);
     }
     return t;
@@ -107,50 +113,66 @@ Metric fdMetric() {
 }
 
 void lightningRows(Run& run, int n, int hood, bool volume) {
-  const int seeds = run.quick ? 3 : 10;
+  // D over `seeds`; TV over the first tvSeeds, its reference solve every step costing 10 to 100
+  // times the bolt (and up to 128^2 only: seconds per 256^2 bolt).
+  const int seeds = run.quick ? 3 : 10, tvSeeds = std::min(seeds, 3);
+  const bool withTv = n <= 128;
   const std::string grid = std::to_string(n) + (volume ? "³, " : "², ") + std::to_string(hood) + "-nbhd";
   std::fprintf(stderr, "           %s\n", grid.c_str());
-  std::vector<double> refD;
+  const auto settings = lightningSettings(run.quick, n, hood, volume);
+  std::vector<lt::Params> params;  // every setting's, then the reference's
+  for (const auto& s : settings) params.push_back(s.params);
   {
     lt::Params p = layoutOf(n, volume);
     p.neighbourhood = hood;
     p.method = lt::Method::kDbm;
     p.tolerance = 1e-8;
-    for (int s = 1; s <= seeds; ++s) {
-      p.seed = uint64_t(s);
-      auto b = lt::grow(p);
-      if (b.ok()) refD.push_back(dimensionOf(b.value(), n));
-    }
+    params.push_back(p);
   }
-  const auto [dRef, dRefSd] = meanSd(refD);
-  for (const auto& s : lightningSettings(run.quick, n, hood, volume)) {
-    std::vector<double> dims, tvs;
-    for (int seed = 1; seed <= seeds; ++seed) {
-      lt::Params p = s.params;
-      p.seed = uint64_t(seed);
-      auto b = lt::grow(p);
-      if (!b.ok()) continue;
-      dims.push_back(dimensionOf(b.value(), n));
-      if (n > 128) continue;  // the reference solve every step costs seconds per 256^2 bolt
+  // Every bolt grown at once on the machine's cores: (params, seed) -> D, its time, its TV.
+  const size_t perParams = size_t(seeds + (withTv ? tvSeeds : 0));
+  std::vector<double> dims(params.size() * size_t(seeds), NAN), ms(dims.size(), NAN),
+      tvs(params.size() * size_t(tvSeeds), NAN);
+  onEveryCore(params.size() * perParams, [&](size_t task) {
+    const size_t i = task / perParams, j = task % perParams;
+    lt::Params p = params[i];
+    if (j < size_t(seeds)) {
+      p.seed = j + 1;
+      if (auto b = lt::grow(p); b.ok()) dims[i * size_t(seeds) + j] = dimensionOf(b.value(), n), ms[i * size_t(seeds) + j] = b.value().stats.elapsedMs;
+    } else if (i < settings.size()) {  // the reference's own TV is not measured
+      p.seed = j - size_t(seeds) + 1;
       p.measureError = true;
-      auto e = lt::grow(p);
-      if (e.ok()) tvs.push_back(e.value().stats.error.value_or(0));
+      if (auto e = lt::grow(p); e.ok()) tvs[i * size_t(tvSeeds) + j - size_t(seeds)] = e.value().stats.error.value_or(0);
     }
-    const auto [mean, sd] = meanSd(dims);
+  });
+  const auto of = [](const std::vector<double>& v, size_t i, int count) {
+    std::vector<double> out;
+    for (size_t j = i * size_t(count); j < (i + 1) * size_t(count); ++j)
+      if (!std::isnan(v[j])) out.push_back(v[j]);
+    return out;
+  };
+  const std::vector<double> refD = of(dims, settings.size(), seeds);
+  const auto [dRef, dRefSd] = meanSd(refD);
+  for (size_t i = 0; i < settings.size(); ++i) {
+    const auto& s = settings[i];
+    const std::vector<double> d = of(dims, i, seeds), tv = of(tvs, i, tvSeeds);
+    const auto [mean, sd] = meanSd(d);
     Row r;
     r.series = s.series + " " + grid;  // one curve per method, grid and neighbourhood
     r.setting = s.setting;
     r.group = grid;
     r.request = s.request;
-    r.ticket = timeBolts(run, r.series + " " + s.setting, s.params, seeds);  // over seeds: each a different bolt
+    r.ticket = timeBolts(run, r.series + " " + s.setting, s.params, seeds, quantile(of(ms, i, seeds), 0.5));
     r.errors["fd"] = std::abs(mean - dRef);
     r.note = "D " + fmt(mean, 3) + " ± " + fmt(sd, 2);
-    if (!tvs.empty()) {
-      const auto [tvMean, tvSd] = meanSd(tvs);
+    if (!tv.empty()) {
+      const auto [tvMean, tvSd] = meanSd(tv);
       r.errors["tv"] = tvMean;
       r.note += "; TV ± " + fmt(tvSd, 2);
     }
-    r.note += " (" + std::to_string(dims.size()) + " seeds)";
+    r.note += " (" + std::to_string(d.size()) + " seeds";
+    if (!tv.empty() && tv.size() != d.size()) r.note += ", TV " + std::to_string(tv.size());
+    r.note += ")";
     run.rows.push_back(r);
   }
   Row ref;

@@ -26,8 +26,12 @@ std::vector<LightningSetting> lightningSettings(bool quick, int n, int hood, boo
 // The request fields of a grid: {"grid": {...}, "neighbourhood": hood}.
 json gridRequest(int n, int hood, bool volume);
 double dimensionOf(const lt::Bolt& b, int n);
-// Each seed's bolt grown again, its own elapsed time (the time of `p` over seeds 1..seeds).
-size_t timeBolts(Run& run, const std::string& name, lt::Params p, int seeds);
+// The time of `p` over seeds 1..seeds: each seed's bolt grown again, its own elapsed time. Each
+// timing process grows every seed while they fit in kBoltTimingMs at `boltMs` a bolt (the
+// median the measurement saw); slower bolts get k seeds a process, process r from seed r k + 1,
+// so that the processes together cover the seeds rather than time the first one thrice.
+constexpr double kBoltTimingMs = 300;
+size_t timeBolts(Run& run, const std::string& name, lt::Params p, int seeds, double boltMs);
 
 // The tv and fd metrics (the lightning and lightning3d sections).
 Metric tvMetric();

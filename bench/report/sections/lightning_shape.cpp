@@ -5,6 +5,8 @@
 // channel whose field ahead of the bolt falls far below double's range (DeepField). A bolt
 // that fills its channel scores in the hundreds. Each layout also gets a sheet: the first
 // seeds' DBM bolts above the calibrated fast method's.
+#include <optional>
+
 #include "lightning_common.h"
 #include "sections.h"
 
@@ -105,21 +107,33 @@ void measure(Run& run) {
                     ") and fast calibrated (below), seeds 1 to " + std::to_string(drawn);
     if (!l.params.depth) addObstacles(sheet, l.params.obstacles);
     const bool drawn_ = l.params.width > 3 && run.timed;
-    auto shapes = [&](lt::Params p, const char* label) {
-      std::vector<lt::BoltShape> v;
-      for (int seed = 1; seed <= seeds; ++seed) {
-        p.seed = uint64_t(seed);
-        auto b = lt::grow(p);
-        if (!b.ok()) continue;
-        v.push_back(lt::shapeOf(b.value(), p.width, p.height, p.depth));
-        if (label && drawn_ && seed <= drawn) addPanel(sheet, b.value(), std::string(label) + " seed " + std::to_string(seed));
+    // Each seed's bolt (grown on every core): its shape, and the median bolt's time.
+    struct Shapes {
+      std::vector<lt::BoltShape> shapes;
+      double ms = 0;
+    };
+    auto shapes = [&](const lt::Params& p, const char* label) {
+      std::vector<std::optional<lt::Bolt>> bolts(static_cast<size_t>(seeds));
+      onEveryCore(bolts.size(), [&](size_t j) {
+        lt::Params q = p;
+        q.seed = j + 1;
+        if (auto b = lt::grow(q); b.ok()) bolts[j] = std::move(b.value());
+      });
+      Shapes out;
+      std::vector<double> ms;
+      for (size_t j = 0; j < bolts.size(); ++j) {
+        if (!bolts[j]) continue;
+        out.shapes.push_back(lt::shapeOf(*bolts[j], p.width, p.height, p.depth));
+        ms.push_back(bolts[j]->stats.elapsedMs);
+        if (label && drawn_ && int(j) < drawn) addPanel(sheet, *bolts[j], std::string(label) + " seed " + std::to_string(j + 1));
       }
-      return v;
+      out.ms = quantile(ms, 0.5);
+      return out;
     };
     lt::Params ref = l.params;
     ref.method = lt::Method::kDbm;
     ref.tolerance = 1e-8;
-    const auto refShapes = shapes(ref, "dbm");
+    const Shapes refShapes = shapes(ref, "dbm");
     struct Setting {
       std::string series, setting;
       json request;
@@ -141,20 +155,21 @@ void measure(Run& run) {
       settings.push_back({"dbm-mgpcg", "tol " + fmt(tol, 1), {{"method", "dbm"}, {"solver", "mgpcg"}, {"tolerance", tol}}, d});
     }
     for (const Setting& s : settings) {
-      const auto methodShapes = shapes(s.params, s.series == "fast calibrated" ? "fast" : nullptr);
-      const auto d = lt::shapeDistance(methodShapes, refShapes);
+      const Shapes method = shapes(s.params, s.series == "fast calibrated" ? "fast" : nullptr);
+      const auto& methodShapes = method.shapes;
+      const auto d = lt::shapeDistance(methodShapes, refShapes.shapes);
       Row r;
       r.series = s.series + " " + l.name;
       r.setting = s.setting;
       r.group = l.name;
       r.request = s.request;
       // Fewer than two bolts on a side (failed growths) have no spread to measure against.
-      r.errors["shape"] = methodShapes.size() < 2 || refShapes.size() < 2 ? NAN : d.worst;
+      r.errors["shape"] = methodShapes.size() < 2 || refShapes.shapes.size() < 2 ? NAN : d.worst;
       r.note = fmt(d.mean.cells, 4) + " / " + fmt(d.refMean.cells, 4) + ", " + fmt(d.mean.tips, 3) + " / " +
                fmt(d.refMean.tips, 3) + ", " + fmt(d.mean.dimension, 3) + " / " + fmt(d.refMean.dimension, 3) + " (z " +
                fmt(d.cells, 2) + ", " + fmt(d.tips, 2) + ", " + fmt(d.dimension, 2) + "; " +
                std::to_string(methodShapes.size()) + " seeds)";
-      r.ticket = timeBolts(run, s.series + " " + s.setting + " " + l.name, s.params, seeds);
+      r.ticket = timeBolts(run, s.series + " " + s.setting + " " + l.name, s.params, seeds, method.ms);
       run.rows.push_back(r);
     }
     Row exact;
@@ -163,8 +178,8 @@ void measure(Run& run) {
     exact.group = l.name;
     exact.request = {{"method", "dbm"}, {"tolerance", 1e-8}};
     exact.errors["shape"] = 0;
-    exact.note = std::to_string(refShapes.size()) + " seeds";
-    exact.ticket = timeBolts(run, "dbm exact " + l.name, ref, seeds);
+    exact.note = std::to_string(refShapes.shapes.size()) + " seeds";
+    exact.ticket = timeBolts(run, "dbm exact " + l.name, ref, seeds, refShapes.ms);
     run.rows.push_back(exact);
     if (drawn_) run.sheets.push_back(std::move(sheet));
   }

@@ -95,7 +95,7 @@ void measure(Run& run) {
   ref.request = {{"reference", true}};
   ref.errors["meanDeltaE"] = 0;
   ref.note = "0; 0";
-  ref.ticket = run.time("render reference", [size, f = variants().back().features] {
+  ref.ticket = run.time("render reference", [size, f = variants().back().features](int) {
     effects::ThreadPool pool(2);
     std::vector<double> ms;
     for (int i = 0; i < 2; ++i)
