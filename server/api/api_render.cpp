@@ -29,16 +29,6 @@ RequestContext partContext(const RequestContext& ctx, const std::string& at) {
   return c;
 }
 
-// The scene's bubbles, "bubble" then each of "bubbles": (their bodies, their pointers).
-std::vector<std::pair<const json*, std::string>> sceneBubbles(const json& body) {
-  std::vector<std::pair<const json*, std::string>> out;
-  if (body.contains("bubble")) out.emplace_back(&body["bubble"], "/bubble");
-  if (body.contains("bubbles"))
-    for (size_t i = 0; i < body["bubbles"].size(); ++i)
-      out.emplace_back(&body["bubbles"][i]["bubble"], "/bubbles/" + std::to_string(i) + "/bubble");
-  return out;
-}
-
 JsonReply runScene(const SceneRequest& request, const json& body, const RequestContext& ctx) {
   JsonReply reply;
   reply.method = "scene";
@@ -62,11 +52,9 @@ JsonReply runScene(const SceneRequest& request, const json& body, const RequestC
                               "/lightning", "lightning");
   if (request.fog) out["fog"] = answer(runFog(*request.fog, body["fog"], partContext(ctx, "/fog")), "/fog", "fog");
   if (body.contains("bubbles")) out["bubbles"] = json::array();
-  const auto bubbles = sceneBubbles(body);
-  for (size_t i = 0; i < bubbles.size(); ++i) {
-    const auto& [bubble, at] = bubbles[i];
-    json part = answer(runBubble(request.bubbles[i], *bubble, partContext(ctx, at)), at, "bubble");
-    if (at == "/bubble")
+  for (const SceneBubble& b : request.bubbles) {
+    json part = answer(runBubble(b.request, body[json::json_pointer(b.at)], partContext(ctx, b.at)), b.at, "bubble");
+    if (b.at == "/bubble")
       out["bubble"] = std::move(part);
     else
       out["bubbles"].push_back(std::move(part));
@@ -86,8 +74,9 @@ rd::Reference traceReference(const RenderRequest& request, const rd::Scene& scen
                      "the reference traces " + std::to_string(rd::kReferenceWavelengths) +
                          " wavelengths per pixel: at most " + std::to_string(kMaxReferencePixels) + " pixels");
   auto r = rd::referenceRender(scene, ctx.parallel);
-  // Its one bubble may be the first of "bubbles".
-  if (!r.ok()) throwError(r.error(), "", {{"bubble", {body.contains("bubble") ? "/bubble" : "/bubbles/0/bubble"}}});
+  // Its one bubble, which may be the first of "bubbles" (none: the missing "/bubble").
+  const std::string at = request.scene.bubbles.empty() ? "/bubble" : request.scene.bubbles.front().at;
+  if (!r.ok()) throwError(r.error(), "", {{"bubble", {at}}});
   return std::move(r.value());
 }
 
@@ -165,11 +154,15 @@ SceneRequest parseSceneRequest(const json& body, const RequestContext& ctx) {
   if (body.contains("lightning"))
     r.lightning = parseLightningRequest(body["lightning"], partContext(ctx, "/lightning"));
   if (body.contains("fog")) r.fog = parseFogRequest(body["fog"], partContext(ctx, "/fog"));
-  for (const auto& [bubble, at] : sceneBubbles(body)) {
-    json lit = *bubble;
+  auto add = [&](const std::string& at, const std::string& styleAt) {
+    json lit = body[json::json_pointer(at)];
     if (body.contains("lights")) lit["lights"] = body["lights"];
-    r.bubbles.push_back(parseBubbleRequest(lit, partContext(ctx, at)));
-  }
+    r.bubbles.push_back({parseBubbleRequest(lit, partContext(ctx, at)), at, styleAt});
+  };
+  if (body.contains("bubble")) add("/bubble", "/bubbleStyle");
+  if (body.contains("bubbles"))
+    for (size_t i = 0; i < body["bubbles"].size(); ++i)
+      add("/bubbles/" + std::to_string(i) + "/bubble", "/bubbles/" + std::to_string(i));
   return r;
 }
 

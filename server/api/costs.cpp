@@ -122,7 +122,7 @@ Cost sceneCost(const SceneRequest& r, const Config& config) {
   Cost c{kBase, false};
   if (r.lightning) c += lightningCost(*r.lightning, config);
   if (r.fog) c += fogCost(*r.fog, config);
-  for (const BubbleRequest& b : r.bubbles) c += bubbleCost(b, config);
+  for (const SceneBubble& b : r.bubbles) c += bubbleCost(b.request, config);
   return c;
 }
 
@@ -144,7 +144,8 @@ Cost renderCost(const RenderRequest& r, const Config& config) {
   // Each bubble's thin-film table (float RGB, then 16F on the GPU) and, for the film, its
   // thickness texture rebuilt every frame on the render thread (~1 us per texel).
   size_t thicknessWork = 0;
-  for (const BubbleRequest& b : r.scene.bubbles) {
+  for (const SceneBubble& part : r.scene.bubbles) {
+    const BubbleRequest& b = part.request;
     c.bytes += texels(b.thinFilm.width, b.thinFilm.height, config) * 18;
     if (b.features.shading != effects::bubble::Shading::kFilm) continue;
     const size_t film = texels(b.film.width, b.film.height, config);

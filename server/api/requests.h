@@ -101,11 +101,17 @@ struct BubbleRequest {
 };
 
 // /v1/scene: the parts a scene has, each read by its endpoint's parser at its pointer.
+// One of a scene's bubbles, and where the body holds it.
+struct SceneBubble {
+  BubbleRequest request;  // lit by the scene's lights when it has them
+  std::string at;         // its body: "/bubble" or "/bubbles/<i>/bubble"
+  std::string styleAt;    // its style: "/bubbleStyle" or "/bubbles/<i>"
+};
+
 struct SceneRequest {
   std::optional<LightningRequest> lightning;
   std::optional<FogRequest> fog;
-  std::vector<BubbleRequest> bubbles;  // "bubble", then each of "bubbles"; lit by the scene's
-                                       // lights when it has them
+  std::vector<SceneBubble> bubbles;  // "bubble", then each of "bubbles": the one order of them
 };
 
 // /v1/render: the scene's parts, and the frame.

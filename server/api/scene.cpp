@@ -192,12 +192,15 @@ rd::Lightning sceneLightning(const LightningRequest& r, const json& body, Animat
   return l;
 }
 
-// A bubble (r: /v1/bubble's parser's, lit by the scene's lights when it has them; its body
-// `bj` at pointer `at`, its style at `styleAt`): mesh and thin-film table computed once here,
-// wobbled by the shader.
-rd::Bubble sceneBubble(const BubbleRequest& r, const json& bj, const json& style, const std::string& at,
-                       const std::string& styleAt, const RequestContext& ctx, double sceneTime) {
+// A bubble as /v1/bubble's parser read it, its body and style where the parser found them:
+// mesh and thin-film table computed once here, wobbled by the shader.
+rd::Bubble sceneBubble(const SceneBubble& part, const json& body, const RequestContext& ctx, double sceneTime) {
   const Config& config = ctx.config;
+  const BubbleRequest& r = part.request;
+  const std::string& at = part.at;
+  const json& bj = body[json::json_pointer(at)];
+  const json::json_pointer styleAt(part.styleAt);
+  const json style = body.contains(styleAt) ? body[styleAt] : json::object();
   rd::Bubble b;
   const double t = r.time.value_or(sceneTime);
   b.params = r.params;
@@ -231,7 +234,7 @@ rd::Bubble sceneBubble(const BubbleRequest& r, const json& bj, const json& style
   }
   if (style.contains("center") && !bj.contains("motion")) b.center = toVec3(style["center"]);
   if (style.contains("baseColor")) b.baseColor = rgba(style["baseColor"]);
-  if (style.contains("flowTexture")) b.flowTexture = image(style["flowTexture"], styleAt + "/flowTexture", config);
+  if (style.contains("flowTexture")) b.flowTexture = image(style["flowTexture"], part.styleAt + "/flowTexture", config);
   b.time = t;
   if (auto e = rd::prepareThickness(b, ctx.parallel)) throwError(*e, at);
   return b;
@@ -293,16 +296,7 @@ rd::Scene buildScene(const RenderRequest& request, const json& body, const Reque
   if (body.contains("surfaceWave")) s.wave = parseSurfaceWave(body["surfaceWave"], s.quads.size());
   if (parts.fog) s.fog = sceneFog(*parts.fog);
   if (parts.lightning) s.lightning = sceneLightning(*parts.lightning, body, animation, ctx.progress);
-  size_t k = 0;  // parts.bubbles: "bubble", then each of "bubbles"
-  if (body.contains("bubble"))
-    s.bubbles.push_back(sceneBubble(parts.bubbles.at(k++), body["bubble"], body.value("bubbleStyle", json::object()),
-                                    "/bubble", "/bubbleStyle", ctx, s.time));
-  if (body.contains("bubbles"))
-    for (size_t i = 0; i < body["bubbles"].size(); ++i) {
-      const json& item = body["bubbles"][i];
-      const std::string at = "/bubbles/" + std::to_string(i);
-      s.bubbles.push_back(sceneBubble(parts.bubbles.at(k++), item["bubble"], item, at + "/bubble", at, ctx, s.time));
-    }
+  for (const SceneBubble& b : parts.bubbles) s.bubbles.push_back(sceneBubble(b, body, ctx, s.time));
   if (animation)
     for (const rd::Bubble& b : s.bubbles) animation->bubbleTimes.push_back(b.time);
   if (computeMs) *computeMs = watch.ms();
