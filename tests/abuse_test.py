@@ -10,13 +10,18 @@ and prints what it measured; docs/reliability.md quotes these lines.
   pipelining  requests back to back on one connection, one refused with its body unread: all
               answered in order
   overload    2 x --max-connections trickling connections: a new connection gets 503 at once,
-              the admin port answers /healthz, /readyz and /metrics
+              the admin port answers /healthz, /readyz and /metrics; once the tricklers past the
+              limit are closed (1 s), the public /healthz answers past it too
   drain       SIGTERM with a trickling client and a request being computed: the computed one is
               answered, the trickler closed, the process gone well before the client would stop;
               past --shutdown-grace the process exits anyway
   quota       a key that cannot pay gets 429 before its 8 MiB body is read; invalid bodies are
               charged by size; an exhausted key hammering heavy and invalid requests leaves
               another key's latency and readiness alone; maxConcurrent bounds a key's share
+  streams     key A opens 80 job event streams against --max-connections 64: A holds its share
+              (--key-max-streams) and its excess gets 429, key B's requests and /healthz are all
+              200 meanwhile; without keys, one address's excess gets 429 and another address
+              streams and requests as usual
 """
 import hashlib
 import http.client
@@ -198,6 +203,14 @@ def overload(binary):
         print(f"      admin port with 32 tricklers: p50 {statistics.median(admin_times) * 1e3:.2f} ms, "
               f"max {max(admin_times) * 1e3:.2f} ms")
         check(max(admin_times) < 1.0, "the admin port answers under 1 s")
+        # The tricklers past the limit were read for 1 s only: then the public port answers
+        # /healthz past --max-connections again, and refuses the rest.
+        time.sleep(1.2)
+        past = [request(port, "GET", "/healthz", timeout=5)[0] for _ in range(10)]
+        fog = request(port, "POST", "/v1/fog", FOG, {"Content-Type": "application/json"}, timeout=5)[0]
+        print(f"      16 tricklers holding --max-connections: public /healthz {sorted(set(past))}, a fog table {fog}")
+        check(past == [200] * 10 and fog == 503,
+              "past --max-connections the public /healthz still answers 200, a fog table gets 503")
         for s in held:
             s.close()
         time.sleep(0.3)
@@ -420,9 +433,104 @@ def quota(binary):
         p.wait()
 
 
+def status_line(sock, timeout):
+    """The status of the answer on `sock` once its status line has come (None: none in time)."""
+    sock.settimeout(timeout)
+    got = b""
+    try:
+        while b"\r\n" not in got:
+            chunk = sock.recv(4096)
+            if not chunk:
+                break
+            got += chunk
+    except (socket.timeout, ConnectionResetError):
+        pass
+    return status_of(got)
+
+
+def open_streams(port, job, count, headers=b"", source="127.0.0.1"):
+    """`count` connections, each asking for the job's event stream at once: (sockets, statuses)."""
+    socks = []
+    for _ in range(count):
+        s = socket.create_connection(("127.0.0.1", port), source_address=(source, 0))
+        s.sendall(b"GET " + job.encode() + b"/events HTTP/1.1\r\nHost: x\r\n" + headers + b"\r\n")
+        socks.append(s)
+    return socks, [status_line(s, 10) for s in socks]
+
+
+def others_meanwhile(port, headers, source="127.0.0.1"):
+    """20 fog tables and 20 /healthz on one kept-alive connection from `source`: their statuses."""
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=30, source_address=(source, 0))
+    statuses = []
+    for path, body in (("/v1/fog", FOG), ("/healthz", None)) * 20:
+        c.request("POST" if body else "GET", path, body=body, headers={**headers, "Content-Type": "application/json"})
+        r = c.getresponse()
+        r.read()
+        statuses.append((path, r.status))
+    c.close()
+    return statuses
+
+
+def submit_job(port, headers):
+    body = json.dumps({"effect": "lightning", "request": json.loads(SLOW)}).encode()
+    status, answer_headers, data, _ = request(port, "POST", "/v1/jobs", body, {**headers, "Content-Type": "application/json"})
+    check(status == 202, f"a long job is accepted ({status} {data[:200]})")
+    return answer_headers.get("Location")
+
+
+def streams(binary):
+    work = tempfile.mkdtemp(prefix="effectd-streams.")
+    secrets = {"a": "stream-secret-a", "b": "stream-secret-b"}
+    keys = os.path.join(work, "keys.json")
+    with open(keys, "w") as f:
+        json.dump({"keys": [{"id": k, "sha256": hashlib.sha256(v.encode()).hexdigest(), "perMinute": 1e6,
+                             "burst": 1e6} for k, v in secrets.items()]}, f)
+    auth = {k: {"Authorization": "Bearer " + v} for k, v in secrets.items()}
+    p, port = effectd_process.start(binary, "--api-keys", keys, "--max-connections", "64", "--access-log", "0",
+                                    "--response-cache-mb", "0")
+    try:
+        job = submit_job(port, auth["a"])
+        socks, statuses = open_streams(port, job, 80, b"Authorization: Bearer stream-secret-a\r\n")
+        counts = {s: statuses.count(s) for s in sorted(set(statuses), key=str)}
+        print(f"      key A's 80 streams against --max-connections 64: {counts}")
+        check(statuses.count(200) == 8 and statuses.count(429) == 72,
+              "key A holds its 8 streams (--key-max-streams) and each of its other 72 gets 429")
+        others = others_meanwhile(port, auth["b"])
+        bad = [o for o in others if o[1] != 200]
+        print(f"      meanwhile key B: {len(others) - len(bad)} of {len(others)} fog tables and /healthz answered 200")
+        check(not bad, f"key B's fog tables and /healthz are all 200 while A holds its streams ({bad[:3]})")
+        _, _, metrics, _ = request(port, "GET", "/metrics")
+        check(b"effectd_streams_held 8" in metrics and b'effectd_streams_refused_total{reason="client"} 72' in metrics,
+              "/metrics counts the streams held and the refused")
+        for s in socks:
+            s.close()
+    finally:
+        p.terminate()
+        p.wait()
+    # Without keys: an address's share, and another address alongside it.
+    p, port = effectd_process.start(binary, "--max-connections", "64", "--access-log", "0", "--response-cache-mb", "0")
+    try:
+        job = submit_job(port, {})
+        socks, statuses = open_streams(port, job, 80)
+        counts = {s: statuses.count(s) for s in sorted(set(statuses), key=str)}
+        print(f"      127.0.0.1's 80 streams without keys: {counts}")
+        check(statuses.count(200) == 8 and statuses.count(429) == 72,
+              "one address holds 8 streams (--max-streams-per-address) and each of its other 72 gets 429")
+        mine, mine_statuses = open_streams(port, job, 2, source="127.0.0.2")
+        check(mine_statuses == [200, 200], f"another address still gets its streams ({mine_statuses})")
+        others = others_meanwhile(port, {}, "127.0.0.2")
+        bad = [o for o in others if o[1] != 200]
+        check(not bad, f"... and its fog tables and /healthz are all 200 ({bad[:3]})")
+        for s in socks + mine:
+            s.close()
+    finally:
+        p.terminate()
+        p.wait()
+
+
 def main():
     binary = sys.argv[1]
-    for probe in (trickle, pipelining, overload, drain, quota):
+    for probe in (trickle, pipelining, overload, drain, quota, streams):
         print(f"-- {probe.__name__}", flush=True)
         probe(binary)
     if failures:

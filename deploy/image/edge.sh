@@ -9,7 +9,7 @@
 # with effectd's status. If either exits on its own, the other is stopped and the container
 # exits non-zero, for the runtime to restart it.
 set -u
-/usr/local/bin/effectd serve --host=127.0.0.1 --port=8081 --admin-host=0.0.0.0 --admin-port=9090 \
+/usr/local/bin/effectd serve --host=127.0.0.1 --port=8081 --admin-host=0.0.0.0 --admin-port=9090 --max-streams-per-address=0 \
   --playground=off "$@" &
 effectd=$!
 /usr/sbin/nginx -p /tmp/ -e stderr -c /etc/effectd-edge/nginx.conf -g 'daemon off;' &

@@ -16,7 +16,7 @@ cleanup() {
 trap cleanup EXIT
 
 start_effectd() {  # $1 = name; the port is read from its log by port_of
-  "$bin" --port 0 --threads 4 --access-log 0 >/dev/null 2>"$work/$1.log" &
+  "$bin" --port 0 --threads 4 --access-log 0 --max-streams-per-address 0 >/dev/null 2>"$work/$1.log" &
   pids+=($!)
 }
 port_of() {

@@ -193,6 +193,18 @@ const std::vector<Option>& options() {
        "an API key's requests in progress at once on this replica; more get 429 before their body is read (the key "
        "file's maxConcurrent wins) (default 8)",
        intField(&Config::keyMaxConcurrent, 1, 100000)},
+      {"key-max-streams", "EFFECTD_KEY_MAX_STREAMS",
+       "an API key's job event streams held at once on this replica; more get 429 (the key file's maxStreams wins) "
+       "(default 8)",
+       intField(&Config::keyMaxStreams, 1, 100000)},
+      {"max-streams-per-address", "EFFECTD_MAX_STREAMS_PER_ADDRESS",
+       "job event streams one client address holds at once when it sends no API key; more get 429; 0 = no limit, "
+       "for a server behind a proxy that limits them, which all its clients reach it through (default 8)",
+       intField(&Config::maxStreamsPerAddress, 0, 100000)},
+      {"max-streams", "EFFECTD_MAX_STREAMS",
+       "job event streams held at once in all, each holding a connection and its thread; more get 503; 0 = a "
+       "quarter of --max-connections (default 0)",
+       intField(&Config::maxStreams, 0, 65536)},
       {"job-workers", "EFFECTD_JOB_WORKERS", "jobs (POST /v1/jobs, Prefer: respond-async) running at once (default 1)",
        intField(&Config::jobWorkers, 1, 64)},
       {"max-job-grid-cells", "EFFECTD_MAX_JOB_GRID_CELLS",

@@ -51,6 +51,12 @@ struct Config {
   std::string apiKeysFile;               // "" = no API keys: the service is open
   std::string quotaRedis;                // redis://host:port: quotas shared by replicas; "" = per process
   int keyMaxConcurrent = 8;              // an API key's requests in progress at once (per replica)
+  // Event streams (GET /v1/jobs/{id}/events) held at once (http/streams.h): an API key's (the
+  // key file's maxStreams wins), a keyless client address's (0 = no limit: behind a proxy that
+  // limits them), and all of them (0 = a quarter of maxConnections).
+  int keyMaxStreams = 8;
+  int maxStreamsPerAddress = 8;
+  int maxStreams = 0;
   // Jobs (POST /v1/jobs, Prefer: respond-async; server/http/jobs.h): the work's own limits.
   int jobWorkers = 1;                    // jobs running at once
   size_t maxJobGridCells = size_t(1024) * 1024;        // dbm and charges grids in a job (2-D)

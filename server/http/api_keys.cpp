@@ -66,6 +66,12 @@ std::string ApiKeys::read(const std::string& path, std::vector<ApiKey>& keys) {
         return at + "/maxConcurrent must be an integer from 1 to 100000";
       key.maxConcurrent = k["maxConcurrent"].get<int>();
     }
+    if (k.contains("maxStreams")) {
+      if (!k["maxStreams"].is_number_integer() || k["maxStreams"].get<long long>() < 1 ||
+          k["maxStreams"].get<long long>() > 100000)
+        return at + "/maxStreams must be an integer from 1 to 100000";
+      key.maxStreams = k["maxStreams"].get<int>();
+    }
     if (!ids.insert(key.id).second) return at + "/id repeats the id '" + key.id + "'";
     if (!hashes.insert(key.sha256).second) return at + "/sha256 repeats another key's secret";
     keys.push_back(std::move(key));

@@ -4,7 +4,9 @@
 //              "endpoints": ["/v1/fog", "/v1/lightning"], "maxConcurrent": 4}]}
 // perMinute and burst are quota units (quota.h); endpoints is optional (absent = all);
 // maxConcurrent is optional (absent = --key-max-concurrent): the key's requests in progress at
-// once on one replica, so that one key cannot fill the admission queue and heavy slots.
+// once on one replica, so that one key cannot fill the admission queue and heavy slots;
+// maxStreams is optional (absent = --key-max-streams): its job event streams at once
+// (http/streams.h).
 #pragma once
 
 #include <memory>
@@ -21,6 +23,7 @@ struct ApiKey {
   double perMinute = 0, burst = 0;
   std::vector<std::string> endpoints;  // empty = every endpoint
   int maxConcurrent = 0;               // 0 = the server's --key-max-concurrent
+  int maxStreams = 0;                  // job event streams at once; 0 = the server's --key-max-streams
 
   bool allows(const std::string& path) const;
 };

@@ -22,6 +22,7 @@ using Clock = std::chrono::steady_clock;
 
 thread_local bool closeAfterAnswer_ = false;  // EdgeServer::closeAfterThisAnswer()
 thread_local size_t unreadBody_ = 0;          // EdgeServer::skipUnreadBody()
+thread_local bool overCapacityHere_ = false;  // EdgeServer::overCapacity()
 
 // Waits until `sock` is ready for `events` or `deadline` passes; false on timeout or error.
 bool waitFor(int sock, short events, Clock::time_point deadline) {
@@ -174,6 +175,16 @@ class DeadlineStream final : public httplib::Stream {
 
 void EdgeServer::closeAfterThisAnswer() { closeAfterAnswer_ = true; }
 void EdgeServer::skipUnreadBody(size_t bytes) { unreadBody_ = bytes; }
+bool EdgeServer::overCapacity() { return overCapacityHere_; }
+
+ApiError EdgeServer::overCapacityProblem() {
+  return {503,
+          "overloaded",
+          "Service Unavailable",
+          "the server holds all the connections it serves at once (--max-connections)",
+          {},
+          {{"Retry-After", "1"}, {"Cache-Control", "no-store"}, {"Connection", "close"}}};
+}
 
 bool EdgeServer::waitForRequest(socket_t sock) const {
   // Polled in short steps, as cpp-httplib's keep-alive wait, so that a stop is seen.
@@ -187,26 +198,42 @@ bool EdgeServer::waitForRequest(socket_t sock) const {
 
 bool EdgeServer::process_and_close_socket(socket_t sock) {
   const auto writeTimeout = std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_);
-  bool refuse = false, draining = false;
+  bool refuse = false, draining = false, over = false;
   {
     std::lock_guard lock(mu_);
     draining = draining_;
-    refuse = draining || open_.size() >= maxConnections_;
-    if (!refuse) open_.insert(sock);
+    over = !draining && open_.size() >= maxConnections_;
+    refuse = draining || (over && overCapacityNow_ >= kOverCapacityConnections);
+    if (!refuse && !over) open_.insert(sock);
+    if (over && !refuse) ++overCapacityNow_;  // not among the open: they stay maxConnections
   }
   if (refuse) {
     ++refused_;
-    sendAll(sock,
-            rawProblem({503,
-                        "overloaded",
-                        "Service Unavailable",
-                        draining ? "the server is shutting down" : "the server holds all the connections it serves "
-                                                                   "at once (--max-connections)",
-                        {},
-                        {{"Retry-After", "1"}, {"Cache-Control", "no-store"}}}),
-            Clock::now() + writeTimeout);
+    ApiError problem = overCapacityProblem();
+    if (draining) problem.detail = "the server is shutting down";
+    problem.headers.erase("Connection");  // rawProblem says it
+    sendAll(sock, rawProblem(problem), Clock::now() + writeTimeout);
     closeAfterAnswer(sock);
     return true;
+  }
+  if (over) {  // one request, read quickly; answered as overCapacity() says, then closed
+    ++overCapacity_;
+    DeadlineStream stream(sock, writeTimeout);
+    stream.startRequest(Clock::now() + std::chrono::milliseconds(kOverCapacityReadMs));
+    bool closed = false;
+    overCapacityHere_ = true;
+    const bool ok = process_request(stream, true, closed, nullptr);
+    overCapacityHere_ = false;
+    closeAfterAnswer_ = false;
+    unreadBody_ = 0;
+    tl = RequestState{};
+    if (stream.timedOut()) ++timedOut_;
+    {
+      std::lock_guard lock(mu_);
+      --overCapacityNow_;
+    }
+    closeAfterAnswer(sock);
+    return ok;
   }
 
   DeadlineStream stream(sock, writeTimeout);
@@ -255,7 +282,7 @@ void EdgeServer::drain() {
 
 EdgeServer::Counts EdgeServer::counts() const {
   std::lock_guard lock(mu_);
-  return {open_.size(), refused_.load(), timedOut_.load(), drained_.load()};
+  return {open_.size(), refused_.load(), timedOut_.load(), drained_.load(), overCapacity_.load()};
 }
 
 std::string EdgeServer::metricsText() const {
@@ -267,7 +294,10 @@ std::string EdgeServer::metricsText() const {
          "idle or sending at shutdown (drained).\n# TYPE effectd_connections_closed_total counter\n"
          "effectd_connections_closed_total{reason=\"refused\"} " + std::to_string(c.refused) + "\n" +
          "effectd_connections_closed_total{reason=\"request-timeout\"} " + std::to_string(c.timedOut) + "\n" +
-         "effectd_connections_closed_total{reason=\"drained\"} " + std::to_string(c.drained) + "\n";
+         "effectd_connections_closed_total{reason=\"drained\"} " + std::to_string(c.drained) + "\n" +
+         "# HELP effectd_connections_over_capacity_total Connections past --max-connections read for one request "
+         "(health and readiness answered, the rest refused).\n# TYPE effectd_connections_over_capacity_total counter\n"
+         "effectd_connections_over_capacity_total " + std::to_string(c.overCapacity) + "\n";
 }
 
 }  // namespace effectd

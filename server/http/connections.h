@@ -6,7 +6,10 @@
 // owns the rest:
 //   - a request's headers and body must all arrive within the read timeout, counted from its
 //     first byte: otherwise a 408 problem, and the connection is closed;
-//   - past `maxConnections` open connections a new one gets a 503 problem at once and is closed;
+//   - past `maxConnections` open connections, up to kOverCapacityConnections more at once are read for
+//     one request each within kOverCapacityReadMs and closed after its answer: health and
+//     readiness are answered, a client over its own share hears 429 (an event stream: streams.h),
+//     anything else 503 (overCapacity()); past those, a new connection gets a 503 at once;
 //   - drain() (SIGTERM) closes every connection that is idle or still sending its request; a
 //     request whose answer is being computed finishes and is answered, then its connection closes.
 #pragma once
@@ -17,6 +20,8 @@
 #include <cstdint>
 #include <mutex>
 #include <set>
+
+#include "contract/problem.h"
 
 namespace effectd {
 
@@ -33,11 +38,17 @@ class EdgeServer : public httplib::Server {
   // that follow its headers are skipped before the next request on the connection (a body
   // over kMaxSkippedBody closes the connection instead).
   static void skipUnreadBody(size_t bytes);
+  // Whether this thread's request came on a connection past maxConnections: only health,
+  // readiness and a client's own refusal are answered there, the rest get overCapacityProblem().
+  static bool overCapacity();
+  static ApiError overCapacityProblem();
+  static constexpr int kOverCapacityReadMs = 1000;
   static constexpr size_t kMaxSkippedBody = 64 << 10;
 
   struct Counts {
     size_t open = 0;
     uint64_t refused = 0;   // over maxConnections, or draining: 503 at once
+    uint64_t overCapacity = 0;  // past maxConnections, read for one request (health, a refusal)
     uint64_t timedOut = 0;  // a request not received within the read timeout: 408
     uint64_t drained = 0;   // closed by drain() while idle or sending
   };
@@ -54,10 +65,14 @@ class EdgeServer : public httplib::Server {
   mutable std::mutex mu_;
   std::set<socket_t> open_;
   bool draining_ = false;
-  std::atomic<uint64_t> refused_{0}, timedOut_{0}, drained_{0};
+  size_t overCapacityNow_ = 0;  // connections being read past maxConnections (under mu_)
+  std::atomic<uint64_t> refused_{0}, timedOut_{0}, drained_{0}, overCapacity_{0};
 };
 
-// Threads a listener needs beyond one per connection: the ones that answer 503 past the limit.
-constexpr size_t kRefusalThreads = 16;
+// Connections past maxConnections read for one request at once (health, a client's refusal).
+constexpr size_t kOverCapacityConnections = 16;
+// Threads a listener needs beyond one per connection: those, and the ones that answer 503 at once
+// past them.
+constexpr size_t kRefusalThreads = kOverCapacityConnections + 16;
 
 }  // namespace effectd

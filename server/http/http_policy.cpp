@@ -234,6 +234,12 @@ bool Service::preRoute(const httplib::Request& req, httplib::Response& res) {
                  {},
                  {{"Allow", allow}}});
   }
+  // Past --max-connections (connections.h): health and readiness are answered, and an event
+  // stream is checked against its client's share (429) before it is refused; nothing else is.
+  const bool events = route->jobs && req.method == "GET" && req.path.size() > 7 &&
+                      req.path.compare(req.path.size() - 7, 7, "/events") == 0;
+  if (EdgeServer::overCapacity() && route->path != "/healthz" && route->path != "/readyz" && !events)
+    return fail(EdgeServer::overCapacityProblem());
   const bool effect = route->json || !route->binary.empty();
   if (effect && req.method != "POST" && req.target.size() > config_.limits.maxUrlBytes)
     return fail({414,

@@ -17,6 +17,7 @@
 #include "http/request_state.h"
 #include "http/route.h"
 #include "http/service.h"
+#include "http/streams.h"
 
 namespace effectd {
 
@@ -222,6 +223,17 @@ void Service::answerJobStatus(const httplib::Request& req, httplib::Response& re
 }
 
 void Service::answerJobEvents(const httplib::Request& req, httplib::Response& res) {
+  // A stream holds its connection and thread while the job runs: one of the client's share
+  // first (http/streams.h), and none at all on a connection past --max-connections.
+  std::shared_ptr<void> place;
+  const std::string client = tl.key ? "key " + tl.key->id : "address " + req.remote_addr;
+  const int most = tl.key ? (tl.key->maxStreams > 0 ? tl.key->maxStreams : config_.keyMaxStreams)
+                          : config_.maxStreamsPerAddress;
+  const std::string whose = tl.key ? "the key '" + tl.key->id + "' (" +
+                                         (tl.key->maxStreams > 0 ? "its maxStreams" : "--key-max-streams") + ")"
+                                   : "the address " + req.remote_addr + " (--max-streams-per-address)";
+  if (auto problem = streams_->enter(client, most, whose, place)) return writeProblem(res, *problem, tl.requestId);
+  if (EdgeServer::overCapacity()) return writeProblem(res, EdgeServer::overCapacityProblem(), tl.requestId);
   auto first = jobOf(req, res);
   if (!first) return;
   // One event per change: "progress" while queued or running, then one named by the final
@@ -231,7 +243,7 @@ void Service::answerJobEvents(const httplib::Request& req, httplib::Response& re
   const std::string id = first->id;
   auto last = std::make_shared<uint64_t>(~uint64_t(0));
   auto quiet = std::make_shared<int>(0);
-  res.set_chunked_content_provider("text/event-stream", [this, id, last, quiet](size_t, httplib::DataSink& sink) {
+  res.set_chunked_content_provider("text/event-stream", [this, id, last, quiet, place](size_t, httplib::DataSink& sink) {
     std::optional<JobView> v;
     try {
       v = *last == ~uint64_t(0) ? jobs_->find(id) : jobs_->waitForChange(id, *last, std::chrono::milliseconds(1000));

@@ -21,6 +21,7 @@
 #include "http/access.h"
 #include "http/connections.h"
 #include "http/elastic_pool.h"
+#include "http/streams.h"
 #include "http/encoding.h"
 #include "http/etag.h"
 #include "http/request_state.h"
@@ -219,6 +220,8 @@ Service::Service(Config config)
       http_(std::make_unique<EdgeServer>(config_.maxConnections)),
       compute_(std::make_unique<effects::ThreadPool>(effects::ThreadPool::besideCaller())),
       access_(std::make_unique<Access>(config_)),
+      streams_(std::make_unique<Streams>(config_.maxStreams > 0 ? config_.maxStreams
+                                                                : std::max(1, config_.maxConnections / 4))),
       idleTrim_(std::make_unique<IdleTrim>([this] { return admission_->counts().reservedBytes == 0; })) {
   std::map<std::string, std::string> docs;
   for (const auto& [name, data] : resources())
@@ -228,6 +231,7 @@ Service::Service(Config config)
   installHttpPolicy();
   installJobs();
   metrics_.addSource([this] { return access_->metricsText(); });
+  metrics_.addSource([this] { return streams_->metricsText(); });
   metrics_.addSource([this] {
     return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
            "# TYPE effectd_memory_trims_total counter\n"

@@ -42,6 +42,7 @@ namespace effectd {
 
 class Access;
 class EdgeServer;
+class Streams;
 
 // Server-Timing entries (name;dur=ms), in order.
 using Stages = std::vector<std::pair<std::string, double>>;
@@ -206,6 +207,7 @@ class Service {
   std::thread adminThread_;
   std::unique_ptr<effects::ThreadPool> compute_;  // shared by every request's parallel steps
   std::unique_ptr<Access> access_;                // who may ask, and how much
+  std::unique_ptr<Streams> streams_;              // who holds the job event streams
   std::unique_ptr<IdleTrim> idleTrim_;
   int listenSocket_ = -1;  // the socket bind() made, so that its backlog can be raised
   int adminPort_ = 0;
