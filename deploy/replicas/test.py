@@ -62,6 +62,14 @@ def fog(i):
     return {"fog": {"fogType": "GL_EXP2", "density": 0.01 + 0.001 * i}, "table": {"size": 64}}
 
 
+def readiness(port):
+    """A replica's /readyz on its admin port: (status, its JSON)."""
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+    c.request("GET", "/readyz")
+    r = c.getresponse()
+    return r.status, json.loads(r.read())
+
+
 def metric(port, pattern):
     """A counter from a replica's /metrics, on its admin port."""
     c = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
@@ -203,6 +211,10 @@ def main():
             check(get(conn, path).status == 404, f"E: {path} is not served through nginx")
         conn = http.client.HTTPConnection("127.0.0.1", admin[ports[0]], timeout=10)
         check(get(conn, "/metrics").status == 200, "E: a replica's admin port serves /metrics")
+        status, ready = readiness(admin[ports[0]])
+        check(status == 200 and ready["status"] == "ready" and ready["components"].get("jobStore") == "ready"
+              and ready["components"].get("quotaStore") == "ready",
+              "E: /readyz names the job store and the quota store, both ready", ready)
         conn = http.client.HTTPConnection("127.0.0.1", ports[0], timeout=10)
         check(get(conn, "/metrics").status == 404, "E: a replica's public port does not")
         slow = []
@@ -351,6 +363,15 @@ def main():
         check(statuses == [200] * 5 and fallbacks >= 5,
               f"D: Redis stopped: keyed requests answered from per-replica buckets ({fallbacks:.0f} local charges)",
               statuses)
+        live = [p for i, p in enumerate(ports) if procs[f"effectd{i}"].poll() is None]
+        status, ready = readiness(admin[live[0]])
+        check(status == 200 and ready["status"] == "degraded" and
+              ready["components"]["jobStore"].startswith("degraded: --jobs-redis unreachable") and
+              ready["components"]["quotaStore"].startswith("degraded: --quota-redis unreachable"),
+              "D: ... /readyz stays 200, says degraded and names both stores", ready)
+        check(metric(admin[live[0]], 'effectd_store_failures_total{store="jobs"}') > 0 and
+              metric(admin[live[0]], 'effectd_store_failures_total{store="quota"}') > 0,
+              "D: ... and /metrics counts the stores' failed exchanges")
         c.request("GET", job, headers=keyed)
         r = c.getresponse()
         raw = r.read()

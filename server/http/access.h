@@ -59,6 +59,11 @@ class Access {
   std::string reload();
   std::string metricsText() const;
   bool open() const { return !signingOn_ && !keysOn_; }
+  // Whether the quotas are shared through Redis (keys on and --quota-redis), its state for
+  // /readyz ("" = answering) and its failed exchanges.
+  bool sharedQuota() const { return keysOn_ && quota_.shared(); }
+  std::string quotaStoreProblem() const { return quota_.storeProblem(); }
+  uint64_t quotaStoreFailures() const { return quota_.storeFailures(); }
 
  private:
   void refused(const std::string& reason);

@@ -97,6 +97,10 @@ class Jobs {
   virtual void stop() = 0;
   virtual std::string metricsText() const = 0;
   virtual bool shared() const = 0;
+  // The shared store's state for /readyz ("" = answering; in this process, always), and its
+  // failed exchanges for /metrics.
+  virtual std::string storeProblem() { return ""; }
+  virtual uint64_t storeFailures() const { return 0; }
 };
 
 }  // namespace effectd

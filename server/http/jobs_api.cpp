@@ -97,6 +97,11 @@ void Service::installJobs() {
   jobs_ = config_.jobsRedis.empty() ? Jobs::inProcess(o, std::move(runner))
                                     : Jobs::inRedis(o, std::move(runner), config_.jobsRedis);
   metrics_.addSource([this] { return jobs_->metricsText(); });
+  if (jobs_->shared())  // --jobs-redis: synchronous requests go on without it, jobs do not
+    addDegradedCheck("jobStore", [this] {
+      const std::string why = jobs_->storeProblem();
+      return why.empty() ? why : "--jobs-redis " + why + ": jobs answer 503 until it is back";
+    });
 
   auto route = [this](const std::string& path, std::vector<std::string> methods) {
     auto r = std::make_unique<Route>();

@@ -324,6 +324,12 @@ class RedisJobs final : public Jobs {
   }
 
   bool shared() const override { return true; }
+  // From the last exchanges, without one of its own: the heartbeat talks to Redis every
+  // kHeartbeat, and a probe must answer within its timeout (a blackholed Redis takes 2 s).
+  std::string storeProblem() override {
+    return work_.lastFailed() || control_.lastFailed() ? "unreachable at " + work_.address() : "";
+  }
+  uint64_t storeFailures() const override { return control_.failures() + work_.failures(); }
 
  private:
   long long ttlMs() const { return static_cast<long long>(o_.ttl.count()) * 1000; }

@@ -70,6 +70,8 @@ class Quota::Redis {
     return std::make_pair(r->items[0].integer == 1, tokens);
   }
 
+  RedisClient& client() { return client_; }
+
  private:
   RedisClient client_;
 };
@@ -79,6 +81,9 @@ Quota::Quota(const std::string& redisUrl) {
 }
 
 Quota::~Quota() = default;
+
+std::string Quota::storeProblem() const { return redis_ ? redis_->client().problem() : std::string(); }
+uint64_t Quota::storeFailures() const { return redis_ ? redis_->client().failures() : 0; }
 
 QuotaDecision Quota::charge(const ApiKey& key, double units, double need) {
   need = std::min(need, key.burst);

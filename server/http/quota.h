@@ -48,6 +48,10 @@ class Quota {
   };
   Counts counts() const;
   bool shared() const { return redis_ != nullptr; }
+  // The shared store's state for /readyz ("" = answering, or not shared), and its failed
+  // exchanges for /metrics.
+  std::string storeProblem() const;
+  uint64_t storeFailures() const;
 
  private:
   struct Bucket {

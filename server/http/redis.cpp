@@ -41,11 +41,21 @@ std::optional<RedisReply> RedisClient::command(const std::vector<std::string>& a
   if ((fd_ >= 0 || connect()) && send(request) && readReply(reply, 0)) {
     buffer_.erase(0, read_);
     read_ = 0;
+    lastFailed_ = false;
     return reply;
   }
   disconnect();
   retryAt_ = now + retry_;
+  ++failures_;
+  lastFailed_ = true;
   return std::nullopt;
+}
+
+std::string RedisClient::problem() {
+  const auto r = command({"PING"});
+  if (!r) return "unreachable at " + address();
+  if (r->type == RedisReply::Type::kError) return "answers " + r->text;
+  return "";
 }
 
 bool RedisClient::connect() {

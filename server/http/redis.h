@@ -7,7 +7,9 @@
 // so that an unreachable Redis costs a caller one timeout per `retry`, not one per command.
 #pragma once
 
+#include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -35,6 +37,13 @@ class RedisClient {
   // The reply (an error reply included: Type::kError), or nullopt when Redis could not be
   // reached, did not answer within the timeout, or answered what is not RESP.
   std::optional<RedisReply> command(const std::vector<std::string>& args);
+  // "" when Redis answers PING now, else why not (for /readyz: it waits up to the timeout).
+  std::string problem();
+  // Whether the last exchange failed, and where Redis is: a state to read without waiting.
+  bool lastFailed() const { return lastFailed_.load(); }
+  std::string address() const { return host_ + ":" + port_; }
+  // Exchanges that failed since start (Redis away, slow or not speaking RESP): /metrics.
+  uint64_t failures() const { return failures_.load(); }
 
  private:
   bool connect();
@@ -50,6 +59,8 @@ class RedisClient {
   size_t read_ = 0;  // bytes of buffer_ consumed
   int fd_ = -1;
   std::chrono::steady_clock::time_point retryAt_;
+  std::atomic<uint64_t> failures_{0};
+  std::atomic<bool> lastFailed_{false};
 };
 
 }  // namespace effectd

@@ -167,16 +167,22 @@ void encodeAnswer(Coding coding, CachedAnswer& answer) {
 
 using Probes = std::vector<std::pair<std::string, std::function<std::string()>>>;
 
-// /readyz: each component "ready" or why not (503 when one is not), and the info values.
-void answerReadiness(const Probes& readiness, const Probes& info, httplib::Response& res) {
+// /readyz: each component "ready" or why not (503 when a readiness one is not; 200 and
+// "degraded" when only a degraded one is not), and the info values.
+void answerReadiness(const Probes& readiness, const Probes& degraded, const Probes& info, httplib::Response& res) {
   json components = json::object();
-  bool ready = true;
+  bool ready = true, whole = true;
   for (const auto& [name, probe] : readiness) {
     std::string why = probe();
     components[name] = why.empty() ? json("ready") : json(why);
     ready = ready && why.empty();
   }
-  json out = {{"status", ready ? "ready" : "not ready"}, {"components", components}};
+  for (const auto& [name, probe] : degraded) {
+    std::string why = probe();
+    components[name] = why.empty() ? json("ready") : json("degraded: " + why);
+    whole = whole && why.empty();
+  }
+  json out = {{"status", !ready ? "not ready" : whole ? "ready" : "degraded"}, {"components", components}};
   for (const auto& [name, value] : info) out["info"][name] = value();
   res.status = ready ? 200 : 503;
   res.set_content(out.dump(), "application/json");
@@ -233,6 +239,21 @@ Service::Service(Config config)
   metrics_.addSource([this] { return access_->metricsText(); });
   metrics_.addSource([this] { return streams_->metricsText(); });
   metrics_.addSource([this] {
+    std::string out =
+        "# HELP effectd_store_failures_total Exchanges with a shared store (Redis) that failed: unreachable, slow "
+        "or not speaking RESP.\n# TYPE effectd_store_failures_total counter\n";
+    if (jobs_->shared()) out += "effectd_store_failures_total{store=\"jobs\"} " + std::to_string(jobs_->storeFailures()) + "\n";
+    if (access_->sharedQuota())
+      out += "effectd_store_failures_total{store=\"quota\"} " + std::to_string(access_->quotaStoreFailures()) + "\n";
+    return out;
+  });
+  if (access_->sharedQuota()) {  // keys on and --quota-redis (each process keeps its own buckets while it is away)
+    addDegradedCheck("quotaStore", [this] {
+      const std::string why = access_->quotaStoreProblem();
+      return why.empty() ? why : "--quota-redis " + why + ": each replica holds keys to its own quota";
+    });
+  }
+  metrics_.addSource([this] {
     return "# HELP effectd_memory_trims_total Times freed memory went back to the system (idle_trim.h).\n"
            "# TYPE effectd_memory_trims_total counter\n"
            "effectd_memory_trims_total " +
@@ -285,7 +306,7 @@ void Service::installCore() {
     res.set_content("{\"status\":\"ok\"}", "application/json");
   };
   const httplib::Server::Handler readyz = [this](const httplib::Request&, httplib::Response& res) {
-    answerReadiness(readiness_, info_, res);
+    answerReadiness(readiness_, degraded_, info_, res);
   };
   const httplib::Server::Handler metrics = [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics_.render(), "text/plain; version=0.0.4; charset=utf-8");
@@ -360,6 +381,10 @@ void Service::addReadinessCheck(const std::string& name, std::function<std::stri
 void Service::setEtagSalt(const std::string& path, std::function<std::string()> salt) {
   for (auto& r : routes_)
     if (r->path == path) r->etagSalt = std::move(salt);
+}
+
+void Service::addDegradedCheck(const std::string& name, std::function<std::string()> probe) {
+  degraded_.emplace_back(name, std::move(probe));
 }
 
 void Service::addReadinessInfo(const std::string& name, std::function<std::string()> value) {

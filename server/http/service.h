@@ -143,6 +143,9 @@ class Service {
                  const std::string& scriptOrigin = "");
   // A component that must be up for /readyz; `probe` returns "" when ready, else why not.
   void addReadinessCheck(const std::string& name, std::function<std::string()> probe);
+  // A component the service works without, less well (a shared store: jobs and quotas): /readyz
+  // stays 200, says "degraded" and names it while `probe` says why.
+  void addDegradedCheck(const std::string& name, std::function<std::string()> probe);
   // Responses carry a strong ETag: SHA-256 of the version, the route, the canonical request
   // and `salt()` (e.g. the renderer, when the answer depends on it); If-None-Match -> 304.
   void setEtagSalt(const std::string& path, std::function<std::string()> salt);
@@ -213,7 +216,7 @@ class Service {
   int adminPort_ = 0;
   std::atomic<bool> stopping_{false};
   std::vector<std::unique_ptr<Route>> routes_;
-  std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, info_;
+  std::vector<std::pair<std::string, std::function<std::string()>>> readiness_, degraded_, info_;
   Config jobConfig_;            // config_ with the job limits in place of the request limits
   std::unique_ptr<Jobs> jobs_;  // last: its workers stop before what they use goes
 };
