@@ -10,7 +10,7 @@ baking tool would call it. Each probe asserts what must hold and prints what it 
              its events: progress with a fraction that never falls, then "done"; the answer has
              the bolt; a job over the job limit is refused when submitted, naming /request/grid
   cancel     DELETE on a running bolt: cancelled within the request, its reservation returned;
-             its result 409; a finished job deleted is gone (404)
+             its result 409; a finished job deleted is gone (410; an id never made: 404)
   problems   an unknown effect, an invalid request (its pointer under /request), a wrong method,
              a request over --job-store-mb
   keys       a key's jobs at once are bounded (429), another key cannot see them (404), the
@@ -177,8 +177,11 @@ def limits_cancel_problems(binary):
                                      json.dumps({"effect": "fog", "request": {"fog": {"fogType": "GL_LINEAR"}}}))
         done = wait_done(port, headers["Location"])
         d_status, _, _ = request(port, "DELETE", headers["Location"])
-        g_status, _, _ = request(port, "GET", headers["Location"])
-        check(done["state"] == "done" and d_status == 204 and g_status == 404, "a finished job deleted is gone",
+        g_status, _, g_body = request(port, "GET", headers["Location"])
+        off = headers["Location"][:-1] + ("0" if headers["Location"][-1] != "0" else "1")  # an id never made
+        check(request(port, "GET", off)[0] == 404, "an id one digit off a job's (never made): 404")
+        check(done["state"] == "done" and d_status == 204 and g_status == 410 and b"no longer here" in g_body,
+              "a finished job deleted is gone: 410 saying why, not 404",
               (done["state"], d_status, g_status))
 
         # Problems.
@@ -197,6 +200,7 @@ def limits_cancel_problems(binary):
         check(status == 503 and b"--job-store-mb" in body, "a request larger than --job-store-mb: 503 naming it", status)
         status, _, _ = request(port, "GET", "/v1/jobs/0123456789abcdef")
         check(status == 404, "an unknown job: 404", status)
+
     finally:
         p.terminate()
         p.wait()

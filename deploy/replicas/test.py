@@ -99,8 +99,20 @@ def main():
     procs = {}
     try:
         redis_port = free_port()
-        procs["redis"] = subprocess.Popen(["redis-server", "--port", str(redis_port), "--bind", "127.0.0.1", "--save", "",
-                                           "--appendonly", "no"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+        def start_redis(data):  # as README.md runs it: its append-only file in `data`, fsync'd every second
+            os.makedirs(data, exist_ok=True)
+            procs["redis"] = subprocess.Popen(["redis-server", "--port", str(redis_port), "--bind", "127.0.0.1",
+                                               "--save", "", "--appendonly", "yes", "--appendfsync", "everysec",
+                                               "--dir", data], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for _ in range(100):
+                try:
+                    socket.create_connection(("127.0.0.1", redis_port), timeout=1).close()
+                    return
+                except OSError:
+                    time.sleep(0.05)
+
+        start_redis(os.path.join(work, "redis"))
         open(os.path.join(work, "signing.txt"), "w").write(SIGNING_KEY + "\n")
         json.dump({"keys": [{"id": "load", "sha256": hashlib.sha256(SECRET.encode()).hexdigest(),
                              "perMinute": PER_MINUTE, "burst": BURST},
@@ -345,6 +357,64 @@ def main():
               f"G: {victim} killed while running the job: {' -> '.join(states)} after "
               f"{time.monotonic() - killed_at:.1f} s, run again by another replica and fetched through nginx",
               (victim, first, state, result.status))
+
+        # H. Redis SIGKILLed and restarted without its data while a job runs: the replica running
+        # it registers it again, and its answer is stored and fetched.
+        def submit(seed, n=512):
+            c.request("POST", "/v1/jobs", body=json.dumps({"effect": "lightning", "request": {
+                "grid": {"width": n, "height": n}, "method": "dbm", "start": [n // 2, 0], "targets": [[n // 2, n - 1]],
+                "seed": seed}}), headers=keyed)
+            r = c.getresponse()
+            r.read()
+            return r.status, r.getheader("Location") or ""
+
+        def state_of(job):
+            c.request("GET", job, headers=keyed)
+            r = c.getresponse()
+            return r.status, json.loads(r.read())
+
+        def wait_state(job, wanted, seconds):
+            seen, deadline = [], time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                status, state = state_of(job)
+                now = state.get("state", status)
+                if not seen or seen[-1] != now:
+                    seen.append(now)
+                if now in wanted:
+                    break
+                time.sleep(0.1)
+            return seen
+
+        status, job = submit(5)
+        wait_state(job, ("running",), 30)
+        procs["redis"].send_signal(signal.SIGKILL)
+        procs["redis"].wait()
+        start_redis(os.path.join(work, "redis-empty"))  # a new, empty data directory
+        seen = wait_state(job, ("done", "failed", "cancelled"), 90)
+        c.request("GET", job + "/result", headers=keyed)
+        result = c.getresponse()
+        bolt = json.loads(result.read())
+        registered = sum(metric(admin[p], "effectd_jobs_registered_again_total") for i, p in enumerate(ports)
+                         if procs[f"effectd{i}"].poll() is None)
+        check(seen[-1] == "done" and result.status == 200 and bolt.get("cellCount", 0) > 0,
+              f"H: Redis SIGKILLed and restarted empty while a job ran: {' -> '.join(map(str, seen))}, its answer "
+              f"fetched ({registered:.0f} registered again by a heartbeat)", (seen, result.status))
+        status, gone = state_of(job[:-4] + ("0000" if job[-4:] != "0000" else "1111"))
+        check(status == 404, "H: an id never made is 404", (status, gone))
+
+        # I. Redis restarted from its append-only file: a queued job is still queued, then done.
+        status, running = submit(6)
+        status, queued = submit(7, 256)
+        first = wait_state(queued, ("queued", "running", "done"), 10)
+        time.sleep(1.5)  # appendfsync everysec: what is older than a second is on disk
+        procs["redis"].send_signal(signal.SIGKILL)
+        procs["redis"].wait()
+        start_redis(os.path.join(work, "redis-empty"))  # the same directory: its AOF is read back
+        seen = wait_state(queued, ("done", "failed", "cancelled"), 90)  # 503 while the replicas reconnect
+        back = [s for s in seen if s != 503]
+        check(first[-1] == "queued" and back[:1] == ["queued"] and back[-1] == "done",
+              f"I: Redis SIGKILLed and restarted from its AOF: the queued job {' -> '.join(map(str, seen))}",
+              (first, seen))
 
         # D. Redis stopped: fail open to each replica's own bucket.
         procs["redis"].terminate()

@@ -2,6 +2,8 @@
 #include "http/jobs.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <ctime>
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -23,6 +25,31 @@ const char* toString(JobState state) {
     case JobState::kCancelled: return "cancelled";
   }
   return "unknown";
+}
+
+namespace {
+unsigned jobIdCheck(const std::string& head) {  // FNV-1a, folded to 16 bits
+  uint32_t h = 2166136261u;
+  for (char c : "effectd-job:" + head) h = (h ^ uint8_t(c)) * 16777619u;
+  return (h >> 16) ^ (h & 0xffffu);
+}
+}  // namespace
+
+std::string newJobId() {
+  char head[21];
+  std::snprintf(head, sizeof head, "%08llx%.12s", static_cast<unsigned long long>(std::time(nullptr)) & 0xffffffffull,
+                newRequestId().c_str());
+  char id[25];
+  std::snprintf(id, sizeof id, "%s%04x", head, jobIdCheck(head));
+  return id;
+}
+
+std::optional<long long> jobIdTime(const std::string& id) {
+  if (id.size() != 24 || id.find_first_not_of("0123456789abcdef") != std::string::npos) return std::nullopt;
+  char check[5];
+  std::snprintf(check, sizeof check, "%04x", jobIdCheck(id.substr(0, 20)));
+  if (id.compare(20, 4, check) != 0) return std::nullopt;
+  return std::stoll(id.substr(0, 8), nullptr, 16);
 }
 
 class LocalJobs final : public Jobs {
@@ -134,7 +161,7 @@ JobView LocalJobs::submit(const std::string& effect, std::string body, const std
     return {};
   }
   auto job = std::make_shared<Job>();
-  job->id = newRequestId();
+  job->id = newJobId();
   job->effect = effect, job->keyId = keyId, job->body = std::move(body);
   requestBytes_ += job->body.size();
   jobs_[job->id] = job;

@@ -28,6 +28,13 @@ enum class JobState { kQueued, kRunning, kDone, kFailed, kCancelled };
 const char* toString(JobState state);
 inline bool finished(JobState s) { return s == JobState::kDone || s == JobState::kFailed || s == JobState::kCancelled; }
 
+// Job ids: 8 hex digits of the Unix time the job was made, 12 random ones, and 4 of a check
+// over both. So an id this service made is told from one it never made, and its age is known:
+// a store that no longer holds a job answers 410 with why, an id never made 404.
+std::string newJobId();
+// The Unix time an id from newJobId() was made at; nullopt for an id it did not make.
+std::optional<long long> jobIdTime(const std::string& id);
+
 // What a job's run answered: the endpoint's status, headers and bytes (a problem when it failed).
 struct JobAnswer {
   int status = 0;
@@ -101,6 +108,9 @@ class Jobs {
   // failed exchanges for /metrics.
   virtual std::string storeProblem() { return ""; }
   virtual uint64_t storeFailures() const { return 0; }
+  // Whether the store came back so lately that the replicas may not yet have registered their
+  // running jobs again (a job not found then is not known to be gone).
+  virtual bool settling() { return false; }
 };
 
 }  // namespace effectd

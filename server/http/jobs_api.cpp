@@ -75,6 +75,17 @@ ApiError notFound(const std::string& id) {
   return {404, "not-found", "Not Found", "no job " + id + " here (finished jobs are kept for --job-ttl)", {}, {}};
 }
 
+// An id this service made that no store holds: deleted, expired, or lost with the store.
+ApiError gone(const std::string& id, long long madeAt, int ttlS) {
+  const long long age = std::max(0LL, (long long)std::time(nullptr) - madeAt);
+  const std::string why =
+      age > ttlS ? "it was made " + std::to_string(age) + " s ago, and a finished job is kept for --job-ttl (" +
+                       std::to_string(ttlS) + " s)"
+                 : "it was deleted, or the job store lost it (a Redis restarted without its data, or a replica's "
+                   "own store with its process): submit it again";
+  return {410, "gone", "Gone", "job " + id + " is no longer here: " + why, {}, {}};
+}
+
 ApiError storeDown(const JobStoreError& e) {
   return {503, "unavailable", "Service Unavailable", std::string(e.what()) + " (--jobs-redis)", {}, {{"Retry-After", "5"}}};
 }
@@ -218,8 +229,18 @@ std::optional<JobView> Service::jobOf(const httplib::Request& req, httplib::Resp
     writeProblem(res, storeDown(e), tl.requestId);
     return std::nullopt;
   }
-  if (v && v->keyId != tl.keyId) v.reset();  // another key's job is not there for this one
-  if (!v) writeProblem(res, notFound(id), tl.requestId);
+  if (v && v->keyId != tl.keyId) {  // another key's job is not there for this one
+    writeProblem(res, notFound(id), tl.requestId);
+    return std::nullopt;
+  }
+  if (!v) {
+    const auto made = jobIdTime(id);
+    if (made && jobs_->settling())
+      writeProblem(res, storeDown(JobStoreError("the job store (Redis) restarted moments ago and the replicas are "
+                                                "registering their running jobs again")), tl.requestId);
+    else
+      writeProblem(res, made ? gone(id, *made, config_.jobTtlS) : notFound(id), tl.requestId);
+  }
   return v;
 }
 

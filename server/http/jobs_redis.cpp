@@ -13,13 +13,16 @@
 // A worker holds a lease on its job, renewed every kHeartbeat; every replica's heartbeat also
 // reaps: a running job whose lease ran out (its replica died) is queued again, and failed after
 // kMaxAttempts. A replica that stops puts its running jobs back at the head of the queue.
+// A Redis that comes back without its data (restarted empty, or its keys evicted) has lost the
+// jobs: each replica's heartbeat registers the ones it runs again, with their progress, and an
+// answer that could not be stored is stored when Redis answers again (docs/serving.md, "Jobs").
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
-#include <set>
+#include <map>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -83,7 +86,7 @@ if ARGV[2] == '1' or f[3] == 'failed' then body = redis.call('HGET', h, 'a_body'
 return {f, now(), body}
 )";
 
-// ARGV: worker, leaseMs -> nil, or {id, effect, body}
+// ARGV: worker, leaseMs -> nil, or {id, effect, body, key, created}
 constexpr const char* kClaim = R"(
 while true do
   local id = redis.call('LPOP', 'effectd:jobs:queue')
@@ -94,14 +97,16 @@ while true do
     redis.call('HSET', h, 'state', 'running', 'worker', ARGV[1], 'lease', t + tonumber(ARGV[2]), 'started', t)
     redis.call('HINCRBY', h, 'version', 1)
     redis.call('SADD', 'effectd:jobs:running', id)
-    local v = redis.call('HMGET', h, 'effect', 'body')
-    return {id, v[1], v[2]}
+    local v = redis.call('HMGET', h, 'effect', 'body', 'key', 'created')
+    return {id, v[1], v[2], v[3] or '', v[4] or tostring(t)}
   end
 end
 )";
 
-// ARGV: id, worker, fraction, cells, steps -> 1 go on, 0 stop (cancelled, or no longer this worker's)
+// ARGV: id, worker, fraction, cells, steps, then kRegister's from its sixth -> 1 go on (2: and
+// Redis had lost it: made again first), 0 stop (cancelled, or no longer this worker's).
 constexpr const char* kProgress = R"(
+local again = register(6)
 local h = jobKey(ARGV[1])
 local v = redis.call('HMGET', h, 'state', 'worker', 'fraction', 'cancel')
 if v[1] ~= 'running' or v[2] ~= ARGV[2] then return 0 end
@@ -109,12 +114,35 @@ redis.call('HSET', h, 'fraction', tostring(math.max(tonumber(v[3]) or 0, tonumbe
            'steps', ARGV[5])
 redis.call('HINCRBY', h, 'version', 1)
 if v[4] == '1' then return 0 end
-return 1
+return 1 + again
 )";
 
-// ARGV: id, worker, state (done or failed), status, headers, body, ttlMs -> 1, or 0 when the job
-// is no longer this worker's. A job asked to cancel ends cancelled, its answer not kept.
+// A running job this worker holds that Redis no longer has, made again as it was.
+// ARGV (from `at`): id, worker, effect, key, created, fraction, cells, steps, leaseMs.
+constexpr const char* kRegisterFn = R"(
+local function register(at)
+  local id = ARGV[at]
+  local h = jobKey(id)
+  if redis.call('EXISTS', h) == 1 then return 0 end
+  local t = now()
+  redis.call('HSET', h, 'effect', ARGV[at + 2], 'key', ARGV[at + 3], 'state', 'running', 'created', ARGV[at + 4],
+             'queued', ARGV[at + 4], 'started', t, 'worker', ARGV[at + 1], 'lease', t + tonumber(ARGV[at + 8]),
+             'fraction', ARGV[at + 5], 'cells', ARGV[at + 6], 'steps', ARGV[at + 7], 'version', 1, 'attempts', 0)
+  redis.call('ZADD', 'effectd:jobs:all', 9e15, id)
+  redis.call('SADD', 'effectd:jobs:running', id)
+  if ARGV[at + 3] ~= '' then redis.call('SADD', 'effectd:jobs:key:' .. ARGV[at + 3], id) end
+  return 1
+end
+)";
+
+// ARGV: id, worker, effect, key, created, fraction, cells, steps, leaseMs -> 1 made again, 0 there
+constexpr const char* kRegister = R"(return register(1))";
+
+// ARGV: id, worker, state (done or failed), status, headers, body, ttlMs, then kRegister's from
+// its effect -> 1, or 0 when the job is no longer this worker's. A job Redis lost is made again
+// first. A job asked to cancel ends cancelled, its answer not kept.
 constexpr const char* kFinish = R"(
+register(8)
 local h = jobKey(ARGV[1])
 local v = redis.call('HMGET', h, 'state', 'worker', 'cancel')
 if v[1] ~= 'running' or v[2] ~= ARGV[2] then return 0 end
@@ -137,13 +165,16 @@ return 1
 )";
 
 // ARGV: worker, leaseMs, ttlMs, maxAttempts, problem, ids...: this worker's leases renewed, and
-// every running job whose lease ran out queued again (or failed) -> how many were reaped.
+// every running job whose lease ran out queued again (or failed) -> {how many were reaped, the
+// ids of this worker's that Redis no longer has...}.
 constexpr const char* kHeartbeatScript = R"(
 local t = now()
+local missing = {}
 for i = 6, #ARGV do
   local h = jobKey(ARGV[i])
   local v = redis.call('HMGET', h, 'state', 'worker')
-  if v[1] == 'running' and v[2] == ARGV[1] then redis.call('HSET', h, 'lease', t + tonumber(ARGV[2])) end
+  if v[1] == 'running' and v[2] == ARGV[1] then redis.call('HSET', h, 'lease', t + tonumber(ARGV[2]))
+  elseif redis.call('EXISTS', h) == 0 then table.insert(missing, ARGV[i]) end
 end
 local reaped = 0
 for _, id in ipairs(redis.call('SMEMBERS', 'effectd:jobs:running')) do
@@ -166,7 +197,7 @@ for _, id in ipairs(redis.call('SMEMBERS', 'effectd:jobs:running')) do
     end
   end
 end
-return reaped
+return {reaped, unpack(missing)}
 )";
 
 // ARGV: id, ttlMs -> the state before (nil: no such job)
@@ -230,7 +261,7 @@ class RedisJobs final : public Jobs {
   ~RedisJobs() override { stop(); }
 
   JobView submit(const std::string& effect, std::string body, const std::string& keyId, Refusal& refusal) override {
-    const std::string id = newRequestId();
+    const std::string id = newJobId();
     const RedisReply r = eval(control_, kSubmit, {id, effect, keyId, body, std::to_string(o_.maxJobs), std::to_string(o_.perKey)});
     refusal = r.text == "full" ? Refusal::kFull : r.text == "busy" ? Refusal::kKeyBusy : Refusal::kNone;
     if (refusal != Refusal::kNone) return {};
@@ -320,7 +351,9 @@ class RedisJobs final : public Jobs {
     const char* states[] = {"done", "failed", "cancelled"};
     for (size_t i = 0; i < 3; ++i)
       out += std::string("effectd_jobs_finished_total{state=\"") + states[i] + "\"} " + std::to_string(n(3 + i)) + "\n";
-    return out;
+    return out + "# HELP effectd_jobs_registered_again_total Running jobs this replica registered again after the "
+                 "job store lost them.\n# TYPE effectd_jobs_registered_again_total counter\n"
+                 "effectd_jobs_registered_again_total " + std::to_string(registered_.load()) + "\n";
   }
 
   bool shared() const override { return true; }
@@ -330,13 +363,20 @@ class RedisJobs final : public Jobs {
     return work_.lastFailed() || control_.lastFailed() ? "unreachable at " + work_.address() : "";
   }
   uint64_t storeFailures() const override { return control_.failures() + work_.failures(); }
+  bool settling() override {  // within a lease of Redis's start: every heartbeat has had its turn
+    const auto r = control_.command({"INFO", "server"});
+    if (!r || !r->isString()) return false;
+    const size_t at = r->text.find("uptime_in_seconds:");
+    return at != std::string::npos &&
+           std::strtoll(r->text.c_str() + at + 18, nullptr, 10) < std::chrono::seconds(kLease).count();
+  }
 
  private:
   long long ttlMs() const { return static_cast<long long>(o_.ttl.count()) * 1000; }
 
   // A script's reply; an unreachable Redis or an error reply is a JobStoreError.
   static RedisReply eval(RedisClient& client, const char* script, const std::vector<std::string>& argv) {
-    std::vector<std::string> args = {"EVAL", std::string(kPrelude) + script, "0"};
+    std::vector<std::string> args = {"EVAL", std::string(kPrelude) + kRegisterFn + script, "0"};
     args.insert(args.end(), argv.begin(), argv.end());
     std::optional<RedisReply> r = client.command(args);
     if (!r) throw JobStoreError("the job store (Redis) did not answer");
@@ -358,21 +398,31 @@ class RedisJobs final : public Jobs {
         if (!idle(std::chrono::seconds(1))) return;
         continue;
       }
-      if (claimed.type != RedisReply::Type::kArray || claimed.items.size() != 3) {
+      if (claimed.type != RedisReply::Type::kArray || claimed.items.size() != 5) {
         if (!idle(kIdlePoll)) return;
         continue;
       }
       const std::string id = claimed.items[0].text, effect = claimed.items[1].text, body = claimed.items[2].text;
       {
         std::lock_guard lock(mu_);
-        mine_.insert(id);
+        mine_[id] = {effect, claimed.items[3].text, claimed.items[4].text, "0", "0", "0"};
       }
       const JobProgress progress = [this, id](double fraction, size_t cells, size_t steps) {
         if (stopping_) return false;
         char f[32];
         std::snprintf(f, sizeof f, "%.6f", std::clamp(fraction, 0.0, 1.0));
+        {
+          std::lock_guard lock(mu_);
+          Held& held = mine_[id];
+          held.fraction = f, held.cells = std::to_string(cells), held.steps = std::to_string(steps);
+        }
         try {
-          return eval(work_, kProgress, {id, worker_, f, std::to_string(cells), std::to_string(steps)}).integer == 1;
+          std::vector<std::string> argv = {id, worker_, f, std::to_string(cells), std::to_string(steps)};
+          const std::vector<std::string> again = registration(id);
+          argv.insert(argv.end(), again.begin(), again.end());
+          const long long go = eval(work_, kProgress, argv).integer;
+          if (go == 2) ++registered_;
+          return go >= 1;
         } catch (const JobStoreError&) {
           return true;  // Redis away for a moment: the work goes on, the lease may still hold
         }
@@ -386,19 +436,28 @@ class RedisJobs final : public Jobs {
         answer.body = std::string("{\"type\":\"https://effectd.dev/problems/internal\",\"title\":\"Internal Server "
                                   "Error\",\"status\":500,\"detail\":\"the job failed\"}");
       }
-      try {
-        // Stopped by this replica's stop (a cancelled bolt's 409, or admission's 503 given up):
-        // back to the queue for another replica. A job that ended on its own is recorded.
-        if (stopping_ && (answer.status == 409 || answer.status == 503)) {
-          eval(work_, kRequeue, {id, worker_});
-        } else {
-          nlohmann::json headers = answer.headers;
-          eval(work_, kFinish,
-               {id, worker_, answer.status < 400 ? "done" : "failed", std::to_string(answer.status), headers.dump(),
-                answer.body, std::to_string(ttlMs())});
+      // Stopped by this replica's stop (a cancelled bolt's 409, or admission's 503 given up):
+      // back to the queue for another replica. A job that ended on its own is recorded, once
+      // Redis answers (the heartbeat keeps its lease meanwhile); a replica stopping first drops
+      // it, and the lease runs out for another replica to run it again.
+      const bool requeue = stopping_ && (answer.status == 409 || answer.status == 503);
+      for (;;) {
+        try {
+          if (requeue) {
+            eval(work_, kRequeue, {id, worker_});
+          } else {
+            nlohmann::json headers = answer.headers;
+            std::vector<std::string> argv = {id, worker_, answer.status < 400 ? "done" : "failed",
+                                             std::to_string(answer.status), headers.dump(), answer.body,
+                                             std::to_string(ttlMs())};
+            const std::vector<std::string> again = registration(id);
+            argv.insert(argv.end(), again.begin(), again.end());
+            eval(work_, kFinish, argv);
+          }
+          break;
+        } catch (const JobStoreError&) {
+          if (requeue || !idle(std::chrono::seconds(1))) break;
         }
-      } catch (const JobStoreError&) {
-        // Not recorded: the lease runs out and another replica runs the job again.
       }
       std::lock_guard lock(mu_);
       mine_.erase(id);
@@ -415,13 +474,23 @@ class RedisJobs final : public Jobs {
                                        std::to_string(ttlMs()), std::to_string(kMaxAttempts), problem};
       {
         std::lock_guard lock(mu_);
-        argv.insert(argv.end(), mine_.begin(), mine_.end());
+        for (const auto& [id, held] : mine_) argv.push_back(id);
       }
       try {
-        eval(work_, kHeartbeatScript, argv);
+        const RedisReply r = eval(work_, kHeartbeatScript, argv);
+        for (size_t i = 1; i < r.items.size(); ++i)  // jobs Redis lost: registered again
+          if (eval(work_, kRegister, registration(r.items[i].text)).integer == 1) ++registered_;
       } catch (const JobStoreError&) {
       }
     }
+  }
+
+  // kRegister's arguments for a job this replica runs: what it was, and its progress so far.
+  std::vector<std::string> registration(const std::string& id) {
+    std::lock_guard lock(mu_);
+    const Held& h = mine_[id];
+    return {id, worker_, h.effect, h.key, h.created, h.fraction, h.cells, h.steps,
+            std::to_string(std::chrono::milliseconds(kLease).count())};
   }
 
   const Options o_;
@@ -432,7 +501,11 @@ class RedisJobs final : public Jobs {
   std::mutex mu_;
   std::condition_variable wake_;
   std::atomic<bool> stopping_{false};
-  std::set<std::string> mine_;  // ids this replica's workers run
+  struct Held {  // a job this replica's workers run, as kRegister makes it again
+    std::string effect, key, created, fraction, cells, steps;
+  };
+  std::map<std::string, Held> mine_;
+  std::atomic<uint64_t> registered_{0};  // jobs registered again after Redis lost them
   std::vector<std::thread> threads_;
 };
 
