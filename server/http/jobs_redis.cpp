@@ -417,10 +417,9 @@ class RedisJobs final : public Jobs {
           held.fraction = f, held.cells = std::to_string(cells), held.steps = std::to_string(steps);
         }
         try {
-          std::vector<std::string> argv = {id, worker_, f, std::to_string(cells), std::to_string(steps)};
-          const std::vector<std::string> again = registration(id);
-          argv.insert(argv.end(), again.begin(), again.end());
-          const long long go = eval(work_, kProgress, argv).integer;
+          const long long go =
+              eval(work_, kProgress, withRegistration({id, worker_, f, std::to_string(cells), std::to_string(steps)}, id))
+                  .integer;
           if (go == 2) ++registered_;
           return go >= 1;
         } catch (const JobStoreError&) {
@@ -447,12 +446,10 @@ class RedisJobs final : public Jobs {
             eval(work_, kRequeue, {id, worker_});
           } else {
             nlohmann::json headers = answer.headers;
-            std::vector<std::string> argv = {id, worker_, answer.status < 400 ? "done" : "failed",
-                                             std::to_string(answer.status), headers.dump(), answer.body,
-                                             std::to_string(ttlMs())};
-            const std::vector<std::string> again = registration(id);
-            argv.insert(argv.end(), again.begin(), again.end());
-            eval(work_, kFinish, argv);
+            eval(work_, kFinish,
+                 withRegistration({id, worker_, answer.status < 400 ? "done" : "failed", std::to_string(answer.status),
+                                   headers.dump(), answer.body, std::to_string(ttlMs())},
+                                  id));
           }
           break;
         } catch (const JobStoreError&) {
@@ -491,6 +488,12 @@ class RedisJobs final : public Jobs {
     const Held& h = mine_[id];
     return {id, worker_, h.effect, h.key, h.created, h.fraction, h.cells, h.steps,
             std::to_string(std::chrono::milliseconds(kLease).count())};
+  }
+  // A script's own arguments followed by kRegister's (kProgress, kFinish make a lost job again).
+  std::vector<std::string> withRegistration(std::vector<std::string> argv, const std::string& id) {
+    const std::vector<std::string> again = registration(id);
+    argv.insert(argv.end(), again.begin(), again.end());
+    return argv;
   }
 
   const Options o_;
