@@ -32,11 +32,12 @@ import re
 import shutil
 import signal
 import socket
-import subprocess
 import sys
 import tempfile
 import threading
 import time
+
+from cluster import Cluster
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SIGNING_KEY = "replicas-signing-key-0123456789"
@@ -44,12 +45,6 @@ SECRET = "replicas-test-secret"
 BAKER = "replicas-baker-secret"  # F's key, whose quota B leaves alone
 PER_MINUTE, BURST = 600, 20
 MAX_CONNECTIONS = 32  # each replica's --max-connections; E opens twice as many slow connections
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def signed(body):
@@ -96,68 +91,17 @@ def main():
             print(f"{tool} missing (scripts/setup.sh installs it)")
             return 1
     work = tempfile.mkdtemp(prefix="effectd-replicas.")
-    procs = {}
+    cluster = Cluster(binary, work, {"load": SECRET, "baker": BAKER}, SIGNING_KEY,
+                      key_quota=lambda k: (PER_MINUTE, BURST) if k == "load" else (60000, 60000))
+    procs, ports, admin = cluster.procs, cluster.ports, cluster.admin
     try:
-        redis_port = free_port()
-
-        def start_redis(data):  # as README.md runs it: its append-only file in `data`, fsync'd every second
-            os.makedirs(data, exist_ok=True)
-            procs["redis"] = subprocess.Popen(["redis-server", "--port", str(redis_port), "--bind", "127.0.0.1",
-                                               "--save", "", "--appendonly", "yes", "--appendfsync", "everysec",
-                                               "--dir", data], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-            for _ in range(100):
-                try:
-                    socket.create_connection(("127.0.0.1", redis_port), timeout=1).close()
-                    return
-                except OSError:
-                    time.sleep(0.05)
-
-        start_redis(os.path.join(work, "redis"))
-        open(os.path.join(work, "signing.txt"), "w").write(SIGNING_KEY + "\n")
-        json.dump({"keys": [{"id": "load", "sha256": hashlib.sha256(SECRET.encode()).hexdigest(),
-                             "perMinute": PER_MINUTE, "burst": BURST},
-                            {"id": "baker", "sha256": hashlib.sha256(BAKER.encode()).hexdigest(),
-                             "perMinute": 60000, "burst": 60000}]}, open(os.path.join(work, "keys.json"), "w"))
-        ports, admin = [], {}
-        for i in range(3):
-            log = open(os.path.join(work, f"effectd{i}.log"), "w+")
-            admin_port = free_port()
-            # As README.md runs them: the playground off, operations on the admin port.
-            procs[f"effectd{i}"] = subprocess.Popen(
-                [binary, "--port", "0", "--threads", "8", "--access-log", "0", "--quota-redis", f"redis://127.0.0.1:{redis_port}",
-                 "--jobs-redis", f"redis://127.0.0.1:{redis_port}",
-                 "--api-keys", os.path.join(work, "keys.json"), "--url-signing-key-file", os.path.join(work, "signing.txt"),
-                 "--playground", "off", "--admin-port", str(admin_port), "--max-connections", str(MAX_CONNECTIONS)],
-                stderr=log)
-            for _ in range(200):
-                log.seek(0)
-                m = re.search(r'"port":(\d+)', log.read())
-                if m:
-                    ports.append(int(m.group(1)))
-                    admin[ports[-1]] = admin_port
-                    break
-                time.sleep(0.05)
-        if not check(len(ports) == 3, "three replicas listening", ports):
+        cluster.start_redis()
+        start_redis = cluster.start_redis
+        if not check(cluster.start_replicas(3, "--max-connections", str(MAX_CONNECTIONS)), "three replicas listening",
+                     ports):
             return 1
-        lb = free_port()
-        conf = open(os.path.join(HERE, "nginx.conf")).read().replace("listen 8080;", f"listen 127.0.0.1:{lb};")
-        for i, p in enumerate(ports):
-            conf = conf.replace(f"127.0.0.1:808{i + 1}", f"127.0.0.1:{p}")
-        os.makedirs(os.path.join(work, "tmp"))
-        os.makedirs(os.path.join(work, "cache"))
-        open(os.path.join(work, "nginx.conf"), "w").write(conf)
-        shutil.copy(os.path.join(HERE, "..", "nginx", "edge.conf"), os.path.join(work, "edge.conf"))
-        user = "user root root;" if os.getuid() == 0 else ""
-        procs["nginx"] = subprocess.Popen(["nginx", "-p", work, "-c", os.path.join(work, "nginx.conf"), "-g",
-                                           f"daemon off; {user}"], stderr=open(os.path.join(work, "nginx.log"), "w"))
-        for _ in range(200):
-            try:
-                c = http.client.HTTPConnection("127.0.0.1", lb, timeout=2)
-                c.request("GET", "/healthz")
-                if c.getresponse().status == 200:
-                    break
-            except OSError:
-                time.sleep(0.05)
+        cluster.start_nginx()
+        lb = cluster.lb
 
         def get(conn, target, headers=None):
             conn.request("GET", target, headers=headers or {})
@@ -389,7 +333,7 @@ def main():
         wait_state(job, ("running",), 30)
         procs["redis"].send_signal(signal.SIGKILL)
         procs["redis"].wait()
-        start_redis(os.path.join(work, "redis-empty"))  # a new, empty data directory
+        start_redis("redis-empty")  # a new, empty data directory
         seen = wait_state(job, ("done", "failed", "cancelled"), 90)
         c.request("GET", job + "/result", headers=keyed)
         result = c.getresponse()
@@ -409,7 +353,7 @@ def main():
         time.sleep(1.5)  # appendfsync everysec: what is older than a second is on disk
         procs["redis"].send_signal(signal.SIGKILL)
         procs["redis"].wait()
-        start_redis(os.path.join(work, "redis-empty"))  # the same directory: its AOF is read back
+        start_redis("redis-empty")  # the same directory: its AOF is read back
         seen = wait_state(queued, ("done", "failed", "cancelled"), 90)  # 503 while the replicas reconnect
         back = [s for s in seen if s != 503]
         check(first[-1] == "queued" and back[:1] == ["queued"] and back[-1] == "done",
@@ -452,18 +396,9 @@ def main():
         check(r.status == 503 and r.getheader("Retry-After") == "5" and "--jobs-redis" in problem.get("detail", ""),
               "D: ... and a job's status is 503 with Retry-After (the job store is away)", (r.status, problem))
     finally:
-        for p in procs.values():
-            if p.poll() is None:
-                p.terminate()
-        for p in procs.values():
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        cluster.stop()
         if failures:
-            for name in os.listdir(work):
-                if name.endswith(".log"):
-                    print(f"--- {name}\n" + open(os.path.join(work, name)).read()[-2000:])
+            print(cluster.logs())
         shutil.rmtree(work, ignore_errors=True)
     print("deploy_replicas: " + ("passed" if not failures else f"{len(failures)} failed"))
     return 1 if failures else 0

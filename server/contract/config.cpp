@@ -183,7 +183,7 @@ const std::vector<Option>& options() {
        "(default none: open)",
        pathField(&Config::apiKeysFile)},
       {"quota-redis", "EFFECTD_QUOTA_REDIS",
-       "redis://host:port holding the API keys' quotas, so that they hold across replicas; unreachable, each process "
+       "redis://[[user]:password@]host:port holding the API keys' quotas, so that they hold across replicas; unreachable, each process "
        "falls back to its own buckets (default none: per process)",
        [](const std::string& s, Config& c) {
          c.quotaRedis = s;
@@ -225,7 +225,7 @@ const std::vector<Option>& options() {
       {"key-max-jobs", "EFFECTD_KEY_MAX_JOBS", "an API key's jobs queued or running at once; more get 429 (default 2)",
        intField(&Config::keyMaxJobs, 1, 100000)},
       {"jobs-redis", "EFFECTD_JOBS_REDIS",
-       "redis://host:port holding the jobs (queue, states, progress, answers), so that every replica sharing it answers "
+       "redis://[[user]:password@]host:port holding the jobs (queue, states, progress, answers), so that every replica sharing it answers "
        "any job and idle ones take queued work; unreachable, the job routes answer 503 (default none: jobs in this "
        "process)",
        [](const std::string& s, Config& c) {

@@ -360,7 +360,8 @@ class RedisJobs final : public Jobs {
   // From the last exchanges, without one of its own: the heartbeat talks to Redis every
   // kHeartbeat, and a probe must answer within its timeout (a blackholed Redis takes 2 s).
   std::string storeProblem() override {
-    return work_.lastFailed() || control_.lastFailed() ? "unreachable at " + work_.address() : "";
+    const std::string work = work_.lastProblem();
+    return work.empty() ? control_.lastProblem() : work;
   }
   uint64_t storeFailures() const override { return control_.failures() + work_.failures(); }
   bool settling() override {  // within a lease of Redis's start: every heartbeat has had its turn

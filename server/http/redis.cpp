@@ -1,6 +1,7 @@
 // The RESP2 client (redis.h).
 #include "http/redis.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 
@@ -17,6 +18,26 @@ namespace {
 constexpr size_t kMaxLine = 1 << 16;          // a status, error or length line
 constexpr long long kMaxBulk = 512ll << 20;   // Redis's own limit on a string
 constexpr int kMaxDepth = 8;                  // nested arrays
+
+std::string percentDecoded(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
+      out += char(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+// A command as RESP: an array of bulk strings.
+std::string encoded(const std::vector<std::string>& args) {
+  std::string out = "*" + std::to_string(args.size()) + "\r\n";
+  for (const auto& a : args) out += "$" + std::to_string(a.size()) + "\r\n" + a + "\r\n";
+  return out;
+}
 }  // namespace
 
 RedisClient::RedisClient(const std::string& url, std::chrono::milliseconds timeout, std::chrono::milliseconds retry)
@@ -24,6 +45,13 @@ RedisClient::RedisClient(const std::string& url, std::chrono::milliseconds timeo
   std::string rest = url.rfind("redis://", 0) == 0 ? url.substr(8) : url;
   const size_t slash = rest.find('/');
   if (slash != std::string::npos) rest.resize(slash);
+  if (const size_t at = rest.rfind('@'); at != std::string::npos) {
+    const std::string userinfo = rest.substr(0, at);
+    const size_t colon = userinfo.find(':');
+    user_ = percentDecoded(colon == std::string::npos ? "" : userinfo.substr(0, colon));
+    password_ = percentDecoded(colon == std::string::npos ? userinfo : userinfo.substr(colon + 1));
+    rest.erase(0, at + 1);
+  }
   const size_t colon = rest.rfind(':');
   host_ = colon == std::string::npos ? rest : rest.substr(0, colon);
   port_ = colon == std::string::npos ? "6379" : rest.substr(colon + 1);
@@ -35,27 +63,36 @@ std::optional<RedisReply> RedisClient::command(const std::vector<std::string>& a
   std::lock_guard lock(mutex_);
   const auto now = std::chrono::steady_clock::now();
   if (fd_ < 0 && now < retryAt_) return std::nullopt;
-  std::string request = "*" + std::to_string(args.size()) + "\r\n";
-  for (const auto& a : args) request += "$" + std::to_string(a.size()) + "\r\n" + a + "\r\n";
+  const std::string request = encoded(args);
   RedisReply reply;
-  if ((fd_ >= 0 || connect()) && send(request) && readReply(reply, 0)) {
+  const bool answered = (fd_ >= 0 || connect()) && send(request) && readReply(reply, 0);
+  std::string problem;
+  if (answered) {
     buffer_.erase(0, read_);
     read_ = 0;
-    lastFailed_ = false;
-    return reply;
+    if (reply.type == RedisReply::Type::kError) problem = "answers " + reply.text + " at " + address();
+  } else {
+    disconnect();
+    retryAt_ = now + retry_;
+    ++failures_;
+    problem = refused_.empty() ? "unreachable at " + address() : "refused AUTH at " + address() + ": " + refused_;
   }
-  disconnect();
-  retryAt_ = now + retry_;
-  ++failures_;
-  lastFailed_ = true;
-  return std::nullopt;
+  {
+    std::lock_guard state(problemMutex_);
+    problem_ = problem;
+  }
+  if (!answered) return std::nullopt;
+  return reply;
 }
 
 std::string RedisClient::problem() {
-  const auto r = command({"PING"});
-  if (!r) return "unreachable at " + address();
-  if (r->type == RedisReply::Type::kError) return "answers " + r->text;
-  return "";
+  command({"PING"});
+  return lastProblem();
+}
+
+std::string RedisClient::lastProblem() const {
+  std::lock_guard lock(problemMutex_);
+  return problem_;
 }
 
 bool RedisClient::connect() {
@@ -75,10 +112,25 @@ bool RedisClient::connect() {
   if (ok) {
     int one = 1;
     ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-  } else {
-    disconnect();
+    ok = authenticate();
   }
+  if (!ok) disconnect();
   return ok;
+}
+
+bool RedisClient::authenticate() {
+  if (password_.empty()) return true;
+  std::vector<std::string> args{"AUTH"};
+  if (!user_.empty()) args.push_back(user_);
+  args.push_back(password_);
+  const std::string request = encoded(args);
+  RedisReply reply;
+  refused_.clear();
+  if (!send(request) || !readReply(reply, 0)) return false;
+  buffer_.erase(0, read_);
+  read_ = 0;
+  if (reply.type == RedisReply::Type::kError) refused_ = reply.text;
+  return refused_.empty();
 }
 
 void RedisClient::disconnect() {

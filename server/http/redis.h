@@ -27,7 +27,8 @@ struct RedisReply {
 
 class RedisClient {
  public:
-  // `url`: redis://host[:port][/...] (the path is ignored).
+  // `url`: redis://[[user]:password@]host[:port][/...] (the path is ignored; the user and
+  // password percent-decoded). With a password every connection starts with AUTH.
   RedisClient(const std::string& url, std::chrono::milliseconds timeout,
               std::chrono::milliseconds retry = std::chrono::seconds(1));
   ~RedisClient();
@@ -39,8 +40,10 @@ class RedisClient {
   std::optional<RedisReply> command(const std::vector<std::string>& args);
   // "" when Redis answers PING now, else why not (for /readyz: it waits up to the timeout).
   std::string problem();
-  // Whether the last exchange failed, and where Redis is: a state to read without waiting.
-  bool lastFailed() const { return lastFailed_.load(); }
+  // What went wrong in the last exchange ("unreachable at ...", "refused AUTH at ...: ...",
+  // "answers OOM ... at ..." for an error reply; "" when it went well), and where Redis is:
+  // states to read without waiting.
+  std::string lastProblem() const;
   std::string address() const { return host_ + ":" + port_; }
   // Exchanges that failed since start (Redis away, slow or not speaking RESP): /metrics.
   uint64_t failures() const { return failures_.load(); }
@@ -55,12 +58,15 @@ class RedisClient {
 
   const std::chrono::milliseconds timeout_, retry_;
   std::mutex mutex_;
-  std::string host_, port_, buffer_;
+  bool authenticate();  // AUTH on a new connection, when the URL has a password
+  std::string host_, port_, user_, password_, buffer_;
+  std::string refused_;              // why Redis refused the last AUTH ("" = it did not)
+  mutable std::mutex problemMutex_;  // problem_ is read without waiting for mutex_
+  std::string problem_;
   size_t read_ = 0;  // bytes of buffer_ consumed
   int fd_ = -1;
   std::chrono::steady_clock::time_point retryAt_;
   std::atomic<uint64_t> failures_{0};
-  std::atomic<bool> lastFailed_{false};
 };
 
 }  // namespace effectd
