@@ -129,7 +129,12 @@ def limits_cancel_problems(binary):
     try:
         big = bolt(300)
         status, _, body = request(port, "POST", "/v1/lightning", json.dumps(big))
-        check(status == 413 and b"--max-solver-grid-cells" in body, "300^2 dbm over the synchronous limit: 413", status)
+        check(status == 413 and b"--max-solver-grid-cells" in body and
+              b"send it as a job: POST /v1/jobs or Prefer: respond-async (jobs take up to 262144 cells" in body,
+              "300^2 dbm over the synchronous limit: 413 naming the limit and saying to send it as a job", body[:400])
+        status, _, body = request(port, "POST", "/v1/lightning", json.dumps(bolt(600)))
+        check(status == 413 and b"send it as a job" not in body,
+              "600^2 dbm over the job limit too: 413 without the job hint", body[:400])
         status, headers, _ = request(port, "POST", "/v1/jobs", json.dumps({"effect": "lightning", "request": big}))
         location = headers.get("Location", "")
         t0 = time.monotonic()
@@ -148,8 +153,11 @@ def limits_cancel_problems(binary):
               (status, {k: answer.get(k) for k in ("grid", "method", "struck")}))
         status, _, body = request(port, "POST", "/v1/jobs", json.dumps({"effect": "lightning", "request": bolt(600)}))
         problem = json.loads(body)
-        check(status == 413 and problem["errors"] and problem["errors"][0]["pointer"].startswith("/request/grid"),
-              "a job over --max-job-grid-cells: 413 when submitted, at /request/grid", (status, problem.get("detail")))
+        check(status == 413 and problem["errors"] and problem["errors"][0]["pointer"].startswith("/request/grid") and
+              "--max-job-grid-cells" in json.dumps(problem) and "--max-solver-grid-cells" not in json.dumps(problem) and
+              "send it as a job" not in json.dumps(problem),
+              "a job over --max-job-grid-cells: 413 when submitted, at /request/grid, naming that flag",
+              (status, problem.get("detail"), problem.get("errors")))
 
         # Cancel: a bolt that takes several seconds, stopped while it grows.
         status, headers, _ = request(port, "POST", "/v1/jobs", json.dumps({"effect": "lightning", "request": bolt(400)}))

@@ -144,9 +144,17 @@ LightningRequest parseLightningRequest(const json& body, const RequestContext& c
   p.method = lt::parseMethod(body.value("method", "fast")).value_or(lt::Method::kFast);  // the schema's enum
   lt::Limits limits;
   limits.maxGridCells = config.limits.maxGridCells, limits.gridKnob = "--max-grid-cells";
-  limits.maxSolverGridCells = config.limits.maxSolverGridCells, limits.solverGridKnob = "--max-solver-grid-cells";
-  limits.maxSolverVolumeCells = config.limits.maxSolverVolumeCells, limits.solverVolumeKnob = "--max-solver-volume-cells";
-  if (auto e = lt::checkLimits(p, limits)) throwError(*e, at);
+  limits.maxSolverGridCells = config.limits.maxSolverGridCells, limits.solverGridKnob = config.limits.solverGridKnob;
+  limits.maxSolverVolumeCells = config.limits.maxSolverVolumeCells, limits.solverVolumeKnob = config.limits.solverVolumeKnob;
+  if (auto e = lt::checkLimits(p, limits)) {
+    // Past a solver bound on a synchronous route, a grid within the job bound may go as a job.
+    const size_t cells = size_t(p.width) * size_t(p.height) * size_t(std::max(p.depth, 1));
+    const size_t job = p.depth ? config.maxJobVolumeCells : config.maxJobGridCells;
+    if (config.limits.jobsTakeMore && p.method != lt::Method::kFast && cells <= limits.maxGridCells && cells <= job)
+      e->message += "; send it as a job: POST /v1/jobs or Prefer: respond-async (jobs take up to " +
+                    std::to_string(job) + " cells, " + (p.depth ? "--max-job-volume-cells" : "--max-job-grid-cells") + ")";
+    throwError(*e, at);
+  }
   if (body.contains("world") && !p.depth) throw fieldError(400, at + "/world", "is for 3-D grids (grid.depth)");
   r.world = parseWorld(body);
   p.start = cellOf(body["start"], p.depth, at + "/start");

@@ -18,6 +18,12 @@ struct Limits {
   size_t maxGrowthSteps = effects::lightning::Limits{}.maxGrowthSteps;
   size_t maxSolverGridCells = effects::lightning::Limits{}.maxSolverGridCells;
   size_t maxSolverVolumeCells = effects::lightning::Limits{}.maxSolverVolumeCells;
+  // The flags that raise the solver bounds where these limits apply (a job's: --max-job-*, set by
+  // Service::installJobs), and whether a request past them may go as a job instead, whose bounds
+  // are the Config's maxJob* (the synchronous routes: their 413 says so).
+  const char* solverGridKnob = "--max-solver-grid-cells";
+  const char* solverVolumeKnob = "--max-solver-volume-cells";
+  bool jobsTakeMore = true;
   size_t maxTableSize = 65536;              // fog table entries (all dimensions together)
   size_t maxMeshVertices = 2'000'000;       // tangents / bubble meshes
   size_t maxMeshTriangles = 4'000'000;

@@ -96,6 +96,9 @@ void Service::installJobs() {
   jobConfig_ = config_;
   jobConfig_.limits.maxSolverGridCells = std::max(config_.maxJobGridCells, config_.limits.maxSolverGridCells);
   jobConfig_.limits.maxSolverVolumeCells = std::max(config_.maxJobVolumeCells, config_.limits.maxSolverVolumeCells);
+  jobConfig_.limits.solverGridKnob = "--max-job-grid-cells";
+  jobConfig_.limits.solverVolumeKnob = "--max-job-volume-cells";
+  jobConfig_.limits.jobsTakeMore = false;
   Jobs::Options o;
   o.workers = config_.jobWorkers;
   o.maxJobs = size_t(config_.maxJobs);
