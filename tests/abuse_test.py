@@ -20,7 +20,8 @@ and prints what it measured; docs/reliability.md quotes these lines.
               another key's latency and readiness alone; maxConcurrent bounds a key's share
   streams     key A opens 80 job event streams against --max-connections 64: A holds its share
               (--key-max-streams) and its excess gets 429, key B's requests and /healthz are all
-              200 meanwhile; without keys, one address's excess gets 429 and another address
+              200 meanwhile; 16 streams against --max-connections 16 leave 16 connections at once
+              to another key; without keys, one address's excess gets 429 and another address
               streams and requests as usual
 """
 import hashlib
@@ -502,6 +503,32 @@ def streams(binary):
         _, _, metrics, _ = request(port, "GET", "/metrics")
         check(b"effectd_streams_held 8" in metrics and b'effectd_streams_refused_total{reason="client"} 72' in metrics,
               "/metrics counts the streams held and the refused")
+        for s in socks:
+            s.close()
+    finally:
+        p.terminate()
+        p.wait()
+    # Streams have threads of their own: as many streams as --max-connections, and every
+    # connection requests need is still free.
+    p, port = effectd_process.start(binary, "--api-keys", keys, "--max-connections", "16", "--max-streams", "16",
+                                    "--key-max-streams", "16", "--access-log", "0", "--response-cache-mb", "0")
+    try:
+        job = submit_job(port, auth["a"])
+        socks, statuses = open_streams(port, job, 16, b"Authorization: Bearer stream-secret-a\r\n")
+        check(statuses == [200] * 16, f"key A holds 16 streams against --max-connections 16 ({statuses})")
+        conns = [http.client.HTTPConnection("127.0.0.1", port, timeout=30) for _ in range(16)]
+        for c in conns:
+            c.connect()  # all 16 open at once, beside the 16 streams
+        answered = []
+        for c in conns:
+            c.request("POST", "/v1/fog", body=FOG, headers={**auth["b"], "Content-Type": "application/json"})
+            r = c.getresponse()
+            r.read()
+            answered.append(r.status)
+            c.close()
+        print(f"      16 streams held, then 16 connections at once from key B: {answered}")
+        check(answered == [200] * 16, "... and key B's 16 connections at once are all answered 200: streams hold "
+              "no connection requests need")
         for s in socks:
             s.close()
     finally:

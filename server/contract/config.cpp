@@ -202,8 +202,8 @@ const std::vector<Option>& options() {
        "for a server behind a proxy that limits them, which all its clients reach it through (default 8)",
        intField(&Config::maxStreamsPerAddress, 0, 100000)},
       {"max-streams", "EFFECTD_MAX_STREAMS",
-       "job event streams held at once in all, each holding a connection and its thread; more get 503; 0 = a "
-       "quarter of --max-connections (default 0)",
+       "job event streams held at once in all, each on a connection and a thread of its own beyond "
+       "--max-connections; more get 503; 0 = a quarter of --max-connections (default 0)",
        intField(&Config::maxStreams, 0, 65536)},
       {"job-workers", "EFFECTD_JOB_WORKERS", "jobs (POST /v1/jobs, Prefer: respond-async) running at once (default 1)",
        intField(&Config::jobWorkers, 1, 64)},

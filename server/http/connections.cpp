@@ -196,13 +196,22 @@ bool EdgeServer::waitForRequest(socket_t sock) const {
   return false;
 }
 
+std::shared_ptr<void> EdgeServer::holdAsStream() {
+  std::lock_guard lock(mu_);
+  ++streaming_;
+  return std::shared_ptr<void>(nullptr, [this](void*) {
+    std::lock_guard lock(mu_);
+    --streaming_;
+  });
+}
+
 bool EdgeServer::process_and_close_socket(socket_t sock) {
   const auto writeTimeout = std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_);
   bool refuse = false, draining = false, over = false;
   {
     std::lock_guard lock(mu_);
     draining = draining_;
-    over = !draining && open_.size() >= maxConnections_;
+    over = !draining && open_.size() - std::min(streaming_, open_.size()) >= maxConnections_;
     refuse = draining || (over && overCapacityNow_ >= kOverCapacityConnections);
     if (!refuse && !over) open_.insert(sock);
     if (over && !refuse) ++overCapacityNow_;  // not among the open: they stay maxConnections

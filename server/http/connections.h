@@ -6,7 +6,7 @@
 // owns the rest:
 //   - a request's headers and body must all arrive within the read timeout, counted from its
 //     first byte: otherwise a 408 problem, and the connection is closed;
-//   - past `maxConnections` open connections, up to kOverCapacityConnections more at once are read for
+//   - past `maxConnections` open connections (a stream's not among them: holdAsStream), up to kOverCapacityConnections more at once are read for
 //     one request each within kOverCapacityReadMs and closed after its answer: health and
 //     readiness are answered, a client over its own share hears 429 (an event stream: streams.h),
 //     anything else 503 (overCapacity()); past those, a new connection gets a 503 at once;
@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <set>
 
@@ -42,6 +43,11 @@ class EdgeServer : public httplib::Server {
   // readiness and a client's own refusal are answered there, the rest get overCapacityProblem().
   static bool overCapacity();
   static ApiError overCapacityProblem();
+  // Called while answering a request that becomes a long answer (an event stream, streams.h):
+  // until the token is dropped, its connection does not count against maxConnections, so the
+  // connections and threads requests need stay free. The streams' own bound (--max-streams) is
+  // the caller's; the pool has a thread for each beyond maxConnections.
+  std::shared_ptr<void> holdAsStream();
   static constexpr int kOverCapacityReadMs = 1000;
   static constexpr size_t kMaxSkippedBody = 64 << 10;
 
@@ -66,13 +72,14 @@ class EdgeServer : public httplib::Server {
   std::set<socket_t> open_;
   bool draining_ = false;
   size_t overCapacityNow_ = 0;  // connections being read past maxConnections (under mu_)
+  size_t streaming_ = 0;        // of open_, those holding a stream (holdAsStream; under mu_)
   std::atomic<uint64_t> refused_{0}, timedOut_{0}, drained_{0}, overCapacity_{0};
 };
 
 // Connections past maxConnections read for one request at once (health, a client's refusal).
 constexpr size_t kOverCapacityConnections = 16;
-// Threads a listener needs beyond one per connection: those, and the ones that answer 503 at once
-// past them.
+// Threads a listener needs beyond one per connection and one per stream: those, and the ones
+// that answer 503 at once past them.
 constexpr size_t kRefusalThreads = kOverCapacityConnections + 16;
 
 }  // namespace effectd

@@ -253,7 +253,8 @@ void Service::answerJobStatus(const httplib::Request& req, httplib::Response& re
 
 void Service::answerJobEvents(const httplib::Request& req, httplib::Response& res) {
   // A stream holds its connection and thread while the job runs: one of the client's share
-  // first (http/streams.h), and none at all on a connection past --max-connections.
+  // first (http/streams.h), and none at all on a connection past --max-connections; then the
+  // connection is counted among the streams, not the connections requests need.
   std::shared_ptr<void> place;
   const std::string client = tl.key ? "key " + tl.key->id : "address " + req.remote_addr;
   const int most = tl.key ? (tl.key->maxStreams > 0 ? tl.key->maxStreams : config_.keyMaxStreams)
@@ -263,6 +264,8 @@ void Service::answerJobEvents(const httplib::Request& req, httplib::Response& re
                                    : "the address " + req.remote_addr + " (--max-streams-per-address)";
   if (auto problem = streams_->enter(client, most, whose, place)) return writeProblem(res, *problem, tl.requestId);
   if (EdgeServer::overCapacity()) return writeProblem(res, EdgeServer::overCapacityProblem(), tl.requestId);
+  // From here the connection is the stream's, not one of --max-connections.
+  place = std::make_shared<std::pair<std::shared_ptr<void>, std::shared_ptr<void>>>(std::move(place), http_->holdAsStream());
   auto first = jobOf(req, res);
   if (!first) return;
   // One event per change: "progress" while queued or running, then one named by the final

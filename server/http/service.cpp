@@ -271,8 +271,10 @@ const Service::Route* Service::findRoute(const std::string& path) const {
 
 void Service::installCore() {
   httplib::Server& s = *http_;
-  const size_t threads = size_t(config_.threads), connections = size_t(config_.maxConnections);
-  s.new_task_queue = [threads, connections] { return new ElasticPool(threads, connections + kRefusalThreads); };
+  // A thread for each connection, each stream (beyond the connections: holdAsStream) and each refusal.
+  const size_t threads = size_t(config_.threads),
+               most = size_t(config_.maxConnections) + size_t(streams_->total()) + kRefusalThreads;
+  s.new_task_queue = [threads, most] { return new ElasticPool(threads, most); };
   s.set_payload_max_length(config_.limits.maxBodyBytes);
   s.set_read_timeout(config_.readTimeoutS, 0);
   s.set_write_timeout(config_.writeTimeoutS, 0);

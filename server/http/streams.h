@@ -4,8 +4,9 @@
 //   - a client's own: an API key's `maxStreams` (absent: --key-max-streams), or without keys the
 //     client address's --max-streams-per-address; past it that client gets 429 with Retry-After,
 //     and no one else notices;
-//   - all of them together: --max-streams, less than --max-connections, so that streams can
-//     never hold the connections and threads that requests need; past it, 503.
+//   - all of them together: --max-streams; past it, 503. A stream's connection and thread are
+//     not among --max-connections (EdgeServer::holdAsStream): the pool has --max-streams threads
+//     more, so streams never hold the connections and threads that requests need.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +23,7 @@ namespace effectd {
 class Streams {
  public:
   explicit Streams(int total) : total_(total) {}
+  int total() const { return total_; }
 
   // One more stream for `client` ("key <id>" or "address <ip>"), of at most `most` at once
   // (0: no share of its own), named in a refusal by `whose` ("the key 'a' (its maxStreams)").
