@@ -501,8 +501,10 @@ def streams(binary):
         print(f"      meanwhile key B: {len(others) - len(bad)} of {len(others)} fog tables and /healthz answered 200")
         check(not bad, f"key B's fog tables and /healthz are all 200 while A holds its streams ({bad[:3]})")
         _, _, metrics, _ = request(port, "GET", "/metrics")
-        check(b"effectd_streams_held 8" in metrics and b'effectd_streams_refused_total{reason="client"} 72' in metrics,
-              "/metrics counts the streams held and the refused")
+        check(b"effectd_streams_held 8" in metrics and b'effectd_streams_refused_total{reason="client"} 72' in metrics
+              and b'effectd_key_streams_refused_total{key="a"} 72' in metrics
+              and b'effectd_key_streams_refused_total{key="b"}' not in metrics,
+              "/metrics counts the streams held and the refused, per key")
         for s in socks:
             s.close()
     finally:

@@ -10,6 +10,7 @@ std::optional<ApiError> Streams::enter(const std::string& client, int most, cons
     const int mine = it == held_.end() ? 0 : it->second;
     if (most > 0 && mine >= most) {
       ++refusedClient_;
+      if (client.rfind("key ", 0) == 0) ++refusedByKey_[client.substr(4)];
       return ApiError{429,
                       "too-many-streams",
                       "Too Many Requests",
@@ -46,7 +47,15 @@ Streams::Counts Streams::counts() const {
 
 std::string Streams::metricsText() const {
   const Counts c = counts();
-  return "# HELP effectd_streams_held Event streams being served (GET /v1/jobs/{id}/events).\n"
+  std::string byKey =
+      "# HELP effectd_key_streams_refused_total Event streams refused to an API key past its share (429).\n"
+      "# TYPE effectd_key_streams_refused_total counter\n";
+  {
+    std::lock_guard lock(mu_);
+    for (const auto& [id, n] : refusedByKey_)
+      byKey += "effectd_key_streams_refused_total{key=\"" + id + "\"} " + std::to_string(n) + "\n";
+  }
+  return byKey + "# HELP effectd_streams_held Event streams being served (GET /v1/jobs/{id}/events).\n"
          "# TYPE effectd_streams_held gauge\n"
          "effectd_streams_held " + std::to_string(c.held) + "\n" +
          "# HELP effectd_streams_refused_total Event streams refused, by reason: the client's own share "

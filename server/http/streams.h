@@ -45,6 +45,7 @@ class Streams {
   std::map<std::string, int> held_;  // by client, only while it holds some
   size_t all_ = 0;
   uint64_t refusedClient_ = 0, refusedTotal_ = 0;
+  std::map<std::string, uint64_t> refusedByKey_;  // by key id (ids are few; addresses are not counted so)
 };
 
 }  // namespace effectd
