@@ -9,7 +9,7 @@ using System.Runtime.InteropServices;
 using System.Text;
 
 static class Native {
-  const string Lib = "libeffects.so";
+  const string Lib = "effects";  // as Unity names it: libeffects.so here, effects.dll on Windows
 
   [StructLayout(LayoutKind.Sequential)]
   public struct BoltParams {

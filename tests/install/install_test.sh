@@ -3,7 +3,8 @@
 # it twice, with find_package(effectd CONFIG) (static and shared) and with pkg-config; each
 # program's fog table, bolt and tangents must equal the server's answers to the same
 # parameters. Also: the shared library's SONAME, the headers and package files, and
-# docs/engines.md's C snippet compiled against the prefix.
+# docs/engines.md's C snippet compiled against the prefix, by pkg-config and by its C-only CMake
+# project linking the archive.
 #   install_test.sh BUILD_DIR EFFECTD_BINARY
 set -euo pipefail
 # shellcheck source=/dev/null
@@ -62,6 +63,24 @@ cc -std=c99 -Wall -Wextra -pedantic -Werror "$work/snippet.c" -o "$work/snippet"
 printed=$(env -u LD_LIBRARY_PATH "$work/snippet") || fail "docs/engines.md's C snippet failed (run as built, no LD_LIBRARY_PATH)"
 grep -q "^[0-9]* cells$" <<<"$printed" || fail "docs/engines.md's C snippet did not print its cells"
 echo "ok   docs/engines.md's C snippet: $printed"
+# The same snippet as bolt.c in docs/engines.md's C-only CMake project (its cmake block with
+# LANGUAGES C, as printed) linking the archive, effectd::effects: the target carries its C++
+# runtime and libm (effects/CMakeLists.txt).
+mkdir -p "$work/c_consumer"
+cp "$work/snippet.c" "$work/c_consumer/bolt.c"
+{
+  echo "cmake_minimum_required(VERSION 3.18)"
+  awk '/^```cmake$/{on=1; block=""; next} /^```/{if (on && block ~ /LANGUAGES C\)/) {printf "%s", block; exit} on=0} on{block = block $0 "\n"}' \
+    "$root/docs/engines.md"
+} >"$work/c_consumer/CMakeLists.txt"
+grep -q "effectd::effects)" "$work/c_consumer/CMakeLists.txt" || fail "no C-only CMake project in docs/engines.md"
+cmake -S "$work/c_consumer" -B "$work/c_build" -DCMAKE_PREFIX_PATH="$prefix" >"$work/c_cmake.log" 2>&1 ||
+  { cat "$work/c_cmake.log"; fail "find_package(effectd) from a C-only project"; }
+cmake --build "$work/c_build" >"$work/c_build.log" 2>&1 || { tail -20 "$work/c_build.log"; fail "a C-only CMake project does not link effectd::effects"; }
+linked=$(ldd "$work/c_build/bolt") || fail "ldd $work/c_build/bolt"
+! grep -q libeffects <<<"$linked" || fail "the C-only project linked libeffects.so, not the archive"
+printed=$("$work/c_build/bolt") || fail "the C-only project's snippet failed"
+echo "ok   a C-only CMake project links effectd::effects (the archive): $printed"
 
 "$bin" --port 0 --access-log 0 2>"$work/log" &
 pid=$!
