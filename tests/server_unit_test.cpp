@@ -75,6 +75,9 @@ TEST(Schema, ReportsPointers) {
   EXPECT_EQ(first(json{{"n", 0}}), "/n must be >= 1");
   EXPECT_EQ(first(json{{"n", 2.5}}), "/n must be integer, got number");
   EXPECT_EQ(first(json{{"n", 2}, {"x~y/z", 1}}), "/x~0y~1z is not a known field");
+  // The nearest known field, when one is near and nearer than the others.
+  EXPECT_EQ(first(json{{"n", 2}, {"V", {1}}}), "/V is not a known field: did you mean \"v\"?");
+  EXPECT_EQ(first(json{{"n", 2}, {"oo", {1}}}), "/oo is not a known field: did you mean \"o\"?");
   EXPECT_EQ(first(json{{"n", 2}, {"v", {1, "a"}}}), "/v/1 must be number, got string");
   EXPECT_EQ(first(json{{"n", 2}, {"v", {1, 2, 3}}}), "/v must have at most 2 items");
   EXPECT_EQ(first(json{{"n", 2}, {"e", "z"}}), "/e must be one of [\"x\",\"y\"]");

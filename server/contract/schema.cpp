@@ -1,9 +1,13 @@
 #include "contract/schema.h"
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <set>
 #include <stdexcept>
+#include <string_view>
+#include <vector>
 
 namespace effectd {
 
@@ -121,6 +125,39 @@ std::string exclusiveMembers(const json& alternatives) {
   std::string out;
   for (size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
   return out;
+}
+
+// Letters to turn `a` into `b` (insertions, deletions, substitutions and swaps of neighbours,
+// case ignored): how far an unknown field is from a known one.
+size_t editDistance(std::string_view a, std::string_view b) {
+  const auto lower = [](char c) { return char(std::tolower(static_cast<unsigned char>(c))); };
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const bool same = lower(a[i - 1]) == lower(b[j - 1]);
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (same ? 0 : 1)});
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1]))
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// "is not a known field", with the one known field it most likely meant: within a third of its
+// letters (at least one), and nearer than any other ("colour" -> "color", "fogtype" -> "fogType").
+template <typename Properties>
+std::string unknownField(const std::string& key, const Properties& known) {
+  std::string best;
+  size_t bestDistance = std::max<size_t>(1, key.size() / 3) + 1, ties = 0;
+  if (key.size() <= 64)  // a long key is no typo; the distance costs its length squared
+    for (const auto& [name, _] : known) {
+      const size_t d = editDistance(key, name);
+      if (d < bestDistance) best = name, bestDistance = d, ties = 0;
+      else if (d == bestDistance) ++ties;
+    }
+  if (best.empty() || ties) return "is not a known field";
+  return "is not a known field: did you mean \"" + best + "\"?";
 }
 
 }  // namespace
@@ -369,7 +406,7 @@ void SchemaRegistry::check(const Node& s, const json& v, const Path& path, Ctx& 
       if (auto p = s.properties.find(key); p != s.properties.end())
         check(*p->second, value, member, ctx);
       else if (s.additional == Node::Additional::kForbidden)
-        ctx.add(member, "is not a known field");
+        ctx.add(member, unknownField(key, s.properties));
       else if (s.additional == Node::Additional::kSchema)
         check(*s.additionalSchema, value, member, ctx);
     }
