@@ -96,6 +96,7 @@ std::string RedisClient::lastProblem() const {
 }
 
 bool RedisClient::connect() {
+  refused_.clear();  // a refusal is this connection's, not the last one's
   addrinfo hints{}, *found = nullptr;
   hints.ai_socktype = SOCK_STREAM;
   if (getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found) != 0 || !found) return false;
@@ -125,7 +126,6 @@ bool RedisClient::authenticate() {
   args.push_back(password_);
   const std::string request = encoded(args);
   RedisReply reply;
-  refused_.clear();
   if (!send(request) || !readReply(reply, 0)) return false;
   buffer_.erase(0, read_);
   read_ = 0;
